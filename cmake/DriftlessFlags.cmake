@@ -1,0 +1,27 @@
+# driftless_flags: the warning and sanitizer settings every one of our targets links privately.
+# (no global CMAKE_CXX_FLAGS: third-party code is compiled as its packagers intended)
+add_library(driftless_flags INTERFACE)
+add_library(driftless::flags ALIAS driftless_flags)
+target_compile_options(driftless_flags INTERFACE -Wall -Wextra -Werror)
+if(DRIFTLESS_SANITIZE)
+  target_compile_options(driftless_flags INTERFACE
+    -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer)
+  target_link_options(driftless_flags INTERFACE -fsanitize=address,undefined)
+endif()
+
+# the repository root is the include root, so an include names its folder:
+#   #include "estimator/log.hpp"   (and estimator/ never includes twin/, hil_bridge/ or renders/)
+set(DRIFTLESS_SOURCE_ROOT ${PROJECT_SOURCE_DIR})
+
+# driftless_add_test(name SOURCES ... LIBS ...): one GoogleTest binary registered with CTest.
+function(driftless_add_test name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;LIBS;LABELS" ${ARGN})
+  add_executable(${name} ${ARG_SOURCES})
+  target_link_libraries(${name} PRIVATE ${ARG_LIBS} GTest::gtest GTest::gtest_main driftless::flags)
+  target_compile_definitions(${name} PRIVATE
+    DRIFTLESS_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
+    DRIFTLESS_BINARY_DIR="${PROJECT_BINARY_DIR}")
+  set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR}/tests)
+  gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60 PROPERTIES LABELS "${ARG_LABELS}"
+    WORKING_DIRECTORY ${PROJECT_BINARY_DIR})
+endfunction()

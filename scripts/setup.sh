@@ -1,0 +1,27 @@
+#!/usr/bin/env bash
+# Install everything DriftLess Twin needs from Debian 12 packages. Idempotent: skips apt when all present.
+set -euo pipefail
+packages=(
+  build-essential cmake pkg-config ccache git
+  libmujoco-dev libqhull-dev libeigen3-dev libyaml-cpp-dev libosmesa6-dev
+  libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev libfmt-dev libfast-float-dev
+  ffmpeg gnuplot-nox openmpi-bin libopenmpi-dev
+)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "setup: all ${#packages[@]} Debian packages present"
+  exit 0
+fi
+echo "setup: installing ${missing[*]}"
+sudo_cmd=()
+if [ "$(id -u)" -ne 0 ]; then
+  command -v sudo >/dev/null || { echo "setup: need root (or sudo) to install: ${missing[*]}" >&2; exit 1; }
+  sudo_cmd=(sudo)
+fi
+export DEBIAN_FRONTEND=noninteractive
+"${sudo_cmd[@]}" apt-get update -qq
+"${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+echo "setup: done"
