@@ -25,3 +25,32 @@ function(driftless_add_test name)
   gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60 PROPERTIES LABELS "${ARG_LABELS}"
     WORKING_DIRECTORY ${PROJECT_BINARY_DIR})
 endfunction()
+
+# driftless_add_tests_in_folder(LIBS ...): every test_*.cpp / slow_test_*.cpp here is one binary.
+function(driftless_add_tests_in_folder)
+  cmake_parse_arguments(ARG "" "" "LIBS" ${ARGN})
+  file(GLOB files CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/test_*.cpp
+       ${CMAKE_CURRENT_SOURCE_DIR}/slow_test_*.cpp)
+  get_filename_component(folder ${CMAKE_CURRENT_SOURCE_DIR} NAME)
+  foreach(f ${files})
+    get_filename_component(stem ${f} NAME_WE)
+    set(labels ${folder})
+    if(stem MATCHES "^slow_")
+      list(APPEND labels slow)
+    endif()
+    driftless_add_test(${folder}_${stem} SOURCES ${f} LIBS ${ARG_LIBS} LABELS "${labels}")
+  endforeach()
+endfunction()
+
+# driftless_add_benchmarks_in_folder(LIBS ...): every bench_*.cpp here is one benchmark program.
+function(driftless_add_benchmarks_in_folder)
+  cmake_parse_arguments(ARG "" "" "LIBS" ${ARGN})
+  file(GLOB files CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/bench_*.cpp)
+  foreach(f ${files})
+    get_filename_component(stem ${f} NAME_WE)
+    add_executable(${stem} ${f})
+    target_link_libraries(${stem} PRIVATE ${ARG_LIBS} benchmark::benchmark driftless::flags)
+    target_compile_definitions(${stem} PRIVATE DRIFTLESS_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+    set_target_properties(${stem} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR}/bench)
+  endforeach()
+endfunction()
