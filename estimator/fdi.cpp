@@ -113,6 +113,7 @@ void FaultDetector::check_stuck(const FdiInput& in) {
       f.t_alarm_s = f.t_isolated_s = in.t_s;
       f.t_onset_s = in.t_s - run_[i] / p_.sample_rate_hz;
       f.magnitude = v;
+      f.bias_before_dps = in.bias_dps;
       fault_ = f;
       if (!first_alarm_s_) first_alarm_s_ = in.t_s;
     }
@@ -289,6 +290,7 @@ void FaultDetector::try_classify(double t_s) {
     f.t_onset_s = t_onset_;
     f.magnitude = ratio[j_noise];
     f.confident = std::abs(z) >= p_.noise_sign_z;
+    f.bias_before_dps = bias_ref_;
     fault_ = f;
     return;
   }
@@ -338,6 +340,7 @@ void FaultDetector::try_classify(double t_s) {
     f.magnitude = std::abs(slope);
     f.sensor_ambiguous = true;
     kind_ = FaultKind::kScaleChange;
+    f.bias_before_dps = bias_ref_;
     fault_ = f;
     return;
   }
@@ -399,6 +402,7 @@ void FaultDetector::try_isolate_mean(double t_s, bool timeout) {
   f.t_onset_s = t_onset_;
   f.magnitude = mag[order[0]];
   f.confident = decided;
+  f.bias_before_dps = bias_ref_;
   fault_ = f;
 }
 

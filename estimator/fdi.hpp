@@ -73,6 +73,7 @@ struct FaultReport {
   double magnitude = 0.0;  // bias step: deg/s; scale: relative gain change; noise: variance ratio
   bool confident = true;   // false: reported at the isolation timeout as the best guess
   bool sensor_ambiguous = false;  // scale changes: see docs/fdi.md (+e on 1 == -e/(1+e) on 2)
+  Vector6d bias_before_dps = Vector6d::Zero();  // filter estimate just before the onset, deg/s
   std::string describe() const;
 };
 
