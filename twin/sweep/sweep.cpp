@@ -141,6 +141,7 @@ SweepConfig parse_sweep(const std::string& yaml_text, const std::string& file,
           }
         }
         if (kv.second["vector3"]) a.vector3 = kv.second["vector3"].as<bool>();
+        if (kv.second["boolean"]) a.boolean = kv.second["boolean"].as<bool>();
         if (const auto r = kv.second["range"]) {  // {range: [from, to, step]}
           if (!r.IsSequence() || r.size() != 3) fail(file, r, "'range' is [from, to, step]");
           const double from = as_double(file, r[0], "range"), to = as_double(file, r[1], "range"),
@@ -207,7 +208,8 @@ SweepConfig load_sweep(const std::filesystem::path& path) {
 }
 
 std::uint64_t run_seed(std::uint64_t base_seed, int mc) {
-  return splitmix64(base_seed * 0x100000001B3ull + static_cast<std::uint64_t>(mc)) >> 1;
+  // 31 bits: scenario files and other tools read a seed as a plain integer
+  return splitmix64(base_seed * 0x100000001B3ull + static_cast<std::uint64_t>(mc)) >> 33;
 }
 
 std::vector<RunSpec> expand(const SweepConfig& cfg) {

@@ -22,6 +22,7 @@ struct GridAxis {
   std::vector<std::string> set;     // dotted key paths the value goes to (default: {name})
   std::vector<double> values;
   bool vector3 = false;             // write [v, v, v] (for per-axis 3-vector keys)
+  bool boolean = false;             // write true (v != 0) or false (for enabled switches)
 };
 
 /// Which plot to draw from the summary table (gnuplot).
@@ -69,7 +70,7 @@ struct RunSpec {
 
 /// Every run, in index order (last grid axis varies fastest, then the Monte-Carlo index).
 std::vector<RunSpec> expand(const SweepConfig& cfg);
-/// The seed of Monte-Carlo run `mc` (splitmix64 of the base seed and mc; same for every point).
+/// The seed of Monte-Carlo run `mc` (31 bits of splitmix64 of the base seed and mc; same for every point).
 std::uint64_t run_seed(std::uint64_t base_seed, int mc);
 
 /// Named results of one run, in a fixed order.
