@@ -108,4 +108,21 @@ void ResidualChart::push(const Sample& s, bool at_rest) {
   }
 }
 
+BiasChart::BiasChart(int sensor, double window_s, int points)
+    : chart_(fmt::format("bias {} estimate xyz, pale: true (deg/s)", sensor),
+             {{"est x", {0.95f, 0.25f, 0.25f}},
+              {"est y", {0.25f, 0.85f, 0.25f}},
+              {"est z", {0.35f, 0.5f, 1.0f}},
+              {"true x", {1.0f, 0.7f, 0.7f}},
+              {"true y", {0.7f, 1.0f, 0.7f}},
+              {"true z", {0.75f, 0.8f, 1.0f}}},
+             window_s),
+      bucket_s_(window_s / points) {}
+
+void BiasChart::push(double t_s, const Eigen::Vector3d& est, const Eigen::Vector3d& truth) {
+  if (!std::isnan(last_push_s_) && t_s - last_push_s_ < bucket_s_) return;
+  last_push_s_ = t_s;
+  chart_.push(t_s, {est[0], est[1], est[2], truth[0], truth[1], truth[2]});
+}
+
 }  // namespace driftless::render
