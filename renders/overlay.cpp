@@ -40,8 +40,9 @@ OverlayText overlay_text(const std::string& title, double t_s, double speed, boo
     next = fmt::format("~{:.1f} s, platform {}", st.next_flip_s, st.next_platform + 1);
   }
   const std::string att = std::isnan(st.attitude_error_deg)
-                              ? std::string("n/a (no attitude estimate)")
-                              : fmt::format("{:.3f} deg", st.attitude_error_deg);
+                              ? std::string("n/a (needs ref_q and the estimator)")
+                              : fmt::format("{:.4f} deg (DriftLess-corrected)",
+                                            st.attitude_error_deg);
   const int h = static_cast<int>(t_s / 3600.0);
   const int mi = static_cast<int>((t_s - 3600.0 * h) / 60.0);
   const double sec = t_s - 3600.0 * h - 60.0 * mi;

@@ -7,6 +7,7 @@
 #include <optional>
 #include <vector>
 
+#include "estimator/attitude.hpp"
 #include "estimator/filter.hpp"
 #include "estimator/log.hpp"
 #include "renders/overlay.hpp"
@@ -42,6 +43,8 @@ class Telemetry {
   ResidualChart residual_;
   std::unique_ptr<est::DriftlessFilter> filter_;
   std::optional<BiasChart> bias1_, bias2_;
+  std::optional<est::AttitudeIntegrator> attitude_;  // from the filter's corrected body rate
+  double attitude_error_deg_ = kNaN;
 };
 
 }  // namespace driftless::render
