@@ -316,7 +316,7 @@ int run_estimate_cmd(const EstimateArgs& a) {
     fmt::print("  attitude drift: {:.2f} deg/h with DriftLess, {:.2f} deg/h without\n",
                summary.drift_corrected_deg_per_h, summary.drift_raw_deg_per_h);
   }
-  if (truth) {
+  if (truth && summary.truth.updates > 0) {
     fmt::print("  against truth: bias error rms {:.5f} deg/s, mean NEES {:.2f} (95 % band {:.2f}..{:.2f})\n",
                summary.truth.bias_error_rms_dps, summary.truth.nees_mean, summary.truth.nees_mean_band_lo,
                summary.truth.nees_mean_band_hi);
