@@ -15,7 +15,9 @@
 #include "cli/command.hpp"
 #include "cli/plot.hpp"
 #include "estimator/allan.hpp"
+#include "estimator/calibration.hpp"
 #include "estimator/pipeline.hpp"
+#include "twin/calib/calib_file.hpp"
 
 namespace driftless::cli {
 namespace {
@@ -27,6 +29,7 @@ struct EstimateArgs {
   std::string out;
   std::string mode;  // empty = config / general
   std::string config;
+  std::string calib;  // calib.yaml from driftless calibrate (docs/calibration.md)
   bool plot = false;
 };
 
@@ -84,9 +87,17 @@ class FileSink : public est::EstimateSink {
     fmt::format_to(std::back_inserter(b), ",{}\n", est::to_string(o.status));
     if (b.size() > (1u << 20)) flush();
     if (keep_series_ && s.gyros_finite()) {
+      if (o.status == est::PushStatus::kMoving) platforms_moved_ = true;
+      // fused body rate, holding the last value while no platform is at rest
+      if (o.rate_body_dps.allFinite()) {
+        last_rate_ = o.rate_body_dps;
+        last_raw_rate_ = o.rate_body_raw_dps;
+      }
       for (int i = 0; i < 3; ++i) {
         raw1_[i].push_back(static_cast<float>(s.gyro1_dps[i]));
         cor1_[i].push_back(static_cast<float>(o.y1c_dps[i]));
+        raw_rate_[i].push_back(static_cast<float>(last_raw_rate_[i]));
+        cor_rate_[i].push_back(static_cast<float>(last_rate_[i]));
       }
     }
   }
@@ -128,9 +139,12 @@ class FileSink : public est::EstimateSink {
     attitude_.close();
   }
 
-  std::vector<float> raw1_[3], cor1_[3];
+  std::vector<float> raw1_[3], cor1_[3];          // sensor 1 output, raw and corrected
+  std::vector<float> raw_rate_[3], cor_rate_[3];  // fused body rate, raw and corrected
+  bool platforms_moved_ = false;
 
  private:
+  Eigen::Vector3d last_rate_ = Eigen::Vector3d::Zero(), last_raw_rate_ = Eigen::Vector3d::Zero();
   fmt::ostream corrected_, estimate_, attitude_;
   fmt::memory_buffer buf_;
   bool truth_;
@@ -200,18 +214,21 @@ std::vector<std::string> make_plots(const fs::path& dir, FileSink& sink, bool tr
     body += "  unset multiplot\n";
     if (auto w = render_gnuplot(dir, "fig4_bias", body); !w.empty()) warnings.push_back(w);
   }
-  // Fig. 5: Allan deviation of sensor 1, raw against corrected
+  // Fig. 5: Allan deviation raw against corrected: sensor 1's axes on a static run (the paper's
+  // Fig. 5); when the platforms flip, the sensor outputs carry the flips, so the fused body rate
   if (!sink.raw1_[0].empty() && sink.raw1_[0].size() >= 3 && std::isfinite(rate_hz)) {
     std::vector<AllanTableColumn> cols;
     est::AllanOptions opt;
     opt.sample_rate_hz = rate_hz;
+    const bool fused = sink.platforms_moved_;
     for (int pass = 0; pass < 2; ++pass) {
       for (int a = 0; a < 3; ++a) {
-        const auto& src = pass == 0 ? sink.raw1_[a] : sink.cor1_[a];
+        const auto& src = fused ? (pass == 0 ? sink.raw_rate_[a] : sink.cor_rate_[a])
+                                : (pass == 0 ? sink.raw1_[a] : sink.cor1_[a]);
         std::vector<double> x(src.begin(), src.end());
         const auto curve = est::allan_deviation(x, opt);
         AllanTableColumn c;
-        c.name = fmt::format("{}gyro1_{}", pass == 0 ? "raw_" : "corrected_", "xyz"[a]);
+        c.name = fmt::format("{}{}_{}", pass == 0 ? "raw_" : "corrected_", fused ? "rate" : "gyro1", "xyz"[a]);
         for (const auto& p : curve.points) {
           c.tau_s.push_back(p.tau_s);
           c.adev.push_back(p.adev);
@@ -222,9 +239,11 @@ std::vector<std::string> make_plots(const fs::path& dir, FileSink& sink, bool tr
       }
     }
     write_allan_table(dir / "allan_fig5.csv", cols);
-    std::string body = "  set logscale xy; set xlabel 'tau [s]'; set ylabel 'Allan deviation [deg/s]'\n"
-                       "  set title 'Fig. 5: Allan deviation of sensor 1, raw (red) and DriftLess-corrected (black)'\n"
-                       "  plot ";
+    std::string body = fmt::format(
+        "  set logscale xy; set xlabel 'tau [s]'; set ylabel 'Allan deviation [deg/s]'\n"
+        "  set title 'Fig. 5: Allan deviation of {}, raw (red) and DriftLess-corrected (black)'\n"
+        "  plot ",
+        fused ? "the fused body rate" : "sensor 1");
     for (int i = 0; i < 6; ++i) {
       body += fmt::format("'allan_fig5.csv' using 1:{} with linespoints lc rgb '{}' dt {} title columnhead({}){}",
                           2 + 3 * i, i < 3 ? "red" : "black", 1 + i % 3, 2 + 3 * i, i < 5 ? ", " : "\n");
@@ -259,10 +278,24 @@ int run_estimate_cmd(const EstimateArgs& a) {
     cfg = est::paper_config();
   }
   if (!a.mode.empty()) est::set_config_value(cfg, "mode", a.mode);
-  // --calib hook (issue 4): fill cfg.calibration with the calibrated matrices M here
+  log::LogReader reader(a.log);
+  // --calib: the calibrated matrices M replace R in eq. (1)-(2) (docs/calibration.md)
+  if (!a.calib.empty()) {
+    const twin::calib::CalibFile c = twin::calib::load_calib(a.calib);
+    const auto& meta = reader.metadata();
+    if ((c.hinge1_axis.normalized() - meta.hinge1_axis().normalized()).norm() > 1e-6 ||
+        (c.hinge2_axis.normalized() - meta.hinge2_axis().normalized()).norm() > 1e-6) {
+      throw std::invalid_argument(fmt::format(
+          "--calib {}: calibrated for hinge axes [{} {} {}] / [{} {} {}] but the log {} has [{} {} {}] / "
+          "[{} {} {}]: not the same box", a.calib, c.hinge1_axis.x(), c.hinge1_axis.y(), c.hinge1_axis.z(),
+          c.hinge2_axis.x(), c.hinge2_axis.y(), c.hinge2_axis.z(), a.log, meta.hinge1_axis().x(),
+          meta.hinge1_axis().y(), meta.hinge1_axis().z(), meta.hinge2_axis().x(), meta.hinge2_axis().y(),
+          meta.hinge2_axis().z()));
+    }
+    cfg.calibration = est::to_filter_calibration(c.M);
+  }
   cfg.validate();
 
-  log::LogReader reader(a.log);
   const bool truth = (reader.fields() & kFieldTrueBias) != 0;
   const bool attitude = (reader.fields() & kFieldRefQ) != 0;
   fs::create_directories(a.out);
@@ -343,6 +376,11 @@ const bool registered = register_command(30, [](CLI::App& app) {
   cmd->add_option("--config", a->config,
                   "Estimator configuration, 'key: value' lines (units in the key names: _s, _deg, "
                   "_dps, _dps_rthz, _dps2; docs/estimator.md)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--calib", a->calib,
+                  "Calibration file from 'driftless calibrate' (calib.yaml): the matrices M per "
+                  "sensor and end stop (deg/s in, deg/s out) replace the hinge rotations; "
+                  "docs/calibration.md")
       ->check(CLI::ExistingFile);
   cmd->add_flag("--plot", a->plot,
                 "Also write Fig. 4 (bias vs truth, deg/s), Fig. 5 (Allan deviation, deg/s vs s) and "
