@@ -45,6 +45,9 @@ class I2cSource final : public SampleSource {
   std::string name() const override { return "i2c:" + bus_.name(); }
   double sample_rate_hz() const override { return p_.sample_rate_hz; }
   std::uint32_t fields() const override { return kFieldAccel | kFieldTemp; }
+  bool knows_platforms() const override { return false; }
+  /// Host-clock time (Clock seconds) at which the sample stamped t_s was due: for latency figures.
+  double host_time_of(double t_s) const { return t0_host_s_ + t_s + 1.0 / p_.sample_rate_hz; }
 
   Status configure() override;
   Status activate() override;
