@@ -37,11 +37,6 @@ int run_hil(const HilOptions& o) {
     throw std::invalid_argument("hil: --switch-to needs --at T (session time of the switch, s)");
   }
   if (o.switch_to.empty() && !std::isnan(o.at_s)) throw std::invalid_argument("hil: --at needs --switch-to SOURCE");
-  const bool hardware = o.source.rfind("i2c:", 0) == 0 || o.source.rfind("serial:", 0) == 0 ||
-                        o.source == "emu-serial";
-  if (std::isnan(o.duration_s) && !hardware && o.source.rfind("replay:", 0) != 0 && o.source != "twin") {
-    throw std::invalid_argument("hil: " + o.source + " streams forever: give --duration S (s)");
-  }
   std::filesystem::create_directories(o.out_dir);
 
   hil::RigOptions ro;
@@ -54,6 +49,11 @@ int run_hil(const HilOptions& o) {
   auto first = hil::make_source_rig(o.source, ro);
   std::unique_ptr<hil::SourceRig> second;
   if (!o.switch_to.empty()) second = hil::make_source_rig(o.switch_to, ro);
+  const bool hardware = o.source.rfind("i2c:", 0) == 0 || o.source.rfind("serial:", 0) == 0 ||
+                        o.source == "emu-serial";
+  if (std::isnan(o.duration_s) && !hardware && o.source.rfind("replay:", 0) != 0 && o.source != "twin") {
+    throw std::invalid_argument("hil: " + o.source + " streams forever: give --duration S (s)");
+  }
 
   // every device is checked before anything runs: a missing one is one clear error
   for (hil::SourceRig* rig : {first.get(), second.get()}) {
