@@ -185,12 +185,13 @@ std::vector<std::string> make_plots(const fs::path& dir, FileSink& sink, bool tr
     for (int sensor = 1; sensor <= 2; ++sensor) {
       const int c0 = sensor == 1 ? 2 : 5;
       body += fmt::format("  set title 'sensor {}'\n  plot ", sensor);
+      static constexpr const char* kColour[3] = {"#d62728", "#2ca02c", "#1f77b4"};
       for (int a = 0; a < 3; ++a) {
-        body += fmt::format("'estimate.csv' using 1:{} with lines lw 2 title 'b{}_{} est', ", c0 + a, sensor,
-                            "xyz"[a]);
+        body += fmt::format("'estimate.csv' using 1:{} with lines lw 2 lc rgb '{}' title 'b{}_{} estimate', ",
+                            c0 + a, kColour[a], sensor, "xyz"[a]);
         if (truth) {
-          body += fmt::format("'estimate.csv' using 1:{} with lines dt 2 title 'b{}_{} true', ", c0 + a + 19,
-                              sensor, "xyz"[a]);
+          body += fmt::format("'estimate.csv' using 1:{} with lines dt 2 lc rgb '{}' title 'b{}_{} true', ",
+                              c0 + a + 19, kColour[a], sensor, "xyz"[a]);
         }
       }
       body.resize(body.size() - 2);
@@ -316,7 +317,7 @@ int run_estimate_cmd(const EstimateArgs& a) {
     fmt::print("  attitude drift: {:.2f} deg/h with DriftLess, {:.2f} deg/h without\n",
                summary.drift_corrected_deg_per_h, summary.drift_raw_deg_per_h);
   }
-  if (truth) {
+  if (truth && summary.truth.updates > 0) {
     fmt::print("  against truth: bias error rms {:.5f} deg/s, mean NEES {:.2f} (95 % band {:.2f}..{:.2f})\n",
                summary.truth.bias_error_rms_dps, summary.truth.nees_mean, summary.truth.nees_mean_band_lo,
                summary.truth.nees_mean_band_hi);

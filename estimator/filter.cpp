@@ -241,7 +241,7 @@ bool DriftlessFilter::update(const Eigen::Matrix<double, D, 1>& r, const Eigen::
   } else {
     P_ = IKH * P_;  // as printed
   }
-  P_ = 0.5 * (P_ + P_.transpose());
+  P_ = (0.5 * (P_ + P_.transpose())).eval();  // eval: no aliasing with the transpose
   for (int i = 0; i < 6; ++i) P_(i, i) = std::max(P_(i, i), cfg_.variance_floor_dps2);
   return true;
 }
@@ -316,8 +316,9 @@ int DriftlessFilter::close_segment() {
   cur.r = M1 * y1 - M2 * y2;  // eq. (2): r = R1 y1 - R2 y2
   cur.H.block<3, 3>(0, kBias1.start) = M1;
   cur.H.block<3, 3>(0, kBias2.start) = -M2;
-  // eq. (2)'s noise R1 n1 - R2 n2, averaged over n samples
-  const double var = cfg_.sample_variance_dps2(rate_hz) / double(s.n);
+  // eq. (2)'s noise R1 n1 - R2 n2, averaged over n samples; the bias random walk adds q T / 12
+  // (its mean over the standstill scatters about its value at the midpoint)
+  const double var = cfg_.sample_variance_dps2(rate_hz) / double(s.n) + q_rate_dps2_per_s_ * span / 12.0;
   cur.R = var * (M1 * M1.transpose() + M2 * M2.transpose());
 
   UpdateRecord rec;
@@ -326,7 +327,9 @@ int DriftlessFilter::close_segment() {
   rec.samples = s.n;
   rec.plat1_deg = p1;
   rec.plat2_deg = p2;
-  predict_to(s.t_last_s);
+  // the average measures the bias at the standstill's midpoint: update there, then carry P on
+  const double t_mid = 0.5 * (s.t_first_s + s.t_last_s);
+  predict_to(std::max(t_mid, finite(t_filter_s_) ? t_filter_s_ : t_mid));
   int result = 0;
   if (cfg_.mode == FilterMode::kGeneral) {
     const bool ok = update<3>(cur.r, cur.H, cur.R, rec);
@@ -347,6 +350,8 @@ int DriftlessFilter::close_segment() {
     result = ok ? 1 : -1;
   }
   prev_res_ = cur;
+  predict_to(s.t_last_s);
+  if (result != 0) last_update_.sigma_dps = sigma_dps();
   return result;
 }
 
