@@ -84,9 +84,17 @@ class FileSink : public est::EstimateSink {
     fmt::format_to(std::back_inserter(b), ",{}\n", est::to_string(o.status));
     if (b.size() > (1u << 20)) flush();
     if (keep_series_ && s.gyros_finite()) {
+      if (o.status == est::PushStatus::kMoving) platforms_moved_ = true;
+      // fused body rate, holding the last value while no platform is at rest
+      if (o.rate_body_dps.allFinite()) {
+        last_rate_ = o.rate_body_dps;
+        last_raw_rate_ = o.rate_body_raw_dps;
+      }
       for (int i = 0; i < 3; ++i) {
         raw1_[i].push_back(static_cast<float>(s.gyro1_dps[i]));
         cor1_[i].push_back(static_cast<float>(o.y1c_dps[i]));
+        raw_rate_[i].push_back(static_cast<float>(last_raw_rate_[i]));
+        cor_rate_[i].push_back(static_cast<float>(last_rate_[i]));
       }
     }
   }
@@ -128,9 +136,12 @@ class FileSink : public est::EstimateSink {
     attitude_.close();
   }
 
-  std::vector<float> raw1_[3], cor1_[3];
+  std::vector<float> raw1_[3], cor1_[3];          // sensor 1 output, raw and corrected
+  std::vector<float> raw_rate_[3], cor_rate_[3];  // fused body rate, raw and corrected
+  bool platforms_moved_ = false;
 
  private:
+  Eigen::Vector3d last_rate_ = Eigen::Vector3d::Zero(), last_raw_rate_ = Eigen::Vector3d::Zero();
   fmt::ostream corrected_, estimate_, attitude_;
   fmt::memory_buffer buf_;
   bool truth_;
@@ -200,18 +211,21 @@ std::vector<std::string> make_plots(const fs::path& dir, FileSink& sink, bool tr
     body += "  unset multiplot\n";
     if (auto w = render_gnuplot(dir, "fig4_bias", body); !w.empty()) warnings.push_back(w);
   }
-  // Fig. 5: Allan deviation of sensor 1, raw against corrected
+  // Fig. 5: Allan deviation raw against corrected: sensor 1's axes on a static run (the paper's
+  // Fig. 5); when the platforms flip, the sensor outputs carry the flips, so the fused body rate
   if (!sink.raw1_[0].empty() && sink.raw1_[0].size() >= 3 && std::isfinite(rate_hz)) {
     std::vector<AllanTableColumn> cols;
     est::AllanOptions opt;
     opt.sample_rate_hz = rate_hz;
+    const bool fused = sink.platforms_moved_;
     for (int pass = 0; pass < 2; ++pass) {
       for (int a = 0; a < 3; ++a) {
-        const auto& src = pass == 0 ? sink.raw1_[a] : sink.cor1_[a];
+        const auto& src = fused ? (pass == 0 ? sink.raw_rate_[a] : sink.cor_rate_[a])
+                                : (pass == 0 ? sink.raw1_[a] : sink.cor1_[a]);
         std::vector<double> x(src.begin(), src.end());
         const auto curve = est::allan_deviation(x, opt);
         AllanTableColumn c;
-        c.name = fmt::format("{}gyro1_{}", pass == 0 ? "raw_" : "corrected_", "xyz"[a]);
+        c.name = fmt::format("{}{}_{}", pass == 0 ? "raw_" : "corrected_", fused ? "rate" : "gyro1", "xyz"[a]);
         for (const auto& p : curve.points) {
           c.tau_s.push_back(p.tau_s);
           c.adev.push_back(p.adev);
@@ -222,9 +236,11 @@ std::vector<std::string> make_plots(const fs::path& dir, FileSink& sink, bool tr
       }
     }
     write_allan_table(dir / "allan_fig5.csv", cols);
-    std::string body = "  set logscale xy; set xlabel 'tau [s]'; set ylabel 'Allan deviation [deg/s]'\n"
-                       "  set title 'Fig. 5: Allan deviation of sensor 1, raw (red) and DriftLess-corrected (black)'\n"
-                       "  plot ";
+    std::string body = fmt::format(
+        "  set logscale xy; set xlabel 'tau [s]'; set ylabel 'Allan deviation [deg/s]'\n"
+        "  set title 'Fig. 5: Allan deviation of {}, raw (red) and DriftLess-corrected (black)'\n"
+        "  plot ",
+        fused ? "the fused body rate" : "sensor 1");
     for (int i = 0; i < 6; ++i) {
       body += fmt::format("'allan_fig5.csv' using 1:{} with linespoints lc rgb '{}' dt {} title columnhead({}){}",
                           2 + 3 * i, i < 3 ? "red" : "black", 1 + i % 3, 2 + 3 * i, i < 5 ? ", " : "\n");

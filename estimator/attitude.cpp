@@ -13,7 +13,7 @@ AttitudeIntegrator::AttitudeIntegrator(double latitude_deg) {
 void AttitudeIntegrator::reset(const Eigen::Quaterniond& q, double t_s) {
   q_ = q.normalized();
   t_ = t_s;
-  last_rate_radps_.setZero();
+  last_rate_radps_.setConstant(kNaN);  // no rate yet: the first interval uses its end rate
   initialized_ = true;
 }
 
@@ -21,10 +21,15 @@ void AttitudeIntegrator::step(double t_s, const Eigen::Vector3d& rate_body_dps) 
   if (!initialized_) return;
   const Eigen::Vector3d w_now = rate_body_dps.allFinite() ? Eigen::Vector3d(rate_body_dps * kRadPerDeg)
                                                           : last_rate_radps_;
+  if (!w_now.allFinite()) {  // no rate seen yet: nothing to integrate with
+    t_ = t_s;
+    return;
+  }
+  const Eigen::Vector3d w_prev = last_rate_radps_.allFinite() ? last_rate_radps_ : w_now;
   const double dt = t_s - t_;
   if (dt > 0.0) {
     // w_nb^b = w_ib^b - C_bn w_ie^n: the box's rate relative to the (Earth-fixed) ENU frame
-    const Eigen::Vector3d w_ib = 0.5 * (w_now + last_rate_radps_);
+    const Eigen::Vector3d w_ib = 0.5 * (w_now + w_prev);
     const Eigen::Vector3d w_nb = w_ib - q_.conjugate() * w_ie_enu_;
     const Eigen::Vector3d phi = w_nb * dt;
     const double angle = phi.norm();
