@@ -153,7 +153,8 @@ ReadStatus SerialSource::read(Sample& out) {
     const SerialPort::Io io = port_.read(buf, sizeof buf, wait, n);
     if (io == SerialPort::Io::kHangup) {
       gone_ = true;
-      lost_host_s_ = clock_.now_s();
+      // frames still buffered in the tty die with it: the gap starts at the last frame received
+      lost_host_s_ = have_last_ ? last_frame_host_s_ : clock_.now_s();
       port_.close();
       report(EventKind::kDisconnected, t_last(), p_.path + " hung up (device unplugged or reset)");
       return ReadStatus::kDisconnected;

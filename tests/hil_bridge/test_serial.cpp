@@ -246,9 +246,11 @@ TEST(SerialSource, TtyThatVanishesAndComesBackIsReopened) {
   const Stream run = stream(emu, sp, 5.0);
   EXPECT_EQ(run.count(EventKind::kDisconnected), 1);
   EXPECT_EQ(run.count(EventKind::kReconnected), 1);
-  // frames 40..69 were never sent; the host clock estimates the gap
-  EXPECT_NEAR(static_cast<double>(run.samples.size()), 90.0, 2.0);
-  EXPECT_NEAR(static_cast<double>(run.lost()), 30.0, 6.0);
+  // frames 40..69 were never sent (and any still buffered in the closed pty are gone too); the
+  // host clock estimates the gap, so received + lost spans the 120 frames within a few periods
+  EXPECT_GE(run.samples.size(), 75u);
+  EXPECT_LE(run.samples.size(), 90u);
+  EXPECT_NEAR(static_cast<double>(run.samples.size() + run.lost()), 120.0, 8.0);
   expect_monotonic_and_accounted(run, 100.0);
 }
 
