@@ -19,7 +19,7 @@ namespace driftless::cli {
 namespace {
 
 struct HilOptions {
-  std::string source, switch_to, out_dir, estimator_config;
+  std::string source, switch_to, out_dir, estimator_config, scenario;
   double at_s = kNaN;
   double duration_s = kNaN;
   double rate_hz = 100.0;
@@ -46,6 +46,7 @@ int run_hil(const HilOptions& o) {
   ro.baud = o.baud;
   ro.work_dir = o.out_dir;
   ro.seed = o.seed;
+  ro.scenario = o.scenario;
   auto first = hil::make_source_rig(o.source, ro);
   std::unique_ptr<hil::SourceRig> second;
   if (!o.switch_to.empty()) second = hil::make_source_rig(o.switch_to, ro);
@@ -147,6 +148,7 @@ const bool registered = register_command(60, [](CLI::App& app) {
   cmd->add_option("--rate", o->rate_hz, "Sample rate of i2c, serial and emulated sources, Hz")->default_val(100.0);
   cmd->add_option("--standstill", o->standstill_s, "Flip schedule hold time at each position, s")->default_val(10.0);
   cmd->add_option("--baud", o->baud, "Serial link speed, bit/s")->default_val(921600);
+  cmd->add_option("--scenario", o->scenario, "twin: scenario YAML file or built-in name (default: the built-in default)");
   cmd->add_option("--seed", o->seed, "Seed of the emulators and the twin")->default_val(1);
   cmd->add_option("--estimator-config", o->estimator_config, "Estimator configuration (key: value, docs/estimator.md)");
   cmd->add_option("--print-every", o->print_every_s, "Terminal line every this much session time, s")->default_val(10.0);
