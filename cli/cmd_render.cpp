@@ -57,11 +57,8 @@ int run_render(const RenderArgs& a) {
     throw std::invalid_argument("--log needs --model FILE.xml (an MJCF model of the box)");
   }
   auto model = load_mjcf(a.model);
-  auto poser = std::make_shared<render::BoxPoser>(model.get());
-  render::LogFrameSource source(a.log, model.get(),
-                                [poser](const Sample& s, render::WorldPose& w) {
-                                  poser->pose(s, w);
-                                });
+  render::BoxPoser poser(model.get());
+  render::LogFrameSource source(a.log, poser);
 
   Progress bar("render");
   const double end = std::isnan(a.to) ? source.info().end_s : a.to;
