@@ -20,7 +20,8 @@ LogFrameSource::LogFrameSource(const std::filesystem::path& log, WorldPoser& pos
                                double max_gap_s)
     : reader_(log), poser_(poser), max_gap_s_(max_gap_s) {
   const auto& meta = reader_.metadata();
-  info_.title = log.filename().string();
+  // a simulated log names its scenario: the replay then looks exactly like the simulation
+  info_.title = meta.get("scenario").value_or(log.filename().string());
   info_.metadata = meta;
   info_.end_s = meta.get_number("duration_s", kNaN);
 }
