@@ -57,7 +57,6 @@ int run_render(const RenderArgs& a) {
   std::unique_ptr<render::FrameSource> source;
   std::unique_ptr<render::WorldPoser> poser;
   ModelPtr mjcf(nullptr, &mj_deleteModel);
-#ifdef DRIFTLESS_RENDERS_HAVE_SIMULATOR
   if (!a.scenario.empty()) {
     source = std::make_unique<render::ScenarioFrameSource>(twin::load_scenario(a.scenario));
   } else {
@@ -77,17 +76,6 @@ int run_render(const RenderArgs& a) {
     }
     source = std::make_unique<render::LogFrameSource>(a.log, *poser);
   }
-#else
-  if (!a.scenario.empty()) {
-    throw std::invalid_argument("--scenario needs the twin simulation, which this build lacks");
-  }
-  if (a.model.empty()) {
-    throw std::invalid_argument("--log needs --model FILE.xml (an MJCF model of the box)");
-  }
-  mjcf = load_mjcf(a.model);
-  poser = std::make_unique<render::BoxPoser>(mjcf.get());
-  source = std::make_unique<render::LogFrameSource>(a.log, *poser);
-#endif
 
   Progress bar("render");
   const double end = std::isnan(a.to) ? source->info().end_s : a.to;

@@ -1,7 +1,5 @@
 #include "renders/twin_source.hpp"
 
-#ifdef DRIFTLESS_RENDERS_HAVE_SIMULATOR
-
 #include <stdexcept>
 
 #include <fmt/core.h>
@@ -43,5 +41,3 @@ bool ScenarioFrameSource::next(Sample& sample, Sample& posed) {
 }
 
 }  // namespace driftless::render
-
-#endif

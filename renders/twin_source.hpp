@@ -2,9 +2,6 @@
 // source that simulates a scenario as it renders.
 #pragma once
 
-#if __has_include("twin/simulator.hpp")
-#define DRIFTLESS_RENDERS_HAVE_SIMULATOR 1
-
 #include <memory>
 #include <string>
 
@@ -49,5 +46,3 @@ class ScenarioFrameSource final : public FrameSource {
 };
 
 }  // namespace driftless::render
-
-#endif

@@ -8,8 +8,6 @@
 namespace driftless::render {
 namespace {
 
-#ifdef DRIFTLESS_RENDERS_HAVE_SIMULATOR
-
 TEST(RenderTwin, ScenarioAndItsLogGiveTheSameFrames) {
   const auto dir = testing::scratch_dir("twin");
   twin::Scenario sc = twin::load_scenario("static");
@@ -48,14 +46,6 @@ TEST(RenderTwin, ScenarioAndItsLogGiveTheSameFrames) {
   EXPECT_LT(worst, 0.5);
   EXPECT_GT(motion, 5.0 * std::max(worst, 0.2));
 }
-
-#else
-
-TEST(RenderTwin, ScenarioAndItsLogGiveTheSameFrames) {
-  GTEST_SKIP() << "the twin simulator is not in this build yet";
-}
-
-#endif
 
 }  // namespace
 }  // namespace driftless::render
