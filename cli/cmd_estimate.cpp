@@ -15,7 +15,9 @@
 #include "cli/command.hpp"
 #include "cli/plot.hpp"
 #include "estimator/allan.hpp"
+#include "estimator/calibration.hpp"
 #include "estimator/pipeline.hpp"
+#include "twin/calib/calib_file.hpp"
 
 namespace driftless::cli {
 namespace {
@@ -27,6 +29,7 @@ struct EstimateArgs {
   std::string out;
   std::string mode;  // empty = config / general
   std::string config;
+  std::string calib;  // calib.yaml from driftless calibrate (docs/calibration.md)
   bool plot = false;
 };
 
@@ -275,10 +278,24 @@ int run_estimate_cmd(const EstimateArgs& a) {
     cfg = est::paper_config();
   }
   if (!a.mode.empty()) est::set_config_value(cfg, "mode", a.mode);
-  // --calib hook (issue 4): fill cfg.calibration with the calibrated matrices M here
+  log::LogReader reader(a.log);
+  // --calib: the calibrated matrices M replace R in eq. (1)-(2) (docs/calibration.md)
+  if (!a.calib.empty()) {
+    const twin::calib::CalibFile c = twin::calib::load_calib(a.calib);
+    const auto& meta = reader.metadata();
+    if ((c.hinge1_axis.normalized() - meta.hinge1_axis().normalized()).norm() > 1e-6 ||
+        (c.hinge2_axis.normalized() - meta.hinge2_axis().normalized()).norm() > 1e-6) {
+      throw std::invalid_argument(fmt::format(
+          "--calib {}: calibrated for hinge axes [{} {} {}] / [{} {} {}] but the log {} has [{} {} {}] / "
+          "[{} {} {}]: not the same box", a.calib, c.hinge1_axis.x(), c.hinge1_axis.y(), c.hinge1_axis.z(),
+          c.hinge2_axis.x(), c.hinge2_axis.y(), c.hinge2_axis.z(), a.log, meta.hinge1_axis().x(),
+          meta.hinge1_axis().y(), meta.hinge1_axis().z(), meta.hinge2_axis().x(), meta.hinge2_axis().y(),
+          meta.hinge2_axis().z()));
+    }
+    cfg.calibration = est::to_filter_calibration(c.M);
+  }
   cfg.validate();
 
-  log::LogReader reader(a.log);
   const bool truth = (reader.fields() & kFieldTrueBias) != 0;
   const bool attitude = (reader.fields() & kFieldRefQ) != 0;
   fs::create_directories(a.out);
@@ -359,6 +376,11 @@ const bool registered = register_command(30, [](CLI::App& app) {
   cmd->add_option("--config", a->config,
                   "Estimator configuration, 'key: value' lines (units in the key names: _s, _deg, "
                   "_dps, _dps_rthz, _dps2; docs/estimator.md)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--calib", a->calib,
+                  "Calibration file from 'driftless calibrate' (calib.yaml): the matrices M per "
+                  "sensor and end stop (deg/s in, deg/s out) replace the hinge rotations; "
+                  "docs/calibration.md")
       ->check(CLI::ExistingFile);
   cmd->add_flag("--plot", a->plot,
                 "Also write Fig. 4 (bias vs truth, deg/s), Fig. 5 (Allan deviation, deg/s vs s) and "
