@@ -46,9 +46,9 @@ grid:
   const RunSetup s = SetupBuilder(c).build(expand(c)[0]);
   EXPECT_EQ(s.estimator.noise_density_dps_rthz, 0.02);
   EXPECT_EQ(s.scenario.flip_schedule.flip_angle_deg, 45.0);
-  const SensorParams p2 = parse_sensor_params(s.scenario.model.sensor2, mpu6050_defaults(), "t");
+  const SensorParams& p2 = s.scenario.model.sensor2;
   EXPECT_TRUE(p2.adc_missing_codes.enabled);
-  const SensorParams p1 = parse_sensor_params(s.scenario.model.sensor1, mpu6050_defaults(), "t");
+  const SensorParams& p1 = s.scenario.model.sensor1;
   EXPECT_EQ(p1.white_noise.density_dps_rthz, Eigen::Vector3d::Constant(0.02));
   EXPECT_THROW(SetupBuilder(parse_sweep("grid: {x: {set: fault.bogus, values: [1]}}\n", "u.yaml", "."))
                    .build(RunSpec{0, 0, 0, 1, {1.0}}),

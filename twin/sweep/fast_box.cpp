@@ -11,20 +11,15 @@
 namespace driftless::twin::sweep {
 namespace {
 
-SensorParams sensor_of(const YAML::Node& node, const Scenario& sc, const char* which) {
-  return parse_sensor_params(node, mpu6050_defaults(),
-                             (sc.name.empty() ? std::string("scenario") : sc.name) + " model." + which);
-}
-
 }  // namespace
 
 FastBox::FastBox(const Scenario& scenario)
     : sc_((scenario.validate(), scenario)),
       motion_(make_motion(sc_.motion, sc_.duration_s, sc_.seed, sc_.base_dir)),
       flips_(sc_.flip_schedule, sc_.model.box),
-      sensor1_(sensor_of(sc_.model.sensor1, sc_, "sensor1"), sc_.sample_rate_hz,
+      sensor1_(sc_.model.sensor1, sc_.sample_rate_hz,
                derive_seed(sc_.seed, 101)),
-      sensor2_(sensor_of(sc_.model.sensor2, sc_, "sensor2"), sc_.sample_rate_hz,
+      sensor2_(sc_.model.sensor2, sc_.sample_rate_hz,
                derive_seed(sc_.seed, 102)),
       earth_enu_radps_(earth_rate_enu_radps(sc_.latitude_deg)),
       a1_(sc_.model.box.hinge_axis(1)),
