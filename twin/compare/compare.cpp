@@ -597,7 +597,7 @@ CompareResult compare(const Replay& r, const CompareModel& model, const CompareO
       auto res = eval_regression(def.channel_sets[si], def.cols);
       if (res.sv.rank == 0) continue;
       double ev = res.gain - res.sv.rank * log_m;
-      if (cd.effect == "lowpass_latency") {
+      if (cd.effect == "lowpass_latency" && ev > 0) {
         // the DLPF also colours the noise: its lag-1 autocorrelation must move the same way
         const int s = static_cast<int>(si);
         const double dz = (rho1[s] - rho1_model[s]) * std::sqrt(std::max(1.0, rho1_n[s]));
@@ -759,7 +759,8 @@ CompareResult compare(const Replay& r, const CompareModel& model, const CompareO
       // white noise: fitted N (already the nuisance value) against the model's N
       ChannelNoise nm = C.noise;
       const double Nmodel = p.white_noise.enabled ? p.white_noise.density_dps_rthz[C.j] : 0.0;
-      nm.white_dps_rthz = std::max(Nmodel, 1e-7);
+      // the DLPF correlates neighbouring samples: the model's block-mean noise is a bit lower
+      nm.white_dps_rthz = std::max(Nmodel * std::sqrt(block_mean_variance_ratio(deterministic_part(p), fs, L)), 1e-7);
       const double l_model = BiasWhitener(blocks, nm).neg2_loglik(zr);
       const double l_fit = BiasWhitener(blocks, C.noise).neg2_loglik(zr);
       const double gw = l_model - l_fit;
@@ -948,7 +949,7 @@ CompareResult compare(const Replay& r, const CompareModel& model, const CompareO
               if (hist.count(code)) continue;
               auto cnt = [&](long cc) { auto it = hist.find(cc); return it == hist.end() ? 0.0 : static_cast<double>(it->second); };
               const double lam = 0.25 * (cnt(code - 2) + cnt(code - 1) + cnt(code + 1) + cnt(code + 2));
-              if (lam >= 5.0) { missing.push_back(code); ev_m += 2.0 * lam - log_m; }
+              if (lam >= 40.0) { missing.push_back(code); ev_m += 2.0 * lam - log_m - 2.0 * std::log(static_cast<double>(hi - lo + 1)); }
             }
           }
         }
@@ -1194,8 +1195,15 @@ CompareResult compare(const Replay& r, const CompareModel& model, const CompareO
   }
 
   // ---- ranking, after-residuals, verdict ----
-  std::stable_sort(cands.begin(), cands.end(), [](const Candidate& a, const Candidate& b) {
+  // noise-type candidates are judged on what the systematic ones leave: when a systematic
+  // candidate is supported, an inflated noise level is its symptom, not a separate cause
+  double best_sys = -kInf;
+  for (const auto& cd : cands)
+    if (cd.testable && cd.kind != "noise") best_sys = std::max(best_sys, cd.evidence);
+  const bool sys_first = best_sys > opt.evidence_threshold;
+  std::stable_sort(cands.begin(), cands.end(), [&](const Candidate& a, const Candidate& b) {
     if (a.testable != b.testable) return a.testable;
+    if (sys_first && (a.kind == "noise") != (b.kind == "noise")) return b.kind == "noise";
     return a.evidence > b.evidence;
   });
   for (auto& cd : cands) {

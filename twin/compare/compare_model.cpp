@@ -168,6 +168,18 @@ double white_noise_floor_dps(const SensorParams& p, int axis, double fs) {
   return p.white_noise.density_dps_rthz[axis] * std::sqrt(fs * g);
 }
 
+double block_mean_variance_ratio(const SensorParams& p, double fs, std::size_t block_len) {
+  // var of a block mean of DLPF-filtered white noise relative to unfiltered white noise
+  const auto h = dlpf_impulse(p, fs);
+  const auto L = static_cast<long>(block_len);
+  std::vector<double> g(static_cast<std::size_t>(L), 0.0);
+  for (long l = 0; l < L; ++l)
+    for (std::size_t k = 0; k + static_cast<std::size_t>(l) < h.size(); ++k) g[static_cast<std::size_t>(l)] += h[k] * h[k + static_cast<std::size_t>(l)];
+  double v = static_cast<double>(L) * g[0];
+  for (long l = 1; l < L; ++l) v += 2.0 * static_cast<double>(L - l) * g[static_cast<std::size_t>(l)];
+  return v / static_cast<double>(L);
+}
+
 double dlpf_lag1_autocorrelation(const SensorParams& p, double fs) {
   const auto h = dlpf_impulse(p, fs);
   double g0 = 0.0, g1 = 0.0;

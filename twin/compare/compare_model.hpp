@@ -50,6 +50,9 @@ SensorPrediction predict_sensor(const Replay& r, int s, const SensorParams& p);
 
 /// Per-sample standard deviation of the model's white noise after its DLPF, deg/s.
 double white_noise_floor_dps(const SensorParams& p, int axis, double sample_rate_hz);
+/// Variance of a block mean (block_len samples) of the model's DLPF-filtered white noise,
+/// relative to that of unfiltered white noise of the same density (1 without a DLPF).
+double block_mean_variance_ratio(const SensorParams& p, double sample_rate_hz, std::size_t block_len);
 /// Lag-1 autocorrelation the model's DLPF gives white noise (0 without a DLPF).
 double dlpf_lag1_autocorrelation(const SensorParams& p, double sample_rate_hz);
 
