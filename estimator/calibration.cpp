@@ -280,6 +280,16 @@ void CalibMatrices::validate() const {
     }
 }
 
+Calibration to_filter_calibration(const CalibMatrices& m) {
+  m.validate();
+  Calibration c;
+  for (int p = 0; p < 2; ++p) {
+    c.sensor1.push_back({position_deg(p), m.M(0, p)});
+    c.sensor2.push_back({position_deg(p), m.M(1, p)});
+  }
+  return c;
+}
+
 Eigen::Vector3d sensor_output_dps(const Eigen::Matrix3d& M_box_from_sensor,
                                   const Eigen::Vector3d& w_body_dps,
                                   const Eigen::Vector3d& bias_dps) {

@@ -23,6 +23,8 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "estimator/filter.hpp"
+
 namespace driftless::est {
 
 /// Index of a platform end stop in calibration tables: 0 = -90 deg, 1 = +90 deg.
@@ -50,6 +52,9 @@ struct CalibMatrices {
   /// Throws std::invalid_argument when a matrix is not finite or is (near) singular.
   void validate() const;
 };
+
+/// The filter's calibration hook (EstimatorConfig::calibration) holding these four matrices.
+Calibration to_filter_calibration(const CalibMatrices& m);
 
 /// eq. (1) with M: the output of a calibrated sensor without noise, y = M^{-1} w_body + b (deg/s).
 Eigen::Vector3d sensor_output_dps(const Eigen::Matrix3d& M_box_from_sensor,

@@ -4,7 +4,7 @@ set -euo pipefail
 packages=(
   build-essential cmake pkg-config ccache git
   libmujoco-dev libqhull-dev libeigen3-dev libyaml-cpp-dev libosmesa6-dev
-  libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev libfmt-dev libfast-float-dev
+  libpng-dev libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev libfmt-dev libfast-float-dev
   ffmpeg gnuplot-nox openmpi-bin libopenmpi-dev
 )
 missing=()

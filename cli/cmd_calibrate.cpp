@@ -1,0 +1,111 @@
+// driftless calibrate: the pan/tilt calibration of paper section 4, on a recorded log + rig plan
+// or on the twin's simulated rig; writes calib.yaml (docs/calibration.md).
+#include <cmath>
+#include <memory>
+#include <string>
+
+#include <fmt/core.h>
+
+#include "cli/command.hpp"
+#include "estimator/calibration.hpp"
+#include "estimator/log.hpp"
+#include "twin/calib/calib_file.hpp"
+#include "twin/calib/rig_plan.hpp"
+
+namespace driftless::cli {
+namespace {
+
+struct Options {
+  std::string scenario, log, plan, out, method = "least_squares", save_log, save_plan;
+};
+
+est::CalibMethod parse_method(const std::string& m) {
+  if (m == "least_squares") return est::CalibMethod::kLeastSquares;
+  if (m == "top_to_top") return est::CalibMethod::kTopToTop;
+  throw std::invalid_argument("--method: expected least_squares or top_to_top, got '" + m + "'");
+}
+
+void print_summary(const est::CalibFit& fit, const twin::calib::RigConditions& rig,
+                   const twin::calib::ExtractReport& rep) {
+  fmt::print("calibration ({}), {} segments, Earth rate {}\n", est::method_name(fit.method),
+             rig.plan.segments.size(), rep.earth_rate_removed ? "removed" : "NOT removed");
+  for (const auto& n : rep.notes) fmt::print("  note: {}\n", n);
+  const est::CalibMatrices m = fit.matrices();
+  for (int i = 0; i < 2; ++i) {
+    for (int p = 0; p < 2; ++p) {
+      const auto& f = fit.fit[i][p];
+      fmt::print("  sensor {} at {}: {} samples, residual rms [{:.4f} {:.4f} {:.4f}] deg/s, "
+                 "max sigma(M) {:.2e}\n",
+                 i + 1, est::position_name(p), f.n_samples, f.residual_rms_dps.x(),
+                 f.residual_rms_dps.y(), f.residual_rms_dps.z(), f.M_sigma.maxCoeff());
+    }
+    const auto e = est::describe_errors(m, i, i == 0 ? rig.hinge1_axis : rig.hinge2_axis);
+    fmt::print("  sensor {}: scale error [{:+.3f} {:+.3f} {:+.3f}] %, non-orthogonality "
+               "[{:+.3f} {:+.3f} {:+.3f}] deg, end-stop travel error {:+.3f} deg\n",
+               i + 1, 100 * e.scale_error.x(), 100 * e.scale_error.y(), 100 * e.scale_error.z(),
+               e.nonorthogonality_deg.x(), e.nonorthogonality_deg.y(), e.nonorthogonality_deg.z(),
+               e.travel_error_deg);
+  }
+}
+
+int run_from_log(const Options& o) {
+  log::Metadata meta;
+  const std::vector<Sample> samples = log::read_all(o.log, &meta);
+  const twin::calib::RigPlan plan = twin::calib::load_rig_plan(o.plan);
+  twin::calib::ExtractReport rep;
+  const auto segs = twin::calib::extract_segments(samples, meta, plan, o.log, &rep);
+  est::CalibFitOptions fo;
+  fo.method = parse_method(o.method);
+  const est::CalibFit fit = est::fit_calibration(segs, fo);
+  twin::calib::RigConditions rig;
+  rig.source = "log " + o.log + ", plan " + o.plan;
+  rig.latitude_deg = rep.latitude_deg;
+  rig.sample_rate_hz = rep.sample_rate_hz;
+  rig.earth_rate_removed = rep.earth_rate_removed && fo.method == est::CalibMethod::kLeastSquares;
+  rig.mean_temp_c = rep.mean_temp_c;
+  rig.hinge1_axis = meta.hinge1_axis();
+  rig.hinge2_axis = meta.hinge2_axis();
+  rig.plan = plan;
+  rig.samples_used = rep.samples_used;
+  twin::calib::save_calib(o.out, fit, rig);
+  print_summary(fit, rig, rep);
+  fmt::print("wrote {}\n", o.out);
+  return 0;
+}
+
+const bool registered = register_command(40, [](CLI::App& app) {
+  auto* cmd = app.add_subcommand(
+      "calibrate",
+      "Calibrate the box on a pan/tilt unit (paper section 4): fit M per sensor and end stop "
+      "from a recorded log + rig plan, or run the simulated rig of a scenario; writes calib.yaml "
+      "(docs/calibration.md)");
+  auto o = std::make_shared<Options>();
+  auto* scen = cmd->add_option("--scenario", o->scenario,
+                               "Scenario with a calibration: block; runs the twin's pan/tilt rig "
+                               "(e.g. models/scenarios/calibration.yaml)")
+                   ->check(CLI::ExistingFile);
+  auto* logo = cmd->add_option("--log", o->log, "Recorded rig log (driftless-log 1; gyro deg/s, "
+                                                "ref_q for the Earth rate)")
+                   ->check(CLI::ExistingFile);
+  auto* plano = cmd->add_option("--plan", o->plan, "Rig plan (YAML; segment times s, rates deg/s, "
+                                                   "end stops deg; docs/calibration.md)")
+                    ->check(CLI::ExistingFile);
+  cmd->add_option("--out", o->out, "Output calibration file (calib.yaml)")->required();
+  cmd->add_option("--method", o->method,
+                  "least_squares (Earth rate removed, default) or top_to_top (the paper's averaging)");
+  cmd->add_option("--save-log", o->save_log, "With --scenario: also write the simulated rig log");
+  cmd->add_option("--save-plan", o->save_plan, "With --scenario: also write its rig plan");
+  scen->excludes(logo)->excludes(plano);
+  logo->needs(plano);
+  plano->needs(logo);
+  return [o] {
+    if (o->scenario.empty() && o->log.empty())
+      throw std::invalid_argument("calibrate: give --scenario FILE, or --log FILE --plan FILE");
+    if (!o->scenario.empty())
+      throw std::invalid_argument("calibrate --scenario: the simulated rig is not available in this build yet");
+    return run_from_log(*o);
+  };
+});
+
+}  // namespace
+}  // namespace driftless::cli

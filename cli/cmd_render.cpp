@@ -1,0 +1,150 @@
+// driftless render: an off-screen video (OSMesa, no display or GPU) of a log replay or a
+// simulated scenario, with an overlay of time, platform state, residual and attitude error.
+#include <cmath>
+#include <memory>
+#include <string>
+
+#include <fmt/core.h>
+#include <mujoco/mujoco.h>
+
+#include "cli/command.hpp"
+#include "renders/render_job.hpp"
+
+namespace driftless::cli {
+namespace {
+
+struct RenderArgs {
+  std::string scenario, log, model, out;
+  int width = 640, height = 480;
+  double fps = 30.0, speed = 1.0;
+  double from = kNaN, to = kNaN;
+  double realtime_flip_every = kNaN;
+  std::string camera;
+  std::string preset = "ultrafast";
+  int crf = 23;
+  bool no_overlay = false;
+};
+
+using ModelPtr = std::unique_ptr<mjModel, decltype(&mj_deleteModel)>;
+
+ModelPtr load_mjcf(const std::string& path) {
+  char err[1000] = "";
+  ModelPtr m(mj_loadXML(path.c_str(), nullptr, err, sizeof err), &mj_deleteModel);
+  if (!m) throw std::runtime_error(fmt::format("{}: cannot load the MJCF model: {}", path, err));
+  return m;
+}
+
+int run_render(const RenderArgs& a) {
+  render::RenderParams p;
+  p.scene.width_px = a.width;
+  p.scene.height_px = a.height;
+  p.scene.camera = a.camera;
+  p.timeline.fps = a.fps;
+  p.timeline.speed = a.speed;
+  p.timeline.from_s = a.from;
+  p.timeline.to_s = a.to;
+  p.timeline.realtime_flip_every_s = a.realtime_flip_every;
+  p.encoder.preset = a.preset;
+  p.encoder.crf = a.crf;
+  p.out = a.out;
+  p.overlay = !a.no_overlay;
+  p.validate();
+
+  if (!a.scenario.empty()) {
+    throw std::invalid_argument("--scenario needs the twin simulation, which this build lacks");
+  }
+  if (a.model.empty()) {
+    throw std::invalid_argument("--log needs --model FILE.xml (an MJCF model of the box)");
+  }
+  auto model = load_mjcf(a.model);
+  auto poser = std::make_shared<render::BoxPoser>(model.get());
+  render::LogFrameSource source(a.log, model.get(),
+                                [poser](const Sample& s, render::WorldPose& w) {
+                                  poser->pose(s, w);
+                                });
+
+  Progress bar("render");
+  const double end = std::isnan(a.to) ? source.info().end_s : a.to;
+  const double begin = std::isnan(a.from) ? 0.0 : a.from;
+  const auto stats = render::render_video(source, p, [&](double t, std::uint64_t frames) {
+    if (std::isfinite(end) && end > begin) {
+      bar.update(std::clamp((t - begin) / (end - begin), 0.0, 1.0),
+                 fmt::format("{} frames, t = {:.1f} s", frames, t));
+    }
+    return !stop_requested().load();
+  });
+  bar.done(fmt::format("{} frames", stats.frames));
+  if (stats.png_fallback) {
+    fmt::print(stderr,
+               "driftless render: note: the ffmpeg program was not found (set {} or install "
+               "ffmpeg), so no MP4 was made: wrote {} PNG frames to {} instead\n",
+               render::kFfmpegEnv, stats.frames, stats.output);
+  }
+  fmt::print("{}: {} frames {}x{} px at {:g} frames/s ({:.2f} s of video), data t = {:.2f} .. "
+             "{:.2f} s, {} frames of flips at x1; rendered in {:.1f} s ({:.1f} frames/s)\n",
+             stats.output, stats.frames, a.width, a.height, a.fps,
+             static_cast<double>(stats.frames) / a.fps, stats.first_frame_s, stats.last_frame_s,
+             stats.realtime_flip_frames, stats.wall_s,
+             stats.wall_s > 0 ? static_cast<double>(stats.frames) / stats.wall_s : 0.0);
+  if (stop_requested().load()) {
+    fmt::print(stderr, "driftless render: stopped early (Ctrl-C); the video ends at t = {:.2f} s\n",
+               stats.last_frame_s);
+    return 130;
+  }
+  return 0;
+}
+
+const bool registered = register_command(60, [](CLI::App& app) {
+  auto* cmd = app.add_subcommand(
+      "render",
+      "Render an off-screen video (MP4, H.264 via ffmpeg; PNG frames if ffmpeg is missing) of a "
+      "log replay or a simulated scenario: box, platforms, sensor axes, carrier, overlay "
+      "(docs/render.md)");
+  auto a = std::make_shared<RenderArgs>();
+  auto* scen = cmd->add_option("--scenario", a->scenario,
+                               "Scenario YAML to simulate and render (models/scenarios/*.yaml)")
+                   ->check(CLI::ExistingFile);
+  auto* log = cmd->add_option("--log", a->log,
+                              "Measurement log to replay (docs/log-format.md): base from "
+                              "ref_q/ref_p, platforms from plat1_deg/plat2_deg")
+                  ->check(CLI::ExistingFile);
+  scen->excludes(log);
+  log->excludes(scen);
+  cmd->add_option("--model", a->model, "Model for --log: an MJCF file (.xml)")
+      ->check(CLI::ExistingFile)
+      ->needs(log);
+  cmd->add_option("--out", a->out, "Output video file (.mp4)")->required();
+  cmd->add_option("--width", a->width, "Frame width, px (even)")->capture_default_str();
+  cmd->add_option("--height", a->height, "Frame height, px (even)")->capture_default_str();
+  cmd->add_option("--fps", a->fps, "Video frame rate, frames/s")->capture_default_str();
+  cmd->add_option("--camera", a->camera,
+                  "MJCF camera name, or 'free' (orbit camera tracking the box); default: the "
+                  "tracking camera if the model has one");
+  auto* from = cmd->add_option("--from", a->from, "First data time shown, s (default: start)");
+  auto* to = cmd->add_option("--to", a->to, "Data time where the video ends, s (default: end)");
+  (void)from;
+  (void)to;
+  cmd->add_option("--speed", a->speed,
+                  "Playback speed, x real time (data s per video s); > 1 is a time-lapse in "
+                  "which flips are still shown at x1 now and then (--realtime-flip-every)")
+      ->capture_default_str();
+  cmd->add_option("--realtime-flip-every", a->realtime_flip_every,
+                  "In a time-lapse, play a flip at x1 if it starts at least this long after the "
+                  "last one so shown, s of data time (default: 5 s of video, i.e. 5 x speed; "
+                  "0: never)");
+  cmd->add_option("--preset", a->preset, "x264 preset (ultrafast .. veryslow)")
+      ->capture_default_str();
+  cmd->add_option("--crf", a->crf, "x264 quality, 0 (lossless) .. 51 (worst)")
+      ->capture_default_str();
+  cmd->add_flag("--no-overlay", a->no_overlay, "Draw the scene only (no text, no chart)");
+  return [a, cmd] {
+    if (a->scenario.empty() && a->log.empty()) {
+      throw std::invalid_argument("give --scenario FILE or --log FILE (see driftless render --help)");
+    }
+    (void)cmd;
+    return run_render(*a);
+  };
+});
+
+}  // namespace
+}  // namespace driftless::cli

@@ -1,0 +1,104 @@
+#include "renders/pose.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+#include <fmt/core.h>
+
+namespace driftless::render {
+
+void WorldPose::capture(const mjModel* m, const mjData* d) {
+  qpos.assign(d->qpos, d->qpos + m->nq);
+  mocap_pos.assign(d->mocap_pos, d->mocap_pos + 3 * m->nmocap);
+  mocap_quat.assign(d->mocap_quat, d->mocap_quat + 4 * m->nmocap);
+}
+
+void WorldPose::apply(const mjModel* m, mjData* d) const {
+  if (qpos.size() == static_cast<std::size_t>(m->nq)) {
+    std::copy(qpos.begin(), qpos.end(), d->qpos);
+  }
+  if (mocap_pos.size() == static_cast<std::size_t>(3 * m->nmocap)) {
+    std::copy(mocap_pos.begin(), mocap_pos.end(), d->mocap_pos);
+    std::copy(mocap_quat.begin(), mocap_quat.end(), d->mocap_quat);
+  }
+  // only what drawing needs: body/geom/site frames, subtree centres (tracking cameras), cameras
+  mj_kinematics(m, d);
+  mj_comPos(m, d);
+  mj_camlight(m, d);
+}
+
+BoxPoser::BoxPoser(const mjModel* m, const std::string& base_body, const std::string& plat1_joint,
+                   const std::string& plat2_joint)
+    : m_(m) {
+  const int body = mj_name2id(m, mjOBJ_BODY, base_body.c_str());
+  if (body < 0) {
+    throw std::invalid_argument(
+        fmt::format("the model has no body '{}' to pose from ref_p/ref_q", base_body));
+  }
+  for (int j = m->body_jntadr[body]; j >= 0 && j < m->body_jntadr[body] + m->body_jntnum[body];
+       ++j) {
+    switch (m->jnt_type[j]) {
+      case mjJNT_FREE: free_adr_ = m->jnt_qposadr[j]; break;
+      case mjJNT_BALL: ball_adr_ = m->jnt_qposadr[j]; break;
+      case mjJNT_SLIDE: slides_.emplace_back(m->jnt_qposadr[j], j); break;
+      default: break;
+    }
+  }
+  const std::string names[2] = {plat1_joint, plat2_joint};
+  for (int i = 0; i < 2; ++i) {
+    const int j = mj_name2id(m, mjOBJ_JOINT, names[i].c_str());
+    if (j < 0 || m->jnt_type[j] != mjJNT_HINGE) {
+      throw std::invalid_argument(
+          fmt::format("the model has no hinge joint '{}' for platform {}", names[i], i + 1));
+    }
+    plat_adr_[i] = m->jnt_qposadr[j];
+  }
+}
+
+void BoxPoser::pose(const Sample& s, WorldPose& out) const {
+  const mjModel* m = m_;
+  if (out.qpos.size() != static_cast<std::size_t>(m->nq)) {
+    out.qpos.assign(m->qpos0, m->qpos0 + m->nq);
+    out.mocap_pos.clear();
+    for (int b = 0; b < m->nbody; ++b) {
+      if (m->body_mocapid[b] < 0) continue;
+      out.mocap_pos.resize(3 * m->nmocap);
+      out.mocap_quat.resize(4 * m->nmocap);
+    }
+    for (int b = 0; b < m->nbody; ++b) {
+      const int id = m->body_mocapid[b];
+      if (id < 0) continue;
+      std::copy(m->body_pos + 3 * b, m->body_pos + 3 * b + 3, out.mocap_pos.begin() + 3 * id);
+      std::copy(m->body_quat + 4 * b, m->body_quat + 4 * b + 4, out.mocap_quat.begin() + 4 * id);
+    }
+  }
+  mjtNum* q = out.qpos.data();
+  const bool has_p = s.ref_p_enu_m.allFinite();
+  Eigen::Vector4d qwxyz = s.ref_q_wxyz;
+  const bool has_q = qwxyz.allFinite() && qwxyz.norm() > 0.5;
+  if (has_q) qwxyz.normalize();
+  if (free_adr_ >= 0) {
+    if (has_p) {
+      for (int k = 0; k < 3; ++k) q[free_adr_ + k] = s.ref_p_enu_m[k];
+    }
+    if (has_q) {
+      for (int k = 0; k < 4; ++k) q[free_adr_ + 3 + k] = qwxyz[k];
+    }
+  }
+  if (has_p) {
+    // slides along world axes take the position's component along their axis
+    for (const auto& [adr, j] : slides_) {
+      const mjtNum* a = m->jnt_axis + 3 * j;
+      q[adr] = a[0] * s.ref_p_enu_m[0] + a[1] * s.ref_p_enu_m[1] + a[2] * s.ref_p_enu_m[2];
+    }
+  }
+  if (ball_adr_ >= 0 && has_q) {
+    for (int k = 0; k < 4; ++k) q[ball_adr_ + k] = qwxyz[k];
+  }
+  const double plat_deg[2] = {s.plat1_deg, s.plat2_deg};
+  for (int i = 0; i < 2; ++i) {
+    if (std::isfinite(plat_deg[i])) q[plat_adr_[i]] = plat_deg[i] * kRadPerDeg;
+  }
+}
+
+}  // namespace driftless::render

@@ -1,0 +1,281 @@
+#include "renders/render_job.hpp"
+
+#include <chrono>
+#include <condition_variable>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include <fmt/core.h>
+
+#include "renders/gl_context.hpp"
+#include "renders/overlay.hpp"
+
+namespace driftless::render {
+
+// ---- log replay ----
+
+LogFrameSource::LogFrameSource(const std::filesystem::path& log, const mjModel* model,
+                               PoseFn pose, double max_gap_s)
+    : reader_(log), model_(model), pose_(std::move(pose)), max_gap_s_(max_gap_s) {
+  if (model_ == nullptr || !pose_) throw std::invalid_argument("LogFrameSource needs a model");
+  const auto& meta = reader_.metadata();
+  info_.title = log.filename().string();
+  info_.hinge1_axis = meta.hinge1_axis();
+  info_.hinge2_axis = meta.hinge2_axis();
+  info_.end_s = meta.get_number("duration_s", kNaN);
+}
+
+bool LogFrameSource::fill_ahead() {
+  if (eof_) return false;
+  Sample s;
+  if (!reader_.next(s)) {
+    eof_ = true;
+    return false;
+  }
+  ahead_.push_back(s);
+  return true;
+}
+
+bool LogFrameSource::next(Sample& sample, WorldPose& pose) {
+  if (ahead_.empty() && !fill_ahead()) return false;
+  sample = ahead_.front();
+  ahead_.pop_front();
+  Sample posed = sample;
+  double* deg[2] = {&posed.plat1_deg, &posed.plat2_deg};
+  for (int i = 0; i < 2; ++i) {
+    if (std::isfinite(*deg[i])) {
+      last_deg_[i] = *deg[i];
+      last_t_[i] = sample.t_s;
+      continue;
+    }
+    // a gap: find the angle after it (reading ahead) and interpolate in time across it
+    double next_deg = kNaN, next_t = kNaN;
+    for (std::size_t k = 0;; ++k) {
+      if (k == ahead_.size() && !fill_ahead()) break;
+      const Sample& a = ahead_[k];
+      if (a.t_s - sample.t_s > max_gap_s_) break;
+      const double v = i == 0 ? a.plat1_deg : a.plat2_deg;
+      if (std::isfinite(v)) {
+        next_deg = v;
+        next_t = a.t_s;
+        break;
+      }
+    }
+    if (std::isfinite(last_deg_[i]) && std::isfinite(next_deg)) {
+      const double f = (sample.t_s - last_t_[i]) / (next_t - last_t_[i]);
+      *deg[i] = last_deg_[i] + f * (next_deg - last_deg_[i]);
+    } else if (std::isfinite(last_deg_[i])) {
+      *deg[i] = last_deg_[i];
+    } else {
+      *deg[i] = next_deg;  // NaN too: the poser keeps the model's reference angle
+    }
+  }
+  pose_(posed, pose);
+  return true;
+}
+
+// ---- params ----
+
+void RenderParams::validate() const {
+  scene.validate();
+  timeline.validate();
+  encoder.validate();
+  if (out.empty()) throw std::invalid_argument("--out needs a file name (e.g. video.mp4)");
+  if (!std::isnan(chart_window_s) && !(chart_window_s > 0.0)) {
+    throw std::invalid_argument("chart window must be > 0 s");
+  }
+}
+
+namespace {
+
+double now_s() {
+  using namespace std::chrono;
+  return duration<double>(steady_clock::now().time_since_epoch()).count();
+}
+
+// hands frames to the sink on a second thread, so drawing and encoding overlap
+class AsyncSink {
+ public:
+  AsyncSink(std::unique_ptr<VideoSink> sink, std::size_t frame_bytes, std::size_t depth = 3)
+      : sink_(std::move(sink)), free_(depth, std::vector<std::uint8_t>(frame_bytes)) {
+    worker_ = std::thread([this] { run(); });
+  }
+  ~AsyncSink() {
+    stop();
+  }
+  // a free buffer to draw into (blocks while all are queued)
+  std::vector<std::uint8_t> take_buffer() {
+    std::unique_lock lk(mu_);
+    cv_.wait(lk, [&] { return !free_.empty() || failed_; });
+    rethrow_locked();
+    auto b = std::move(free_.back());
+    free_.pop_back();
+    return b;
+  }
+  void submit(std::vector<std::uint8_t> frame) {
+    {
+      std::lock_guard lk(mu_);
+      rethrow_locked();
+      queue_.push_back(std::move(frame));
+    }
+    cv_.notify_all();
+  }
+  // waits for the queue to drain and closes the sink; rethrows the sink's error
+  void close() {
+    stop();
+    std::lock_guard lk(mu_);
+    rethrow_locked();
+    sink_->close();
+  }
+  const VideoSink& sink() const { return *sink_; }
+  double busy_s() const { return busy_s_; }
+
+ private:
+  void stop() {
+    {
+      std::lock_guard lk(mu_);
+      stopping_ = true;
+    }
+    cv_.notify_all();
+    if (worker_.joinable()) worker_.join();
+  }
+  void rethrow_locked() {
+    if (error_) {
+      auto e = error_;
+      error_ = nullptr;
+      std::rethrow_exception(e);
+    }
+  }
+  void run() {
+    for (;;) {
+      std::vector<std::uint8_t> frame;
+      {
+        std::unique_lock lk(mu_);
+        cv_.wait(lk, [&] { return !queue_.empty() || stopping_; });
+        if (queue_.empty()) return;
+        frame = std::move(queue_.front());
+        queue_.pop_front();
+      }
+      const double t0 = now_s();
+      try {
+        if (!failed_) sink_->write(frame.data());
+      } catch (...) {
+        std::lock_guard lk(mu_);
+        failed_ = true;
+        error_ = std::current_exception();
+      }
+      busy_s_ += now_s() - t0;
+      {
+        std::lock_guard lk(mu_);
+        free_.push_back(std::move(frame));
+      }
+      cv_.notify_all();
+    }
+  }
+
+  std::unique_ptr<VideoSink> sink_;
+  std::mutex mu_;
+  std::condition_variable cv_;
+  std::vector<std::vector<std::uint8_t>> free_;
+  std::deque<std::vector<std::uint8_t>> queue_;
+  std::thread worker_;
+  bool stopping_ = false;
+  bool failed_ = false;
+  std::exception_ptr error_;
+  double busy_s_ = 0.0;
+};
+
+// time after a flip before the residual counts (stop ringing), s
+constexpr double kSettleS = 0.3;
+
+// what a frame needs of a sample
+struct Held {
+  Sample sample;
+  WorldPose pose;
+  OverlayState overlay;
+};
+
+}  // namespace
+
+RenderStats render_video(FrameSource& source, const RenderParams& params,
+                         const RenderProgress& progress) {
+  params.validate();
+  RenderStats stats;
+  const double t_start = now_s();
+  // the GL context comes first: without it there is nothing to encode
+  GlContext gl;
+  stats.gl_renderer = gl.renderer();
+  SceneRenderer scene(source.model(), params.scene);
+  const mjModel* m = source.model();
+  std::unique_ptr<mjData, decltype(&mj_deleteData)> data(mj_makeData(m), &mj_deleteData);
+
+  const int w = params.scene.width_px, h = params.scene.height_px;
+  std::unique_ptr<VideoSink> sink;
+  const auto ffmpeg = find_ffmpeg();
+  if (ffmpeg.empty()) {
+    sink = make_png_sink(png_fallback_dir(params.out), w, h);
+    stats.png_fallback = true;
+  } else {
+    std::error_code ec;
+    if (params.out.has_parent_path()) std::filesystem::create_directories(params.out.parent_path(), ec);
+    sink = make_ffmpeg_sink(ffmpeg, params.out, w, h, params.timeline.fps, params.encoder);
+  }
+  AsyncSink out(std::move(sink), static_cast<std::size_t>(w) * h * 3);
+  stats.output = out.sink().description();
+
+  const auto& info = source.info();
+  const double speed = params.timeline.speed;
+  const double window_s =
+      std::isnan(params.chart_window_s) ? std::max(30.0, 20.0 * speed) : params.chart_window_s;
+  ResidualChart chart(info.hinge1_axis, info.hinge2_axis, window_s);
+  PlatformTracker tracker;
+  FramePlanner<Held> planner(params.timeline);
+
+  bool keep_going = true;
+  auto emit = [&](const FrameInfo& f, const Held& held) {
+    if (!keep_going) return;
+    const double t0 = now_s();
+    held.pose.apply(m, data.get());
+    data->time = f.t_s;
+    auto buf = out.take_buffer();
+    const double t1 = now_s();
+    if (params.overlay) {
+      const auto text = overlay_text(info.title, f.t_s, speed, f.realtime_flip, held.overlay);
+      scene.render(data.get(), text, &chart.chart(), held.sample.t_s, buf);
+    } else {
+      scene.render(data.get(), OverlayText{}, nullptr, f.t_s, buf);
+    }
+    const double t2 = now_s();
+    out.submit(std::move(buf));
+    stats.draw_s += t2 - t1;
+    stats.sink_s += (t1 - t0) + (now_s() - t2);
+    if (std::isnan(stats.first_frame_s)) stats.first_frame_s = f.t_s;
+    stats.last_frame_s = f.t_s;
+    ++stats.frames;
+    if (f.realtime_flip) ++stats.realtime_flip_frames;
+    if (progress && !progress(f.t_s, stats.frames)) keep_going = false;
+  };
+
+  Held cur;
+  while (keep_going && source.next(cur.sample, cur.pose)) {
+    ++stats.samples;
+    const bool flip_starts =
+        tracker.update(cur.sample.t_s, cur.sample.plat1_deg, cur.sample.plat2_deg);
+    // the residual means something once both platforms settled (eq. (2) assumes rest)
+    if (params.overlay) {
+      chart.push(cur.sample, tracker.rest_duration_s(cur.sample.t_s) >= kSettleS);
+    }
+    cur.overlay = overlay_state(tracker);
+    if (!planner.push(cur.sample.t_s, flip_starts, tracker.rest_duration_s(cur.sample.t_s), cur,
+                      emit)) {
+      break;
+    }
+  }
+  if (keep_going) planner.finish(emit);
+  out.close();
+  stats.wall_s = now_s() - t_start;
+  return stats;
+}
+
+}  // namespace driftless::render
