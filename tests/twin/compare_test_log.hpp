@@ -49,13 +49,21 @@ inline Eigen::Vector3d body_rate(double t, double amp_dps) {
                          std::sin(2 * kPi * 0.023 * t + 2.0) * std::cos(2 * kPi * 0.011 * t));
 }
 
+/// Box-level errors planted in a test log (the log does not know them).
+struct Planted {
+  double stop_error_deg[2][2] = {{0, 0}, {0, 0}};  // [platform][0: + stop, 1: - stop], deg
+  double time_offset_s = 0.0;                      // sensors sample this much before the log time
+  bool with_ref_q = true;
+};
+
 /// Simulates `duration_s` at `fs` Hz with sensors p1, p2 (seeded). amp_dps = 0: static box.
 inline TestLog make_log(const SensorParams& p1, const SensorParams& p2, double duration_s, std::uint64_t seed,
-                        double amp_dps = 30.0, double fs = 100.0, double lat_deg = 52.0) {
+                        double amp_dps = 30.0, double fs = 100.0, double lat_deg = 52.0, const Planted& pl = {}) {
   TestLog out;
   out.meta.set("format", "driftless-log 1");
   out.meta.set("complete", "true");
-  out.meta.set("sample_rate_hz", "100");
+  out.meta.set("sample_rate_hz", std::to_string(fs));
+  if (!pl.with_ref_q) out.fields = kFieldTemp;
   out.meta.set("latitude_deg", std::to_string(lat_deg));
   SensorModel s1(p1, fs, seed * 2 + 1), s2(p2, fs, seed * 2 + 2);
   const double lat = lat_deg * kRadPerDeg;
@@ -76,7 +84,8 @@ inline TestLog make_log(const SensorParams& p1, const SensorParams& p2, double d
       q.normalize();
     }
     const Eigen::Matrix3d R_eb = q.toRotationMatrix();
-    const Eigen::Vector3d w_body = body_rate(t, amp_dps) + R_eb.transpose() * earth;
+    const double ts = t - pl.time_offset_s;  // when the sensors really sampled
+    const Eigen::Vector3d w_body = body_rate(ts, amp_dps) + R_eb.transpose() * earth;
     const Eigen::Vector3d f_body = R_eb.transpose() * Eigen::Vector3d(0, 0, kStandardGravityMps2);
     Sample s;
     s.t_s = t;
@@ -85,8 +94,11 @@ inline TestLog make_log(const SensorParams& p1, const SensorParams& p2, double d
     double ang[2], rate[2];
     SensorReading rd[2];
     for (int p = 0; p < 2; ++p) {
-      platform_state(t, p, 10.0, 1.0, ang[p], rate[p]);
-      const Eigen::Matrix3d R = Eigen::AngleAxisd(ang[p] * kRadPerDeg, axes[p]).toRotationMatrix();
+      platform_state(ts, p, 10.0, 1.0, ang[p], rate[p]);
+      // a platform resting against a stop sits at the stop's true angle
+      double true_ang = ang[p];
+      if (rate[p] == 0.0) true_ang += ang[p] > 0 ? pl.stop_error_deg[p][0] : pl.stop_error_deg[p][1];
+      const Eigen::Matrix3d R = Eigen::AngleAxisd(true_ang * kRadPerDeg, axes[p]).toRotationMatrix();
       SensorTruth tr;
       tr.t_s = t;
       tr.w_radps = R.transpose() * w_body + rate[p] * kRadPerDeg * axes[p];
@@ -100,8 +112,10 @@ inline TestLog make_log(const SensorParams& p1, const SensorParams& p2, double d
       s.gyro1_dps[i] = r7(rd[0].gyro_radps[i] * kDegPerRad);
       s.gyro2_dps[i] = r7(rd[1].gyro_radps[i] * kDegPerRad);
     }
-    s.plat1_deg = r6(ang[0]);
-    s.plat2_deg = r6(ang[1]);
+    double lang[2], lrate[2];
+    for (int p = 0; p < 2; ++p) platform_state(t, p, 10.0, 1.0, lang[p], lrate[p]);
+    s.plat1_deg = r6(lang[0]);
+    s.plat2_deg = r6(lang[1]);
     s.temp1_c = std::round(rd[0].temp_c * 1e3) / 1e3;
     s.temp2_c = std::round(rd[1].temp_c * 1e3) / 1e3;
     out.samples.push_back(s);

@@ -637,6 +637,19 @@ CompareResult compare(const Replay& r, const CompareModel& model, const CompareO
     cd.explained_fraction = jn_sum > 0 ? gain_sum / jn_sum : 0.0;
     cd.sensor = sensors_used.size() == 2 ? "both" : sensors_used[0];
     cd.axis = "x,y,z";
+    if (cd.effect == "end_stop_error") {
+      // equal errors at both stops are a rotation about the hinge axis: the same residual as a
+      // mounting rotation about that axis while the platform rests (only flips tell them apart)
+      for (std::size_t i = 0; i + 1 < cd.params.size(); i += 2) {
+        const auto& a = cd.params[i];
+        const auto& b = cd.params[i + 1];
+        if (std::abs(a.value - b.value) < 2.0 * std::hypot(a.sigma, b.sigma) + 0.1 * std::abs(a.value))
+          cd.note = "equal errors at both stops: indistinguishable from mounting_misalignment about the hinge axis";
+      }
+    }
+    if (cd.effect == "mounting_misalignment") {
+      cd.note = "a rotation about a platform's hinge axis is indistinguishable from equal end-stop errors";
+    }
     if (cd.effect == "lowpass_latency") {
       for (const auto& o : chosen) {
         const int s = static_cast<int>(o.set);
@@ -735,7 +748,27 @@ CompareResult compare(const Replay& r, const CompareModel& model, const CompareO
     }
   }
 
-  // ---- noise-type candidates (on the residual after the nuisance fit) ----
+  // ---- noise-type candidates: on the residual after the nuisance fit and after the best
+  // supported systematic candidate (forward selection: a missing systematic effect must not
+  // be mistaken for more noise) ----
+  // per channel: the strongest supported systematic candidate that touches it
+  std::array<const Candidate*, 6> sys_on{};
+  for (const auto& cd : cands) {
+    if (!cd.testable || cd.fit.empty() || cd.evidence <= opt.evidence_threshold) continue;
+    for (const auto& f : cd.fit)
+      if (!sys_on[f.channel] || cd.evidence > sys_on[f.channel]->evidence) sys_on[f.channel] = &cd;
+  }
+  auto noise_residual = [&](const Chan& C, int c) {
+    std::vector<double> zr = nuisance_residual(C);
+    if (!sys_on[c]) return zr;
+    for (const auto& f : sys_on[c]->fit) {
+      if (f.channel != c) continue;
+      const int i = C.index(f.column);
+      if (i < 0) continue;
+      for (std::size_t b = 0; b < mb; ++b) zr[b] -= C.raw_cols(static_cast<Eigen::Index>(b), i) * f.beta;
+    }
+    return zr;
+  };
   {
     struct NoiseRes { double ev; std::vector<FittedParam> params; double gain; };
     std::array<std::array<NoiseRes, 3>, 6> nr;
@@ -755,7 +788,8 @@ CompareResult compare(const Replay& r, const CompareModel& model, const CompareO
     for (int c = 0; c < 6; ++c) {
       Chan& C = ch[c];
       const SensorParams& p = model.sensor[C.s];
-      std::vector<double> zr = nuisance_residual(C);
+      std::vector<double> zr = noise_residual(C, c);
+      if (sys_on[c]) fit_white(C, zr);  // the white level without the systematic part
       // white noise: fitted N (already the nuisance value) against the model's N
       ChannelNoise nm = C.noise;
       const double Nmodel = p.white_noise.enabled ? p.white_noise.density_dps_rthz[C.j] : 0.0;
@@ -948,7 +982,8 @@ CompareResult compare(const Replay& r, const CompareModel& model, const CompareO
             for (long code = lo + 2; code <= hi - 2; ++code) {
               if (hist.count(code)) continue;
               auto cnt = [&](long cc) { auto it = hist.find(cc); return it == hist.end() ? 0.0 : static_cast<double>(it->second); };
-              const double lam = 0.25 * (cnt(code - 2) + cnt(code - 1) + cnt(code + 1) + cnt(code + 2));
+              // both sides must be well populated (a clipped pile on one side is no evidence)
+              const double lam = 0.5 * std::min(cnt(code - 2) + cnt(code - 1), cnt(code + 1) + cnt(code + 2));
               if (lam >= 40.0) { missing.push_back(code); ev_m += 2.0 * lam - log_m - 2.0 * std::log(static_cast<double>(hi - lo + 1)); }
             }
           }
@@ -1195,15 +1230,16 @@ CompareResult compare(const Replay& r, const CompareModel& model, const CompareO
   }
 
   // ---- ranking, after-residuals, verdict ----
-  // noise-type candidates are judged on what the systematic ones leave: when a systematic
-  // candidate is supported, an inflated noise level is its symptom, not a separate cause
+  // sample_jitter is judged on the full-rate residual with the systematic part still in it:
+  // when a systematic candidate is supported, its excess variance is a symptom, not a cause
   double best_sys = -kInf;
   for (const auto& cd : cands)
     if (cd.testable && cd.kind != "noise") best_sys = std::max(best_sys, cd.evidence);
   const bool sys_first = best_sys > opt.evidence_threshold;
   std::stable_sort(cands.begin(), cands.end(), [&](const Candidate& a, const Candidate& b) {
     if (a.testable != b.testable) return a.testable;
-    if (sys_first && (a.kind == "noise") != (b.kind == "noise")) return b.kind == "noise";
+    const bool an = a.effect == "sample_jitter", bn = b.effect == "sample_jitter";
+    if (sys_first && an != bn) return bn;
     return a.evidence > b.evidence;
   });
   for (auto& cd : cands) {
