@@ -105,7 +105,7 @@ double allan_edf(std::size_t n, std::size_t m, NoiseType noise) {
       edf = (3.0 * (N - 1.0) / (2.0 * M) - 2.0 * (N - 2.0) / N) * 4.0 * M * M / (4.0 * M * M + 5.0);
       break;
     case NoiseType::kFlickerFM:
-      edf = m == 1 ? 2.0 * (N - 2.0) / (2.3 * N - 4.9) : 5.0 * N * N / (4.0 * M * (N + 3.0 * M));
+      edf = m == 1 ? 2.0 * (N - 2.0) * (N - 2.0) / (2.3 * N - 4.9) : 5.0 * N * N / (4.0 * M * (N + 3.0 * M));
       break;
     case NoiseType::kRandomWalkFM:
       edf = (N - 2.0) / M * ((N - 1.0) * (N - 1.0) - 3.0 * M * (N - 1.0) + 4.0 * M * M) /

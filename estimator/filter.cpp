@@ -241,7 +241,7 @@ bool DriftlessFilter::update(const Eigen::Matrix<double, D, 1>& r, const Eigen::
   } else {
     P_ = IKH * P_;  // as printed
   }
-  P_ = 0.5 * (P_ + P_.transpose());
+  P_ = (0.5 * (P_ + P_.transpose())).eval();  // eval: no aliasing with the transpose
   for (int i = 0; i < 6; ++i) P_(i, i) = std::max(P_(i, i), cfg_.variance_floor_dps2);
   return true;
 }
@@ -316,8 +316,9 @@ int DriftlessFilter::close_segment() {
   cur.r = M1 * y1 - M2 * y2;  // eq. (2): r = R1 y1 - R2 y2
   cur.H.block<3, 3>(0, kBias1.start) = M1;
   cur.H.block<3, 3>(0, kBias2.start) = -M2;
-  // eq. (2)'s noise R1 n1 - R2 n2, averaged over n samples
-  const double var = cfg_.sample_variance_dps2(rate_hz) / double(s.n);
+  // eq. (2)'s noise R1 n1 - R2 n2, averaged over n samples; the bias random walk adds q T / 12
+  // (its mean over the standstill scatters about its value at the midpoint)
+  const double var = cfg_.sample_variance_dps2(rate_hz) / double(s.n) + q_rate_dps2_per_s_ * span / 12.0;
   cur.R = var * (M1 * M1.transpose() + M2 * M2.transpose());
 
   UpdateRecord rec;
@@ -326,7 +327,9 @@ int DriftlessFilter::close_segment() {
   rec.samples = s.n;
   rec.plat1_deg = p1;
   rec.plat2_deg = p2;
-  predict_to(s.t_last_s);
+  // the average measures the bias at the standstill's midpoint: update there, then carry P on
+  const double t_mid = 0.5 * (s.t_first_s + s.t_last_s);
+  predict_to(std::max(t_mid, finite(t_filter_s_) ? t_filter_s_ : t_mid));
   int result = 0;
   if (cfg_.mode == FilterMode::kGeneral) {
     const bool ok = update<3>(cur.r, cur.H, cur.R, rec);
@@ -347,6 +350,8 @@ int DriftlessFilter::close_segment() {
     result = ok ? 1 : -1;
   }
   prev_res_ = cur;
+  predict_to(s.t_last_s);
+  if (result != 0) last_update_.sigma_dps = sigma_dps();
   return result;
 }
 
@@ -480,19 +485,26 @@ void DriftlessFilter::commit(const Eigen::Vector3d& y1, const Eigen::Vector3d& y
 void DriftlessFilter::fuse_rate(const Sample& s, double p1, double p2, bool p1_rest, bool p2_rest) {
   out_.y1c_dps = s.gyro1_dps - x_.segment<3>(kBias1.start);
   out_.y2c_dps = s.gyro2_dps - x_.segment<3>(kBias2.start);
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero(), raw = Eigen::Vector3d::Zero();
   int n = 0;
   // a sensor on a moving platform also reads its hinge rate; only resting ones enter the fusion
   if (p1_rest && finite(p1)) {
-    sum += body_from_sensor(1, p1) * out_.y1c_dps;
+    const Eigen::Matrix3d M1 = body_from_sensor(1, p1);
+    sum += M1 * out_.y1c_dps;
+    raw += M1 * s.gyro1_dps;
     ++n;
   }
   if (p2_rest && finite(p2)) {
-    sum += body_from_sensor(2, p2) * out_.y2c_dps;
+    const Eigen::Matrix3d M2 = body_from_sensor(2, p2);
+    sum += M2 * out_.y2c_dps;
+    raw += M2 * s.gyro2_dps;
     ++n;
   }
   out_.sensors_fused = n;
-  out_.rate_body_dps = n > 0 ? Eigen::Vector3d(sum / double(n)) : Eigen::Vector3d::Constant(kNaN);
+  if (n > 0) {
+    out_.rate_body_dps = sum / double(n);
+    out_.rate_body_raw_dps = raw / double(n);
+  }
 }
 
 PushStatus DriftlessFilter::push(const Sample& s) {

@@ -155,6 +155,7 @@ struct SampleOutput {
   // fused inertial body rate in box axes (Earth rate included): the mean of M_i y_ic over the
   // sensors whose platform is at rest with a known angle; NaN when none is
   Eigen::Vector3d rate_body_dps = Eigen::Vector3d::Constant(kNaN);
+  Eigen::Vector3d rate_body_raw_dps = Eigen::Vector3d::Constant(kNaN);  // the same, uncorrected
   int sensors_fused = 0;  // 0, 1 or 2
   PushStatus status = PushStatus::kInvalid;
 };

@@ -40,8 +40,9 @@ OverlayText overlay_text(const std::string& title, double t_s, double speed, boo
     next = fmt::format("~{:.1f} s, platform {}", st.next_flip_s, st.next_platform + 1);
   }
   const std::string att = std::isnan(st.attitude_error_deg)
-                              ? std::string("n/a (no attitude estimate)")
-                              : fmt::format("{:.3f} deg", st.attitude_error_deg);
+                              ? std::string("n/a (needs ref_q and the estimator)")
+                              : fmt::format("{:.4f} deg (DriftLess-corrected)",
+                                            st.attitude_error_deg);
   const int h = static_cast<int>(t_s / 3600.0);
   const int mi = static_cast<int>((t_s - 3600.0 * h) / 60.0);
   const double sec = t_s - 3600.0 * h - 60.0 * mi;
@@ -106,6 +107,23 @@ void ResidualChart::push(const Sample& s, bool at_rest) {
     sum_truth_ += residual_dps(b, a1_, a2_);
     ++n_truth_;
   }
+}
+
+BiasChart::BiasChart(int sensor, double window_s, int points)
+    : chart_(fmt::format("bias {} estimate xyz, pale: true (deg/s)", sensor),
+             {{"est x", {0.95f, 0.25f, 0.25f}},
+              {"est y", {0.25f, 0.85f, 0.25f}},
+              {"est z", {0.35f, 0.5f, 1.0f}},
+              {"true x", {1.0f, 0.7f, 0.7f}},
+              {"true y", {0.7f, 1.0f, 0.7f}},
+              {"true z", {0.75f, 0.8f, 1.0f}}},
+             window_s),
+      bucket_s_(window_s / points) {}
+
+void BiasChart::push(double t_s, const Eigen::Vector3d& est, const Eigen::Vector3d& truth) {
+  if (!std::isnan(last_push_s_) && t_s - last_push_s_ < bucket_s_) return;
+  last_push_s_ = t_s;
+  chart_.push(t_s, {est[0], est[1], est[2], truth[0], truth[1], truth[2]});
 }
 
 }  // namespace driftless::render

@@ -32,14 +32,14 @@ OverlayText overlay_text(const std::string& title, double t_s, double speed, boo
 Eigen::Vector3d residual_dps(const Sample& s, const Eigen::Vector3d& hinge1_axis,
                              const Eigen::Vector3d& hinge2_axis);
 
-/// Feeds the strip chart: the residual averaged over buckets while both platforms rest, and the
-/// residual the logged true biases predict (R1 b1 - R2 b2), when the log carries them.
+/// Feeds the residual strip chart: the residual averaged over buckets while both platforms
+/// rest, and the residual the logged true biases predict (R1 b1 - R2 b2), when the log has them.
 class ResidualChart {
  public:
   /// window_s: chart width in data seconds; points: buckets per window.
   ResidualChart(const Eigen::Vector3d& hinge1_axis, const Eigen::Vector3d& hinge2_axis,
                 double window_s, int points = 400);
-  /// Adds one sample; `at_rest`: both platforms still (the residual is meaningful).
+  /// Adds one sample; `at_rest`: both platforms settled (the residual is meaningful).
   void push(const Sample& s, bool at_rest);
   const StripChart& chart() const { return chart_; }
 
@@ -52,6 +52,21 @@ class ResidualChart {
   Eigen::Vector3d sum_r_ = Eigen::Vector3d::Zero(), sum_truth_ = Eigen::Vector3d::Zero();
   int n_r_ = 0, n_truth_ = 0;
   double last_t_s_ = kNaN;
+};
+
+/// The bias estimate of one sensor against its true bias (deg/s, sensor axes), one point per
+/// bucket.
+class BiasChart {
+ public:
+  BiasChart(int sensor, double window_s, int points = 400);
+  /// est/truth: this sensor's bias, deg/s (NaN parts are skipped).
+  void push(double t_s, const Eigen::Vector3d& est_dps, const Eigen::Vector3d& truth_dps);
+  const StripChart& chart() const { return chart_; }
+
+ private:
+  StripChart chart_;
+  double bucket_s_;
+  double last_push_s_ = kNaN;
 };
 
 }  // namespace driftless::render

@@ -10,6 +10,7 @@
 
 #include "renders/gl_context.hpp"
 #include "renders/overlay.hpp"
+#include "renders/telemetry.hpp"
 
 namespace driftless::render {
 
@@ -21,8 +22,7 @@ LogFrameSource::LogFrameSource(const std::filesystem::path& log, const mjModel* 
   if (model_ == nullptr || !pose_) throw std::invalid_argument("LogFrameSource needs a model");
   const auto& meta = reader_.metadata();
   info_.title = log.filename().string();
-  info_.hinge1_axis = meta.hinge1_axis();
-  info_.hinge2_axis = meta.hinge2_axis();
+  info_.metadata = meta;
   info_.end_s = meta.get_number("duration_s", kNaN);
 }
 
@@ -228,7 +228,12 @@ RenderStats render_video(FrameSource& source, const RenderParams& params,
   const double speed = params.timeline.speed;
   const double window_s =
       std::isnan(params.chart_window_s) ? std::max(30.0, 20.0 * speed) : params.chart_window_s;
-  ResidualChart chart(info.hinge1_axis, info.hinge2_axis, window_s);
+  TelemetryParams tp;
+  tp.run_estimator = params.run_estimator;
+  tp.window_s = window_s;
+  tp.settle_s = kSettleS;
+  Telemetry telemetry(tp, info.metadata);
+  const auto charts = telemetry.charts();
   PlatformTracker tracker;
   FramePlanner<Held> planner(params.timeline);
 
@@ -242,9 +247,9 @@ RenderStats render_video(FrameSource& source, const RenderParams& params,
     const double t1 = now_s();
     if (params.overlay) {
       const auto text = overlay_text(info.title, f.t_s, speed, f.realtime_flip, held.overlay);
-      scene.render(data.get(), text, &chart.chart(), held.sample.t_s, buf);
+      scene.render(data.get(), text, charts, held.sample.t_s, buf);
     } else {
-      scene.render(data.get(), OverlayText{}, nullptr, f.t_s, buf);
+      scene.render(data.get(), OverlayText{}, {}, f.t_s, buf);
     }
     const double t2 = now_s();
     out.submit(std::move(buf));
@@ -262,11 +267,10 @@ RenderStats render_video(FrameSource& source, const RenderParams& params,
     ++stats.samples;
     const bool flip_starts =
         tracker.update(cur.sample.t_s, cur.sample.plat1_deg, cur.sample.plat2_deg);
-    // the residual means something once both platforms settled (eq. (2) assumes rest)
-    if (params.overlay) {
-      chart.push(cur.sample, tracker.rest_duration_s(cur.sample.t_s) >= kSettleS);
-    }
     cur.overlay = overlay_state(tracker);
+    if (params.overlay) {
+      telemetry.push(cur.sample, tracker.rest_duration_s(cur.sample.t_s), cur.overlay);
+    }
     if (!planner.push(cur.sample.t_s, flip_starts, tracker.rest_duration_s(cur.sample.t_s), cur,
                       emit)) {
       break;

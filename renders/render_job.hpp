@@ -22,9 +22,8 @@ namespace driftless::render {
 /// What a source tells the overlay about its stream.
 struct StreamInfo {
   std::string title = "DriftLess Twin";  // first overlay line (scenario or log name)
-  Eigen::Vector3d hinge1_axis = Eigen::Vector3d::UnitZ();  // box frame
-  Eigen::Vector3d hinge2_axis = Eigen::Vector3d::UnitX();
-  double end_s = kNaN;  // last data time if known (progress), s
+  log::Metadata metadata;  // hinge axes, sample rate, latitude (docs/log-format.md keys)
+  double end_s = kNaN;     // last data time if known (progress), s
 };
 
 /// A time-ordered stream of samples, each with the world posed for it.
@@ -68,6 +67,7 @@ struct RenderParams {
   EncoderParams encoder;
   std::filesystem::path out = "video.mp4";
   bool overlay = true;
+  bool run_estimator = true;     // overlay the DriftLess filter's estimate (else the residual)
   double chart_window_s = kNaN;  // strip chart width in data s; NaN: max(30, 20 * speed)
 
   /// Throws std::invalid_argument naming the bad option.

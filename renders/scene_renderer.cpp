@@ -67,7 +67,10 @@ std::vector<std::pair<double, double>> StripChart::points(std::size_t i, double 
 // ---- renderer ----
 
 SceneRenderer::SceneRenderer(const mjModel* model, const SceneParams& params)
-    : params_(params), model_(nullptr, &mj_deleteModel), figure_(std::make_unique<mjvFigure>()) {
+    : params_(params),
+      live_model_(model),
+      model_(nullptr, &mj_deleteModel),
+      figure_(std::make_unique<mjvFigure>()) {
   params_.validate();
   if (model == nullptr) throw std::invalid_argument("SceneRenderer needs a model");
   model_.reset(mj_copyModel(nullptr, model));
@@ -84,6 +87,8 @@ SceneRenderer::SceneRenderer(const mjModel* model, const SceneParams& params)
   if (name.empty()) {
     if (mj_name2id(m, mjOBJ_CAMERA, "track") >= 0) {
       name = "track";
+    } else if (mj_name2id(m, mjOBJ_CAMERA, "cam_track") >= 0) {
+      name = "cam_track";
     } else if (m->ncam > 0) {
       const char* n0 = mj_id2name(m, mjOBJ_CAMERA, 0);
       name = n0 != nullptr ? n0 : "";
@@ -200,7 +205,7 @@ void SceneRenderer::add_triads(const mjData* d) {
   }
 }
 
-void SceneRenderer::draw_chart(const StripChart& chart, double t_now_s) {
+void SceneRenderer::draw_chart(const StripChart& chart, double t_now_s, int slot) {
   mjvFigure& f = *figure_;
   mjv_defaultFigure(&f);
   f.flg_legend = 0;  // the title names the lines; a legend would hide the data
@@ -235,16 +240,16 @@ void SceneRenderer::draw_chart(const StripChart& chart, double t_now_s) {
     }
     f.linepnt[i] = k;
   }
-  const int w = params_.width_px * 45 / 100;
-  const int h = params_.height_px * 36 / 100;
-  mjrRect rect{params_.width_px - w, 0, w, h};
+  const int w = params_.width_px * 40 / 100;
+  const int h = params_.height_px * 25 / 100;
+  mjrRect rect{params_.width_px - w, slot * h, w, h};
   mjr_figure(rect, &f, &context_);
 }
 
-void SceneRenderer::render(mjData* data, const OverlayText& text, const StripChart* chart,
-                           double t_now_s, std::vector<std::uint8_t>& rgb_top_down) {
-  mjModel* m = model_.get();
-  mjv_updateScene(m, data, &option_, nullptr, &camera_, mjCAT_ALL, &scene_);
+void SceneRenderer::render(mjData* data, const OverlayText& text,
+                           const std::vector<const StripChart*>& charts, double t_now_s,
+                           std::vector<std::uint8_t>& rgb_top_down) {
+  mjv_updateScene(live_model_, data, &option_, nullptr, &camera_, mjCAT_ALL, &scene_);
   add_triads(data);
   const mjrRect viewport{0, 0, params_.width_px, params_.height_px};
   mjr_setBuffer(mjFB_OFFSCREEN, &context_);
@@ -257,7 +262,10 @@ void SceneRenderer::render(mjData* data, const OverlayText& text, const StripCha
     mjr_overlay(mjFONT_NORMAL, mjGRID_BOTTOMLEFT, viewport, text.bottom_left_titles.c_str(),
                 text.bottom_left_values.c_str(), &context_);
   }
-  if (chart != nullptr && !chart->empty()) draw_chart(*chart, t_now_s);
+  int slot = 0;
+  for (const StripChart* chart : charts) {
+    if (chart != nullptr && !chart->empty()) draw_chart(*chart, t_now_s, slot++);
+  }
   mjr_readPixels(bottom_up_.data(), nullptr, viewport, &context_);
   // OpenGL rows run bottom-up; video rows run top-down
   const std::size_t row = static_cast<std::size_t>(params_.width_px) * 3;

@@ -14,7 +14,7 @@ namespace driftless::render {
 struct SceneParams {
   int width_px = 640;
   int height_px = 480;
-  std::string camera;           // MJCF camera name, "free", or empty: "track" if any, else first
+  std::string camera;  // MJCF camera name, "free", or empty: "track"/"cam_track", else the first
   bool shadows = false;         // shadows double llvmpipe's cost per frame
   bool reflections = false;
   int msaa_samples = 0;         // off-screen multisampling (0 = off)
@@ -62,7 +62,8 @@ class StripChart {
 /// (GlContext) on the calling thread for its whole life.
 class SceneRenderer {
  public:
-  /// Copies `model` (the copy's off-screen buffer is sized to the frame); throws
+  /// Sizes the off-screen buffer for a copy of `model`; frames draw `model` itself (so changes
+  /// such as hidden carriers show), which must outlive the renderer. Throws
   /// std::invalid_argument for an unknown camera (listing the model's cameras).
   SceneRenderer(const mjModel* model, const SceneParams& params);
   ~SceneRenderer();
@@ -70,9 +71,10 @@ class SceneRenderer {
   SceneRenderer& operator=(const SceneRenderer&) = delete;
 
   /// Renders `data` (positions already computed: mj_kinematics + mj_comPos + mj_camlight) with
-  /// the overlay; `rgb_top_down` receives width*height*3 bytes, first row at the top.
-  void render(mjData* data, const OverlayText& text, const StripChart* chart, double t_now_s,
-              std::vector<std::uint8_t>& rgb_top_down);
+  /// the overlay text and charts (stacked up from the lower right corner, drawn up to t_now_s);
+  /// `rgb_top_down` receives width*height*3 bytes, first row at the top.
+  void render(mjData* data, const OverlayText& text, const std::vector<const StripChart*>& charts,
+              double t_now_s, std::vector<std::uint8_t>& rgb_top_down);
 
   /// The camera in use ("free" or an MJCF camera name).
   const std::string& camera_name() const { return camera_name_; }
@@ -83,9 +85,10 @@ class SceneRenderer {
 
  private:
   void add_triads(const mjData* data);
-  void draw_chart(const StripChart& chart, double t_now_s);
+  void draw_chart(const StripChart& chart, double t_now_s, int slot);
 
   SceneParams params_;
+  const mjModel* live_model_;
   std::unique_ptr<mjModel, decltype(&mj_deleteModel)> model_;
   mjvScene scene_{};
   mjrContext context_{};

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cmath>
+#include <filesystem>
 #include <functional>
 #include <random>
 #include <vector>
@@ -30,7 +31,10 @@ struct SynthParams {
   double noise_sigma_dps = 0.0;     // per-sample white noise, each axis
   double gm_sigma_dps = 0.0;        // Gauss-Markov bias wander (steady-state sigma)
   double gm_tau_s = 1000.0;         // its correlation time
-  std::function<Eigen::Vector3d(double)> body_rate_dps;  // inertial body rate (box axes); zero if empty
+  // box rate relative to ENU in box axes (zero if empty); the sensors also see the Earth rate
+  std::function<Eigen::Vector3d(double)> body_rate_dps;
+  bool earth_rate = true;
+  double latitude_deg = 52.0;
   std::uint64_t seed = 1;
 };
 
@@ -38,7 +42,7 @@ inline log::Metadata synth_metadata(const SynthParams& p) {
   log::Metadata m;
   m.set("complete", "true");
   m.set("sample_rate_hz", std::to_string(p.rate_hz));
-  m.set("latitude_deg", "52.0");
+  m.set("latitude_deg", std::to_string(p.latitude_deg));
   auto vec = [](const Eigen::Vector3d& v) {
     return std::to_string(v.x()) + " " + std::to_string(v.y()) + " " + std::to_string(v.z());
   };
@@ -59,8 +63,8 @@ inline void synth_samples(const SynthParams& p, const std::function<void(const S
   static constexpr int kS1[4] = {+1, +1, -1, -1};
   static constexpr int kS2[4] = {+1, -1, -1, +1};
   Eigen::Vector3d gm1 = Eigen::Vector3d::Zero(), gm2 = Eigen::Vector3d::Zero();
-  const double phi = std::exp(-dt / p.gm_tau_s);
-  const double drive = p.gm_sigma_dps * std::sqrt(1.0 - phi * phi);
+  const double gm_phi = std::exp(-dt / p.gm_tau_s);
+  const double drive = p.gm_sigma_dps * std::sqrt(1.0 - gm_phi * gm_phi);
   if (p.gm_sigma_dps > 0.0) {
     for (int i = 0; i < 3; ++i) {
       gm1[i] = p.gm_sigma_dps * g(rng);
@@ -93,7 +97,12 @@ inline void synth_samples(const SynthParams& p, const std::function<void(const S
       t2 = t2 + (n2 - t2) * s;
       moving = true;
     }
-    const Eigen::Vector3d w = p.body_rate_dps ? p.body_rate_dps(t) : Eigen::Vector3d::Zero();
+    const Eigen::Vector3d w_nb = p.body_rate_dps ? p.body_rate_dps(t) : Eigen::Vector3d::Zero();
+    const double phi = p.latitude_deg * kRadPerDeg;
+    const Eigen::Vector3d w_ie_enu_dps =
+        p.earth_rate ? Eigen::Vector3d(Eigen::Vector3d(0.0, std::cos(phi), std::sin(phi)) * kEarthRateRadps * kDegPerRad)
+                     : Eigen::Vector3d(Eigen::Vector3d::Zero());
+    const Eigen::Vector3d w = w_nb + q.conjugate() * w_ie_enu_dps;  // inertial, box axes
     const Eigen::Matrix3d R1 = Eigen::AngleAxisd(t1 * kRadPerDeg, p.hinge1.normalized()).toRotationMatrix();
     const Eigen::Matrix3d R2 = Eigen::AngleAxisd(t2 * kRadPerDeg, p.hinge2.normalized()).toRotationMatrix();
     const Eigen::Vector3d b1 = p.b1_dps + gm1, b2 = p.b2_dps + gm2;
@@ -117,17 +126,23 @@ inline void synth_samples(const SynthParams& p, const std::function<void(const S
     s.true_rate_body_dps = w;
     s.set_q_enu_from_body(q);
     sink(s);
-    // truth attitude: the body rate here is taken relative to ENU (tests using attitude pass
-    // the Earth rate in separately)
-    const Eigen::Vector3d wr = w * kRadPerDeg * dt;
+    // truth attitude q_enu_from_body follows the rate relative to ENU
+    const Eigen::Vector3d wr = w_nb * kRadPerDeg * dt;
     if (wr.norm() > 0.0) q = (q * Eigen::Quaterniond(Eigen::AngleAxisd(wr.norm(), wr.normalized()))).normalized();
     if (p.gm_sigma_dps > 0.0) {
       for (int i = 0; i < 3; ++i) {
-        gm1[i] = phi * gm1[i] + drive * g(rng);
-        gm2[i] = phi * gm2[i] + drive * g(rng);
+        gm1[i] = gm_phi * gm1[i] + drive * g(rng);
+        gm2[i] = gm_phi * gm2[i] + drive * g(rng);
       }
     }
   }
+}
+
+/// Writes the samples as a log (ref_q and truth columns included).
+inline void synth_log(const SynthParams& p, const std::filesystem::path& path) {
+  log::LogWriter w(path, synth_metadata(p), kFieldRefQ | kFieldTrueBias | kFieldTrueRate | kFieldTruePlat);
+  synth_samples(p, [&](const Sample& s) { w.write(s); });
+  w.finish(true);
 }
 
 inline std::vector<Sample> synth_all(const SynthParams& p) {

@@ -189,3 +189,25 @@ TEST(AllanTest, DeterministicOnRerun) {
 
 }  // namespace
 }  // namespace driftless::est
+
+namespace driftless::est {
+namespace {
+
+TEST(AllanTest, EquivalentDegreesOfFreedomFollowNistTable5) {
+  // N = 1025 phase points (1024 rate samples); values from the closed forms of NIST SP 1065 table 5
+  const std::size_t n = 1024;
+  const double N = 1025.0;
+  EXPECT_NEAR(allan_edf(n, 4, NoiseType::kWhiteFM), (3.0 * (N - 1) / 8.0 - 2.0 * (N - 2) / N) * 64.0 / 69.0, 1e-9);
+  EXPECT_NEAR(allan_edf(n, 1, NoiseType::kFlickerFM), 2.0 * (N - 2) * (N - 2) / (2.3 * N - 4.9), 1e-9);
+  EXPECT_NEAR(allan_edf(n, 8, NoiseType::kFlickerFM), 5.0 * N * N / (32.0 * (N + 24.0)), 1e-9);
+  EXPECT_NEAR(allan_edf(n, 2, NoiseType::kWhitePM), (N + 1) * (N - 4) / (2.0 * (N - 2)), 1e-9);
+  // more data, more degrees of freedom; longer tau, fewer
+  for (NoiseType t : {NoiseType::kWhitePM, NoiseType::kFlickerPM, NoiseType::kWhiteFM, NoiseType::kFlickerFM,
+                      NoiseType::kRandomWalkFM}) {
+    EXPECT_GT(allan_edf(10 * n, 4, t), allan_edf(n, 4, t)) << to_string(t);
+    EXPECT_GT(allan_edf(n, 4, t), allan_edf(n, 64, t)) << to_string(t);
+  }
+}
+
+}  // namespace
+}  // namespace driftless::est

@@ -1,6 +1,9 @@
 // The DriftLess filter on synthetic samples from the closed-form sensor equation.
 #include <cmath>
+#include <cstdio>
 #include <sstream>
+
+#include <Eigen/Eigenvalues>
 
 #include <gtest/gtest.h>
 
@@ -56,6 +59,219 @@ TEST(FilterTest, NoiseFreeConstantBiasesRecoveredPaperMode) {
   EXPECT_EQ(f.counters().schedule_mismatches, 0u);
   EXPECT_EQ(f.last_update().dim, 6);
   EXPECT_LT((f.bias_dps() - truth(p)).cwiseAbs().maxCoeff(), 1e-9) << f.bias_dps().transpose();
+}
+
+}  // namespace
+}  // namespace driftless::est
+
+namespace driftless::est {
+namespace {
+
+EstimatorConfig quiet_config() {
+  EstimatorConfig cfg;
+  cfg.q_override_dps2_per_s = 1e-14;  // constant biases in these runs
+  cfg.noise_density_dps_rthz = 0.005;  // = 0.05 deg/s per sample at 100 Hz, as synthesised
+  return cfg;
+}
+
+TEST(FilterTest, TwoPositionsLeaveTheHingeComponentUnobservable) {
+  // GIVEN platform 2 held at +90 deg: only platform 1 flips (about z)
+  test::SynthParams p;
+  p.hold_platform2 = true;
+  p.noise_sigma_dps = 0.05;
+  p.duration_s = 600.0;
+  DriftlessFilter f(quiet_config(), test::synth_metadata(p));
+  test::synth_samples(p, [&](const Sample& s) { f.push(s); });
+  const Vector6d sd = f.sigma_dps();
+  // THEN b1 across the hinge is estimated, b1 along hinge 1 (z) is not: its sigma stays near P0
+  EXPECT_LT(sd[0], 0.01);
+  EXPECT_LT(sd[1], 0.01);
+  EXPECT_GT(sd[2], 2.0);
+  // the unobservable direction is b1_z together with the part of b2 it maps onto (R2 b2 . z)
+  Eigen::SelfAdjointEigenSolver<Matrix6d> eig(f.covariance_dps2());
+  const Vector6d v = eig.eigenvectors().col(5);
+  EXPECT_GT(std::fabs(v[2]), 0.5);
+  EXPECT_GT(eig.eigenvalues()[5], 1000.0 * eig.eigenvalues()[4]);
+}
+
+TEST(FilterTest, StaticBoxWithWrongRotationMatricesStillEstimatesTheBiases) {
+  // GIVEN a box at rest whose platforms never move (the paper's Fig. 5 run): only the Earth rate
+  test::SynthParams p;
+  p.standstill_s = 1e9;  // no flips
+  p.duration_s = 600.0;
+  p.noise_sigma_dps = 0.05;
+  // WHEN the filter assumes eq. (5)'s positions from a 10 s schedule (matrices that are wrong
+  // three quarters of the time)
+  for (FilterMode mode : {FilterMode::kGeneral, FilterMode::kPaper}) {
+    EstimatorConfig cfg = mode == FilterMode::kPaper ? paper_config() : quiet_config();
+    cfg.q_override_dps2_per_s = 1e-14;
+    cfg.standstill = StandstillSource::kSchedule;
+    cfg.standstill_period_s = 10.0;
+    DriftlessFilter f(cfg, test::synth_metadata(p));
+    test::synth_samples(p, [&](const Sample& s) { f.push(s); });
+    // THEN the biases come out anyway: x ~ 0 so a wrong R adds only Earth rate (0.004 deg/s) terms
+    EXPECT_GT(f.counters().updates, 50u);
+    EXPECT_LT((f.bias_dps() - truth(p)).cwiseAbs().maxCoeff(), 0.02) << f.bias_dps().transpose();
+  }
+}
+
+TEST(FilterTest, NanSamplesNeverEnterTheState) {
+  test::SynthParams p;
+  p.duration_s = 60.0;
+  p.noise_sigma_dps = 0.05;
+  DriftlessFilter f(quiet_config(), test::synth_metadata(p));
+  std::size_t k = 0, nan_pushed = 0;
+  test::synth_samples(p, [&](const Sample& s) {
+    f.push(s);
+    if (++k % 97 == 0) {
+      Sample bad = s;
+      bad.t_s += 0.001;
+      bad.gyro2_dps.y() = kNaN;
+      const Vector6d before = f.bias_dps();
+      const Matrix6d P = f.covariance_dps2();
+      EXPECT_EQ(f.push(bad), PushStatus::kInvalid);
+      EXPECT_EQ(f.bias_dps(), before);
+      EXPECT_EQ(f.covariance_dps2(), P);
+      ++nan_pushed;
+    }
+  });
+  EXPECT_EQ(f.counters().invalid, nan_pushed);
+  EXPECT_TRUE(f.bias_dps().allFinite());
+  EXPECT_LT((f.bias_dps() - truth(p)).cwiseAbs().maxCoeff(), 0.02);
+  // time going backwards is dropped, not thrown
+  Sample back;
+  back.t_s = 1.0;
+  back.gyro1_dps.setZero();
+  back.gyro2_dps.setZero();
+  EXPECT_EQ(f.push(back), PushStatus::kTimeNotIncreasing);
+}
+
+TEST(FilterTest, SurvivesASourceSwitchWithANewTimeline) {
+  // GIVEN a filter fed by one source, then by another whose time restarts at 0
+  test::SynthParams p;
+  p.duration_s = 120.0;
+  p.noise_sigma_dps = 0.05;
+  DriftlessFilter f(quiet_config(), test::synth_metadata(p));
+  test::synth_samples(p, [&](const Sample& s) { f.push(s); });
+  const auto updates_before = f.counters().updates;
+  f.on_source_switch();
+  p.seed = 2;
+  test::synth_samples(p, [&](const Sample& s) { f.push(s); });
+  // THEN it keeps its estimate and keeps updating
+  EXPECT_EQ(f.counters().source_switches, 1u);
+  EXPECT_EQ(f.counters().time_not_increasing, 0u);
+  EXPECT_GT(f.counters().updates, updates_before + 5);
+  EXPECT_LT((f.bias_dps() - truth(p)).cwiseAbs().maxCoeff(), 0.01);
+}
+
+TEST(FilterTest, GyroOnlyStandstillDetectionFindsTheFlips) {
+  // GIVEN end-stop hardware: no angle read-back at all (columns empty), a slowly turning box
+  test::SynthParams p;
+  p.duration_s = 300.0;
+  p.noise_sigma_dps = 0.05;
+  p.body_rate_dps = [](double t) { return Eigen::Vector3d(0.5 * std::sin(0.05 * t), 0.3, 0.0); };
+  EstimatorConfig cfg = quiet_config();
+  cfg.standstill = StandstillSource::kGyroSignal;
+  DriftlessFilter f(cfg, test::synth_metadata(p));
+  test::synth_samples(p, [&](const Sample& s) {
+    Sample blind = s;
+    blind.plat1_deg = blind.plat2_deg = kNaN;
+    f.push(blind);
+  });
+  // THEN every flip was seen (one update per standstill) and the biases are found
+  EXPECT_GE(f.counters().updates, 25u);
+  EXPECT_LE(f.counters().updates, 28u);
+  EXPECT_EQ(f.counters().rejected, 0u);
+  EXPECT_LT((f.bias_dps() - truth(p)).cwiseAbs().maxCoeff(), 0.02) << f.bias_dps().transpose();
+}
+
+TEST(FilterTest, NisGateRejectsAnOutlierStandstillAndReportsIt) {
+  test::SynthParams p;
+  p.duration_s = 200.0;
+  p.noise_sigma_dps = 0.05;
+  DriftlessFilter f(quiet_config(), test::synth_metadata(p));
+  bool saw_reject = false;
+  test::synth_samples(p, [&](const Sample& s) {
+    Sample x = s;
+    if (s.t_s > 155.0 && s.t_s < 160.0) x.gyro1_dps.x() += 3.0;  // a disturbed standstill
+    if (f.push(x) == PushStatus::kRejected) {
+      saw_reject = true;
+      EXPECT_FALSE(f.last_update().accepted);
+      EXPECT_GT(f.last_update().nis, f.last_update().nis_gate);
+    }
+  });
+  EXPECT_TRUE(saw_reject);
+  EXPECT_EQ(f.counters().rejected, 1u);
+  EXPECT_LT((f.bias_dps() - truth(p)).cwiseAbs().maxCoeff(), 0.01);
+}
+
+TEST(FilterTest, PerSampleUpdatesAgreeWithStandstillAverages) {
+  test::SynthParams p;
+  p.duration_s = 120.0;
+  p.noise_sigma_dps = 0.05;
+  EstimatorConfig a = quiet_config(), b = quiet_config();
+  b.per_sample_updates = true;
+  DriftlessFilter fa(a, test::synth_metadata(p)), fb(b, test::synth_metadata(p));
+  test::synth_samples(p, [&](const Sample& s) {
+    fa.push(s);
+    fb.push(s);
+  });
+  // with Q ~ 0 both are the same least-squares problem
+  EXPECT_LT((fa.bias_dps() - fb.bias_dps()).cwiseAbs().maxCoeff(), 2e-3);
+  EXPECT_GT(fb.counters().updates, 50u * fa.counters().updates);
+}
+
+TEST(FilterTest, CalibratedMatricesReplaceTheRotations) {
+  // GIVEN sensor 1 with a 2 % scale error and a small misalignment, known from calibration
+  test::SynthParams p;
+  p.duration_s = 300.0;
+  p.body_rate_dps = [](double t) { return Eigen::Vector3d(10.0 * std::sin(0.2 * t), 5.0, -4.0); };
+  Eigen::Matrix3d C;  // y1 = C^-1 R1^T w + b1  ->  M = R1 C
+  C << 1.02, 0.01, 0.0, -0.005, 0.99, 0.003, 0.0, 0.002, 1.01;
+  EstimatorConfig cfg = quiet_config();
+  cfg.r_override_dps2 = 1e-6;
+  for (double a : {90.0, -90.0}) {
+    const Eigen::Matrix3d R = Eigen::AngleAxisd(a * kRadPerDeg, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    cfg.calibration.sensor1.push_back({a, R * C});
+  }
+  DriftlessFilter f(cfg, test::synth_metadata(p));
+  test::synth_samples(p, [&](const Sample& s) {
+    Sample x = s;
+    const Eigen::Matrix3d R =
+        Eigen::AngleAxisd(s.true_plat1_deg * kRadPerDeg, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    const Eigen::Vector3d ideal = s.gyro1_dps - s.true_bias1_dps;  // R^T w + hinge rate
+    x.gyro1_dps = C.inverse() * ideal + s.true_bias1_dps;
+    (void)R;
+    f.push(x);
+  });
+  // THEN the biases come out of the calibrated model (with rotations alone they would not)
+  EXPECT_LT((f.bias_dps() - truth(p)).cwiseAbs().maxCoeff(), 1e-3) << f.bias_dps().transpose();
+  EXPECT_TRUE(f.body_from_sensor(1, 90.0).isApprox(cfg.calibration.sensor1[0].M_body_from_sensor));
+}
+
+TEST(ConfigTest, RoundTripsAndNamesBadLines) {
+  EstimatorConfig c = paper_config();
+  c.settle_s = 0.75;
+  c.standstill = StandstillSource::kGyroSignal;
+  std::stringstream ss;
+  write_estimator_config(ss, c);
+  const auto back = parse_estimator_config(ss, "cfg.yaml");
+  EXPECT_EQ(back.mode, FilterMode::kPaper);
+  EXPECT_EQ(back.covariance_update, CovarianceUpdate::kPrinted);
+  EXPECT_EQ(back.standstill, StandstillSource::kGyroSignal);
+  EXPECT_DOUBLE_EQ(back.settle_s, 0.75);
+  std::stringstream bad("# tuning\nsettle_s: 0.5\nnoise_density_dps_rthz: fast\n");
+  try {
+    parse_estimator_config(bad, "cfg.yaml");
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("cfg.yaml:3"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("noise_density_dps_rthz"), std::string::npos);
+  }
+  std::stringstream unknown("settle: 1\n");
+  EXPECT_THROW(parse_estimator_config(unknown, "x"), std::invalid_argument);
+  std::stringstream neg("settle_s: -1\n");
+  EXPECT_THROW(parse_estimator_config(neg, "x"), std::invalid_argument);
 }
 
 }  // namespace

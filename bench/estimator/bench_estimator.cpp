@@ -1,0 +1,80 @@
+// Estimator speed: overlapping ADEV of 14 h at 100 Hz, `estimate` on a 14 h log (CSV parsing
+// included), and the per-sample cost of the live push() path.
+#include <cmath>
+#include <filesystem>
+#include <random>
+#include <vector>
+
+#include <benchmark/benchmark.h>
+
+#include "estimator/allan.hpp"
+#include "estimator/filter.hpp"
+#include "estimator/pipeline.hpp"
+#include "tests/estimator/synth.hpp"
+
+namespace {
+
+using namespace driftless;
+
+constexpr std::size_t k14hSamples = 5'040'000;  // 14 h at 100 Hz
+
+void BM_AdevOctave14h(benchmark::State& state) {
+  std::mt19937_64 rng(1);
+  std::normal_distribution<double> g(0.0, 0.05);
+  std::vector<double> x(k14hSamples);
+  for (auto& v : x) v = 1.0 + g(rng);
+  est::AllanOptions opt;
+  opt.sample_rate_hz = 100.0;
+  for (auto _ : state) {
+    auto curve = est::allan_deviation(x, opt);
+    benchmark::DoNotOptimize(curve.points.data());
+  }
+  state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * k14hSamples));
+}
+BENCHMARK(BM_AdevOctave14h)->Unit(benchmark::kMillisecond)->Iterations(3);
+
+test::SynthParams live_params(double duration_s) {
+  test::SynthParams p;
+  p.duration_s = duration_s;
+  p.noise_sigma_dps = 0.05;
+  p.gm_sigma_dps = 0.01;
+  p.body_rate_dps = [](double t) { return Eigen::Vector3d(3.0 * std::sin(0.05 * t), 1.0, 0.5); };
+  return p;
+}
+
+void BM_PushLive(benchmark::State& state) {
+  const auto p = live_params(600.0);
+  const auto samples = test::synth_all(p);
+  const auto meta = test::synth_metadata(p);
+  std::size_t n = 0;
+  for (auto _ : state) {
+    est::DriftlessFilter f(est::EstimatorConfig{}, meta);
+    for (const auto& s : samples) benchmark::DoNotOptimize(f.push(s));
+    n += samples.size();
+  }
+  state.SetItemsProcessed(static_cast<int64_t>(n));
+  state.counters["ns_per_sample"] =
+      benchmark::Counter(static_cast<double>(n), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_PushLive)->Unit(benchmark::kMillisecond);
+
+void BM_Estimate14hLog(benchmark::State& state) {
+  // setup: a 14 h log as the twin writes it (ref_q and truth columns), once per process
+  static const std::filesystem::path path = [] {
+    const auto p = std::filesystem::temp_directory_path() / "driftless_bench_14h.csv";
+    test::synth_log(live_params(14.0 * 3600.0), p);
+    return p;
+  }();
+  for (auto _ : state) {
+    log::LogReader reader(path);
+    auto s = est::run_estimate(reader, est::EstimatorConfig{}, nullptr);
+    benchmark::DoNotOptimize(s.bias_dps.data());
+    state.counters["rows"] = static_cast<double>(s.rows);
+    state.counters["updates"] = static_cast<double>(s.counters.updates);
+  }
+}
+BENCHMARK(BM_Estimate14hLog)->Unit(benchmark::kMillisecond)->Iterations(1);
+
+}  // namespace
+
+BENCHMARK_MAIN();

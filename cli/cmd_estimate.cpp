@@ -1,0 +1,392 @@
+// driftless estimate: run the DriftLess filter over a measurement log and write the bias
+// estimates, corrected outputs, attitude drift and (for simulated logs) errors against truth.
+// Formats: docs/estimator.md.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <fmt/core.h>
+#include <fmt/format.h>
+#include <fmt/os.h>
+
+#include "cli/command.hpp"
+#include "cli/plot.hpp"
+#include "estimator/allan.hpp"
+#include "estimator/calibration.hpp"
+#include "estimator/pipeline.hpp"
+#include "twin/calib/calib_file.hpp"
+
+namespace driftless::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct EstimateArgs {
+  std::string log;
+  std::string out;
+  std::string mode;  // empty = config / general
+  std::string config;
+  std::string calib;  // calib.yaml from driftless calibrate (docs/calibration.md)
+  bool plot = false;
+};
+
+// "%.9f" but NaN -> empty field (the log format's "no value")
+void put(fmt::memory_buffer& b, double v, int decimals) {
+  if (std::isfinite(v)) fmt::format_to(std::back_inserter(b), ",{:.{}f}", v, decimals);
+  else b.push_back(',');
+}
+
+std::string json_number(double v) { return std::isfinite(v) ? fmt::format("{:.9g}", v) : "null"; }
+
+std::string json_vec(const est::Vector6d& v) {
+  return fmt::format("[{}, {}, {}, {}, {}, {}]", json_number(v[0]), json_number(v[1]), json_number(v[2]),
+                     json_number(v[3]), json_number(v[4]), json_number(v[5]));
+}
+
+std::string json_string(const std::string& s) {
+  std::string o = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') o += '\\';
+    if (static_cast<unsigned char>(c) < 0x20) {
+      o += ' ';
+      continue;
+    }
+    o += c;
+  }
+  return o + "\"";
+}
+
+// writes the per-sample and per-update files while the pass runs
+class FileSink : public est::EstimateSink {
+ public:
+  FileSink(const fs::path& dir, bool truth, bool keep_series)
+      : corrected_(fmt::output_file((dir / "corrected.csv").string())),
+        estimate_(fmt::output_file((dir / "estimate.csv").string())),
+        attitude_(fmt::output_file((dir / "attitude.csv").string())),
+        truth_(truth),
+        keep_series_(keep_series) {
+    corrected_.print("t,y1c_x,y1c_y,y1c_z,y2c_x,y2c_y,y2c_z,rate_x,rate_y,rate_z,status\n");
+    estimate_.print(
+        "t,b1_x,b1_y,b1_z,b2_x,b2_y,b2_z,sigma1_x,sigma1_y,sigma1_z,sigma2_x,sigma2_y,sigma2_z,"
+        "nis,nis_gate,dim,samples,plat1_deg,plat2_deg,accepted{}\n",
+        truth ? ",true_bias1_x,true_bias1_y,true_bias1_z,true_bias2_x,true_bias2_y,true_bias2_z" : "");
+    attitude_.print(
+        "t,roll_err_deg,pitch_err_deg,heading_err_deg,angle_err_deg,"
+        "raw_roll_err_deg,raw_pitch_err_deg,raw_heading_err_deg,raw_angle_err_deg\n");
+  }
+
+  void on_sample(const Sample& s, const est::SampleOutput& o) override {
+    auto& b = buf_;
+    fmt::format_to(std::back_inserter(b), "{:.6f}", s.t_s);
+    for (int i = 0; i < 3; ++i) put(b, o.y1c_dps[i], 7);
+    for (int i = 0; i < 3; ++i) put(b, o.y2c_dps[i], 7);
+    for (int i = 0; i < 3; ++i) put(b, o.rate_body_dps[i], 7);
+    fmt::format_to(std::back_inserter(b), ",{}\n", est::to_string(o.status));
+    if (b.size() > (1u << 20)) flush();
+    if (keep_series_ && s.gyros_finite()) {
+      if (o.status == est::PushStatus::kMoving) platforms_moved_ = true;
+      // fused body rate, holding the last value while no platform is at rest
+      if (o.rate_body_dps.allFinite()) {
+        last_rate_ = o.rate_body_dps;
+        last_raw_rate_ = o.rate_body_raw_dps;
+      }
+      for (int i = 0; i < 3; ++i) {
+        raw1_[i].push_back(static_cast<float>(s.gyro1_dps[i]));
+        cor1_[i].push_back(static_cast<float>(o.y1c_dps[i]));
+        raw_rate_[i].push_back(static_cast<float>(last_raw_rate_[i]));
+        cor_rate_[i].push_back(static_cast<float>(last_rate_[i]));
+      }
+    }
+  }
+
+  void on_update(const est::UpdateRecord& r, const est::Matrix6d&, const Sample& s) override {
+    fmt::memory_buffer b;
+    fmt::format_to(std::back_inserter(b), "{:.6f}", r.t_s);
+    for (int i = 0; i < 6; ++i) put(b, r.bias_dps[i], 9);
+    for (int i = 0; i < 6; ++i) put(b, r.sigma_dps[i], 9);
+    put(b, r.nis, 6);
+    put(b, r.nis_gate, 6);
+    fmt::format_to(std::back_inserter(b), ",{},{}", r.dim, r.samples);
+    put(b, r.plat1_deg, 3);
+    put(b, r.plat2_deg, 3);
+    fmt::format_to(std::back_inserter(b), ",{}", r.accepted ? 1 : 0);
+    if (truth_) {
+      for (int i = 0; i < 3; ++i) put(b, s.true_bias1_dps[i], 9);
+      for (int i = 0; i < 3; ++i) put(b, s.true_bias2_dps[i], 9);
+    }
+    b.push_back('\n');
+    estimate_.print("{}", fmt::to_string(b));
+  }
+
+  void on_attitude(const est::AttitudePoint& p) override {
+    attitude_.print("{:.6f},{:.6f},{:.6f},{:.6f},{:.6f},{:.6f},{:.6f},{:.6f},{:.6f}\n", p.t_s,
+                    p.corrected.roll_deg, p.corrected.pitch_deg, p.corrected.heading_deg,
+                    p.corrected.angle_deg, p.raw.roll_deg, p.raw.pitch_deg, p.raw.heading_deg,
+                    p.raw.angle_deg);
+  }
+
+  void flush() {
+    corrected_.print("{}", std::string_view(buf_.data(), buf_.size()));
+    buf_.clear();
+  }
+  void close() {
+    flush();
+    corrected_.close();
+    estimate_.close();
+    attitude_.close();
+  }
+
+  std::vector<float> raw1_[3], cor1_[3];          // sensor 1 output, raw and corrected
+  std::vector<float> raw_rate_[3], cor_rate_[3];  // fused body rate, raw and corrected
+  bool platforms_moved_ = false;
+
+ private:
+  Eigen::Vector3d last_rate_ = Eigen::Vector3d::Zero(), last_raw_rate_ = Eigen::Vector3d::Zero();
+  fmt::ostream corrected_, estimate_, attitude_;
+  fmt::memory_buffer buf_;
+  bool truth_;
+  bool keep_series_;
+};
+
+void write_summary(const fs::path& path, const EstimateArgs& a, const est::EstimatorConfig& cfg,
+                   const est::EstimateSummary& s) {
+  auto o = fmt::output_file(path.string());
+  o.print("{{\n");
+  o.print("  \"log\": {},\n", json_string(a.log));
+  o.print("  \"mode\": \"{}\",\n", cfg.mode == est::FilterMode::kPaper ? "paper" : "general");
+  o.print("  \"rows\": {},\n  \"rows_missing_gyro\": {},\n", s.rows, s.rows_missing_gyro);
+  o.print("  \"log_complete\": {},\n", s.log_complete ? "true" : "false");
+  o.print("  \"t_first_s\": {}, \"t_last_s\": {},\n", json_number(s.t_first_s), json_number(s.t_last_s));
+  o.print("  \"updates\": {}, \"rejected\": {}, \"standstills_too_short\": {}, \"schedule_mismatches\": {},\n",
+          s.counters.updates, s.counters.rejected, s.counters.standstills_too_short,
+          s.counters.schedule_mismatches);
+  o.print("  \"final_bias_dps\": {},\n", json_vec(s.bias_dps));
+  o.print("  \"final_sigma_dps\": {},\n", json_vec(s.sigma_dps));
+  o.print("  \"attitude_drift_deg_per_h\": {{\"with_driftless\": {}, \"without_driftless\": {}}},\n",
+          json_number(s.drift_corrected_deg_per_h), json_number(s.drift_raw_deg_per_h));
+  o.print("  \"final_attitude_error_deg\": {{\"with_driftless\": {}, \"without_driftless\": {}}},\n",
+          json_number(s.final_corrected.angle_deg), json_number(s.final_raw.angle_deg));
+  if (s.truth.available) {
+    const auto& t = s.truth;
+    o.print("  \"truth\": {{\n");
+    o.print("    \"updates_evaluated\": {},\n", t.updates);
+    o.print("    \"bias_error_rms_dps\": {},\n", json_number(t.bias_error_rms_dps));
+    o.print("    \"bias_error_rms_second_half_dps\": {},\n", json_number(t.bias_error_rms_second_half_dps));
+    o.print("    \"final_bias_error_dps\": {},\n", json_vec(t.final_error_dps));
+    o.print("    \"within_3sigma_fraction\": {},\n", json_number(t.within_3sigma_fraction));
+    o.print("    \"nees\": {{\"dof\": 6, \"mean\": {}, \"mean_band_95\": [{}, {}], \"single_band_95\": [{}, {}], "
+            "\"fraction_in_single_band\": {}}}\n",
+            json_number(t.nees_mean), json_number(t.nees_mean_band_lo), json_number(t.nees_mean_band_hi),
+            json_number(t.nees_band_lo), json_number(t.nees_band_hi), json_number(t.nees_fraction_in_band));
+    o.print("  }},\n");
+  }
+  o.print("  \"bias_error_rms_dps\": {},\n", json_number(s.truth.bias_error_rms_dps));
+  o.print("  \"warnings\": [");
+  for (std::size_t i = 0; i < s.warnings.size(); ++i) o.print("{}{}", i ? ", " : "", json_string(s.warnings[i]));
+  o.print("]\n}}\n");
+}
+
+std::vector<std::string> make_plots(const fs::path& dir, FileSink& sink, bool truth, bool attitude,
+                                    double rate_hz) {
+  std::vector<std::string> warnings;
+  // Fig. 4: bias estimate (and truth) against time, one panel per sensor
+  {
+    std::string body = "  set multiplot layout 2,1 title 'Fig. 4: bias estimates'\n"
+                       "  set xlabel 't [s]'; set ylabel 'bias [deg/s]'\n";
+    for (int sensor = 1; sensor <= 2; ++sensor) {
+      const int c0 = sensor == 1 ? 2 : 5;
+      body += fmt::format("  set title 'sensor {}'\n  plot ", sensor);
+      static constexpr const char* kColour[3] = {"#d62728", "#2ca02c", "#1f77b4"};
+      for (int a = 0; a < 3; ++a) {
+        body += fmt::format("'estimate.csv' using 1:{} with lines lw 2 lc rgb '{}' title 'b{}_{} estimate', ",
+                            c0 + a, kColour[a], sensor, "xyz"[a]);
+        if (truth) {
+          body += fmt::format("'estimate.csv' using 1:{} with lines dt 2 lc rgb '{}' title 'b{}_{} true', ",
+                              c0 + a + 19, kColour[a], sensor, "xyz"[a]);
+        }
+      }
+      body.resize(body.size() - 2);
+      body += "\n";
+    }
+    body += "  unset multiplot\n";
+    if (auto w = render_gnuplot(dir, "fig4_bias", body); !w.empty()) warnings.push_back(w);
+  }
+  // Fig. 5: Allan deviation raw against corrected: sensor 1's axes on a static run (the paper's
+  // Fig. 5); when the platforms flip, the sensor outputs carry the flips, so the fused body rate
+  if (!sink.raw1_[0].empty() && sink.raw1_[0].size() >= 3 && std::isfinite(rate_hz)) {
+    std::vector<AllanTableColumn> cols;
+    est::AllanOptions opt;
+    opt.sample_rate_hz = rate_hz;
+    const bool fused = sink.platforms_moved_;
+    for (int pass = 0; pass < 2; ++pass) {
+      for (int a = 0; a < 3; ++a) {
+        const auto& src = fused ? (pass == 0 ? sink.raw_rate_[a] : sink.cor_rate_[a])
+                                : (pass == 0 ? sink.raw1_[a] : sink.cor1_[a]);
+        std::vector<double> x(src.begin(), src.end());
+        const auto curve = est::allan_deviation(x, opt);
+        AllanTableColumn c;
+        c.name = fmt::format("{}{}_{}", pass == 0 ? "raw_" : "corrected_", fused ? "rate" : "gyro1", "xyz"[a]);
+        for (const auto& p : curve.points) {
+          c.tau_s.push_back(p.tau_s);
+          c.adev.push_back(p.adev);
+          c.lo.push_back(p.adev_lo);
+          c.hi.push_back(p.adev_hi);
+        }
+        cols.push_back(std::move(c));
+      }
+    }
+    write_allan_table(dir / "allan_fig5.csv", cols);
+    std::string body = fmt::format(
+        "  set logscale xy; set xlabel 'tau [s]'; set ylabel 'Allan deviation [deg/s]'\n"
+        "  set title 'Fig. 5: Allan deviation of {}, raw (red) and DriftLess-corrected (black)'\n"
+        "  plot ",
+        fused ? "the fused body rate" : "sensor 1");
+    for (int i = 0; i < 6; ++i) {
+      body += fmt::format("'allan_fig5.csv' using 1:{} with linespoints lc rgb '{}' dt {} title columnhead({}){}",
+                          2 + 3 * i, i < 3 ? "red" : "black", 1 + i % 3, 2 + 3 * i, i < 5 ? ", " : "\n");
+    }
+    if (auto w = render_gnuplot(dir, "fig5_allan", body); !w.empty()) warnings.push_back(w);
+  }
+  // Fig. 9: attitude error with and without DriftLess
+  if (attitude) {
+    std::string body =
+        "  set xlabel 't [s]'; set ylabel 'attitude error [deg]'\n"
+        "  set title 'Fig. 9: attitude error without (red) and with (blue) DriftLess'\n"
+        "  plot 'attitude.csv' using 1:6 with lines lc rgb 'red' dt 1 title 'roll (raw)', "
+        "'' using 1:7 with lines lc rgb 'red' dt 2 title 'pitch (raw)', "
+        "'' using 1:8 with lines lc rgb 'red' dt 3 title 'heading (raw)', "
+        "'' using 1:2 with lines lc rgb 'blue' dt 1 title 'roll', "
+        "'' using 1:3 with lines lc rgb 'blue' dt 2 title 'pitch', "
+        "'' using 1:4 with lines lc rgb 'blue' dt 3 title 'heading'\n";
+    if (auto w = render_gnuplot(dir, "fig9_attitude", body); !w.empty()) warnings.push_back(w);
+  }
+  return warnings;
+}
+
+bool stop_polled() { return stop_requested().load(); }
+
+int run_estimate_cmd(const EstimateArgs& a) {
+  est::EstimatorConfig cfg;
+  if (!a.config.empty()) {
+    std::ifstream in(a.config);
+    if (!in) throw std::runtime_error("cannot read --config " + a.config);
+    cfg = est::parse_estimator_config(in, a.config, a.mode == "paper" ? est::paper_config() : est::EstimatorConfig{});
+  } else if (a.mode == "paper") {
+    cfg = est::paper_config();
+  }
+  if (!a.mode.empty()) est::set_config_value(cfg, "mode", a.mode);
+  log::LogReader reader(a.log);
+  // --calib: the calibrated matrices M replace R in eq. (1)-(2) (docs/calibration.md)
+  if (!a.calib.empty()) {
+    const twin::calib::CalibFile c = twin::calib::load_calib(a.calib);
+    const auto& meta = reader.metadata();
+    if ((c.hinge1_axis.normalized() - meta.hinge1_axis().normalized()).norm() > 1e-6 ||
+        (c.hinge2_axis.normalized() - meta.hinge2_axis().normalized()).norm() > 1e-6) {
+      throw std::invalid_argument(fmt::format(
+          "--calib {}: calibrated for hinge axes [{} {} {}] / [{} {} {}] but the log {} has [{} {} {}] / "
+          "[{} {} {}]: not the same box", a.calib, c.hinge1_axis.x(), c.hinge1_axis.y(), c.hinge1_axis.z(),
+          c.hinge2_axis.x(), c.hinge2_axis.y(), c.hinge2_axis.z(), a.log, meta.hinge1_axis().x(),
+          meta.hinge1_axis().y(), meta.hinge1_axis().z(), meta.hinge2_axis().x(), meta.hinge2_axis().y(),
+          meta.hinge2_axis().z()));
+    }
+    cfg.calibration = est::to_filter_calibration(c.M);
+  }
+  cfg.validate();
+
+  const bool truth = (reader.fields() & kFieldTrueBias) != 0;
+  const bool attitude = (reader.fields() & kFieldRefQ) != 0;
+  fs::create_directories(a.out);
+  const fs::path dir(a.out);
+  {
+    std::ofstream used(dir / "config_used.txt");
+    est::write_estimator_config(used, cfg);
+  }
+  FileSink sink(dir, truth, a.plot);
+  Progress progress("estimate");
+  struct ProgressSink : est::EstimateSink {
+    FileSink* inner;
+    Progress* p;
+    double t_end;
+    std::uint64_t n = 0;
+    void on_sample(const Sample& s, const est::SampleOutput& o) override {
+      inner->on_sample(s, o);
+      if ((++n & 8191u) == 0 && std::isfinite(t_end) && t_end > 0) p->update(std::min(1.0, s.t_s / t_end));
+    }
+    void on_update(const est::UpdateRecord& r, const est::Matrix6d& P, const Sample& s) override {
+      inner->on_update(r, P, s);
+    }
+    void on_attitude(const est::AttitudePoint& ap) override { inner->on_attitude(ap); }
+  } ps;
+  ps.inner = &sink;
+  ps.p = &progress;
+  ps.t_end = reader.metadata().get_number("duration_s", kNaN);
+  const auto summary = est::run_estimate(reader, cfg, &ps, {}, &stop_polled);
+  sink.close();
+  progress.done(fmt::format("{} rows, {} updates", summary.rows, summary.counters.updates));
+
+  auto warnings = summary.warnings;
+  if (a.plot) {
+    double rate = reader.metadata().sample_rate_hz();
+    if (!std::isfinite(rate) && summary.rows > 1) rate = double(summary.rows - 1) / (summary.t_last_s - summary.t_first_s);
+    for (auto& w : make_plots(dir, sink, truth, attitude, rate)) warnings.push_back(w);
+  }
+  auto final_summary = summary;
+  final_summary.warnings = warnings;
+  write_summary(dir / "summary.json", a, cfg, final_summary);
+
+  for (const auto& w : warnings) fmt::print(stderr, "driftless estimate: warning: {}\n", w);
+  const auto& b = summary.bias_dps;
+  const auto& sg = summary.sigma_dps;
+  fmt::print("{}: {} rows, {} updates ({} rejected)\n", a.log, summary.rows, summary.counters.updates,
+             summary.counters.rejected);
+  fmt::print("  b1 = ({:+.5f}, {:+.5f}, {:+.5f}) +- ({:.5f}, {:.5f}, {:.5f}) deg/s\n", b[0], b[1], b[2], sg[0],
+             sg[1], sg[2]);
+  fmt::print("  b2 = ({:+.5f}, {:+.5f}, {:+.5f}) +- ({:.5f}, {:.5f}, {:.5f}) deg/s\n", b[3], b[4], b[5], sg[3],
+             sg[4], sg[5]);
+  if (summary.attitude_available) {
+    fmt::print("  attitude drift: {:.2f} deg/h with DriftLess, {:.2f} deg/h without\n",
+               summary.drift_corrected_deg_per_h, summary.drift_raw_deg_per_h);
+  }
+  if (truth && summary.truth.updates > 0) {
+    fmt::print("  against truth: bias error rms {:.5f} deg/s, mean NEES {:.2f} (95 % band {:.2f}..{:.2f})\n",
+               summary.truth.bias_error_rms_dps, summary.truth.nees_mean, summary.truth.nees_mean_band_lo,
+               summary.truth.nees_mean_band_hi);
+  }
+  fmt::print("  wrote {}/{{estimate.csv, corrected.csv, attitude.csv, summary.json}}\n", a.out);
+  return 0;
+}
+
+const bool registered = register_command(30, [](CLI::App& app) {
+  auto* cmd = app.add_subcommand(
+      "estimate", "Run the DriftLess bias filter over a measurement log: bias estimates (deg/s), "
+                  "corrected outputs, attitude drift (deg/h); docs/estimator.md");
+  auto a = std::make_shared<EstimateArgs>();
+  cmd->add_option("--log", a->log, "Measurement log (CSV, driftless-log 1; docs/log-format.md)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--out", a->out, "Output folder (created): estimate.csv, corrected.csv, summary.json")
+      ->required();
+  cmd->add_option("--mode", a->mode,
+                  "paper: eq. (5) switching with 6-dim stacked residuals, printed recursion; "
+                  "general: H from the platform angles in force (default)")
+      ->check(CLI::IsMember({"paper", "general"}));
+  cmd->add_option("--config", a->config,
+                  "Estimator configuration, 'key: value' lines (units in the key names: _s, _deg, "
+                  "_dps, _dps_rthz, _dps2; docs/estimator.md)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--calib", a->calib,
+                  "Calibration file from 'driftless calibrate' (calib.yaml): the matrices M per "
+                  "sensor and end stop (deg/s in, deg/s out) replace the hinge rotations; "
+                  "docs/calibration.md")
+      ->check(CLI::ExistingFile);
+  cmd->add_flag("--plot", a->plot,
+                "Also write Fig. 4 (bias vs truth, deg/s), Fig. 5 (Allan deviation, deg/s vs s) and "
+                "Fig. 9 (attitude error, deg vs s) as PNG + SVG with their gnuplot scripts");
+  return [a] { return run_estimate_cmd(*a); };
+});
+
+}  // namespace
+}  // namespace driftless::cli

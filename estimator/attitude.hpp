@@ -1,0 +1,56 @@
+// Strapdown attitude from the fused body rate (paper section 4): R_be integrated after removing
+// the Earth rate, compared with the reference attitude (ref_q). Eigen + std only.
+#pragma once
+
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "estimator/sample.hpp"
+
+namespace driftless::est {
+
+/// Integrates q_enu_from_body from the inertial body rate (Earth rate included, box axes).
+class AttitudeIntegrator {
+ public:
+  /// latitude_deg: for the Earth rate Omega (0, cos phi, sin phi) in ENU.
+  explicit AttitudeIntegrator(double latitude_deg);
+  /// Starts at attitude q (q_enu_from_body) at time t_s.
+  void reset(const Eigen::Quaterniond& q_enu_from_body, double t_s);
+  bool initialized() const { return initialized_; }
+  /// Advances to t_s with the inertial body rate there (deg/s, box axes); the rate over the
+  /// interval is the mean of the previous and this one. A NaN rate holds the last finite rate.
+  void step(double t_s, const Eigen::Vector3d& rate_body_dps);
+  const Eigen::Quaterniond& q_enu_from_body() const { return q_; }
+  double t_s() const { return t_; }
+  /// Earth rate in ENU, rad/s.
+  const Eigen::Vector3d& earth_rate_enu_radps() const { return w_ie_enu_; }
+
+ private:
+  Eigen::Vector3d w_ie_enu_;
+  Eigen::Quaterniond q_ = Eigen::Quaterniond::Identity();
+  Eigen::Vector3d last_rate_radps_ = Eigen::Vector3d::Zero();
+  double t_ = kNaN;
+  bool initialized_ = false;
+};
+
+/// Attitude error of an estimate against the reference, deg: the error rotation
+/// q_est q_ref^-1 in ENU as a rotation vector, split into roll (about North), pitch (about East)
+/// and heading (about Up) -- the usual INS tilt/heading errors, exact for a box facing north --
+/// and its total angle.
+struct AttitudeError {
+  double roll_deg = 0.0;
+  double pitch_deg = 0.0;
+  double heading_deg = 0.0;
+  double angle_deg = 0.0;
+};
+AttitudeError attitude_error(const Eigen::Quaterniond& q_est, const Eigen::Quaterniond& q_ref);
+
+/// Roll, pitch, yaw (deg) of q_enu_from_body, ZYX convention.
+Eigen::Vector3d roll_pitch_yaw_deg(const Eigen::Quaterniond& q_enu_from_body);
+
+/// Drift rate in deg/h: slope of a least-squares line (with intercept) through err(t) (deg vs s).
+double drift_deg_per_h(const std::vector<double>& t_s, const std::vector<double>& err_deg);
+
+}  // namespace driftless::est

@@ -1,0 +1,78 @@
+// One pass over a log: the DriftLess filter, strapdown attitude with and without the correction,
+// and (evaluation only) errors against the log's true_ columns. The CLI, the benchmarks and the
+// tests share it; file output is the caller's (EstimateSink). Eigen + std only.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "estimator/attitude.hpp"
+#include "estimator/filter.hpp"
+#include "estimator/log.hpp"
+
+namespace driftless::est {
+
+/// One attitude comparison point (deg), with and without the DriftLess correction.
+struct AttitudePoint {
+  double t_s = kNaN;
+  AttitudeError corrected;
+  AttitudeError raw;
+};
+
+/// Receives the pass's outputs as they happen (all optional).
+class EstimateSink {
+ public:
+  virtual ~EstimateSink() = default;
+  /// Every sample, after the filter saw it (out: corrected outputs and fused rate).
+  virtual void on_sample(const Sample& /*s*/, const SampleOutput& /*out*/) {}
+  /// Every update; `s` is the sample whose push produced it (its true_ columns for evaluation).
+  virtual void on_update(const UpdateRecord& /*rec*/, const Matrix6d& /*P*/, const Sample& /*s*/) {}
+  /// Attitude errors every `attitude_interval_s`.
+  virtual void on_attitude(const AttitudePoint& /*p*/) {}
+};
+
+struct EstimateRunOptions {
+  double attitude_interval_s = 1.0;  // s, spacing of attitude comparison points
+  double nees_band_probability = 0.95;  // two-sided chi-square band for the NEES statistics
+};
+
+/// Statistics against the log's truth (filled when the log has true_bias columns).
+struct TruthStats {
+  bool available = false;
+  std::size_t updates = 0;            // accepted updates evaluated
+  double bias_error_rms_dps = kNaN;   // rms over updates and the 6 components
+  double bias_error_rms_second_half_dps = kNaN;  // the same over the second half (converged)
+  Vector6d final_error_dps = Vector6d::Constant(kNaN);
+  double nees_mean = kNaN;            // mean of e^T P^-1 e (6 dof)
+  double nees_mean_band_lo = kNaN;    // band of the mean at nees_band_probability
+  double nees_mean_band_hi = kNaN;
+  double nees_fraction_in_band = kNaN;  // fraction of single NEES values inside the 6-dof band
+  double nees_band_lo = kNaN, nees_band_hi = kNaN;
+  double within_3sigma_fraction = kNaN;  // component errors inside +-3 sigma
+};
+
+/// What a pass produced.
+struct EstimateSummary {
+  std::uint64_t rows = 0;
+  std::uint64_t rows_missing_gyro = 0;
+  FilterCounters counters;
+  Vector6d bias_dps = Vector6d::Constant(kNaN);
+  Vector6d sigma_dps = Vector6d::Constant(kNaN);
+  double t_first_s = kNaN, t_last_s = kNaN;
+  bool attitude_available = false;   // the log has ref_q
+  double drift_corrected_deg_per_h = kNaN;
+  double drift_raw_deg_per_h = kNaN;
+  AttitudeError final_corrected, final_raw;
+  TruthStats truth;
+  bool log_complete = true;
+  std::vector<std::string> warnings;
+};
+
+/// Runs the filter over every row of `reader` (which it consumes). Throws log::LogError on a
+/// malformed log (the reader's message names file and line); NaN rows are counted and skipped.
+/// `should_stop` (optional) is polled every 4096 rows (Ctrl-C).
+EstimateSummary run_estimate(log::LogReader& reader, const EstimatorConfig& cfg, EstimateSink* sink,
+                             const EstimateRunOptions& opt = {}, bool (*should_stop)() = nullptr);
+
+}  // namespace driftless::est
