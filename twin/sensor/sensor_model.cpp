@@ -146,22 +146,22 @@ LowpassDesign design_lowpass(double bandwidth_hz, double delay_s, double fs) {
   return d;
 }
 
-Eigen::Vector3d SensorModel::Lowpass::apply(const Eigen::Vector3d& x) {
-  const int n = d.delay_whole_samples;
+Eigen::Vector3d LowpassFilter::apply(const Eigen::Vector3d& x) {
+  const int n = d_.delay_whole_samples;
   const int size = n + 2;
-  if (!primed) {  // start in steady state at the first input
-    u = x;
-    hist.assign(size, x);
-    head = 0;
-    primed = true;
+  if (!primed_) {  // start in steady state at the first input
+    u_ = x;
+    hist_.assign(static_cast<std::size_t>(size), x);
+    head_ = 0;
+    primed_ = true;
   } else {
-    u = d.pole * u + (1.0 - d.pole) * x;
-    head = (head + 1) % size;
-    hist[head] = u;
+    u_ = d_.pole * u_ + (1.0 - d_.pole) * x;
+    head_ = head_ + 1 == size ? 0 : head_ + 1;
+    hist_[static_cast<std::size_t>(head_)] = u_;
   }
-  const Eigen::Vector3d& a = hist[(head - n + size) % size];
-  const Eigen::Vector3d& b = hist[(head - n - 1 + 2 * size) % size];
-  return (1.0 - d.delay_frac) * a + d.delay_frac * b;
+  const Eigen::Vector3d& a = hist_[static_cast<std::size_t>((head_ - n + size) % size)];
+  const Eigen::Vector3d& b = hist_[static_cast<std::size_t>((head_ - n - 1 + 2 * size) % size)];
+  return (1.0 - d_.delay_frac) * a + d_.delay_frac * b;
 }
 
 // ---- temperature ----
@@ -386,11 +386,9 @@ SensorModel::SensorModel(const SensorParams& params, double sample_rate_hz, std:
   const auto& p = params_;
   if (p.lowpass_latency.enabled) {
     const DlpfSetting d = mpu6050_dlpf(p.lowpass_latency.dlpf_cfg);
-    lp_gyro_ = design_lowpass(d.gyro_bandwidth_hz, d.gyro_delay_s, fs_hz_);
-    lp_accel_ = design_lowpass(d.accel_bandwidth_hz, d.accel_delay_s, fs_hz_);
+    gyro_filter_ = LowpassFilter(design_lowpass(d.gyro_bandwidth_hz, d.gyro_delay_s, fs_hz_));
+    accel_filter_ = LowpassFilter(design_lowpass(d.accel_bandwidth_hz, d.accel_delay_s, fs_hz_));
   }
-  gyro_filter_.d = lp_gyro_;
-  accel_filter_.d = lp_accel_;
   if (p.adc_missing_codes.enabled) {
     missing_lut_.assign(65536, 0);
     for (int c : inst_.missing_codes) missing_lut_[static_cast<std::size_t>(c - kCodeMin)] = 1;
