@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
 #include "estimator/sample.hpp"
 #include "twin/sensor/sensor_model.hpp"
@@ -58,3 +59,50 @@ TEST(EffectsNoise, RunToRunDrawsHaveTheirSigmas) {
   EXPECT_NEAR(std::sqrt(mount2 / (3 * runs)), 0.2, 0.05 * 0.2);
 }
 
+
+TEST(EffectsNoise, NoiseAliasesWhenTheDlpfIsWiderThanNyquist) {
+  // GIVEN DLPF_CFG 0 (256 Hz) at a 100 Hz output: the chip's noise up to 256 Hz folds down,
+  // so each sample carries sigma = N sqrt(2 * 256 Hz) and consecutive samples are uncorrelated
+  SensorParams p = ideal_sensor();
+  p.white_noise.enabled = true;
+  p.lowpass_latency.enabled = true;
+  p.lowpass_latency.dlpf_cfg = 0;
+  const double fs = 100.0;
+  SensorModel m(p, fs, 13);
+  const int n = 50000;
+  std::vector<double> x(n);
+  for (int k = 0; k < n; ++k) x[k] = m.step(SensorTruth{k / fs, {}, {}}).gyro_radps[1] * kDegPerRad;
+  double s2 = 0, s11 = 0;
+  for (int k = 0; k < n; ++k) {
+    s2 += x[k] * x[k];
+    if (k > 0) s11 += x[k] * x[k - 1];
+  }
+  const double want = 0.005 * std::sqrt(2.0 * 256.0);
+  EXPECT_NEAR(std::sqrt(s2 / n), want, 0.02 * want);
+  EXPECT_LT(std::abs(s11 / s2), 4.0 / std::sqrt(n));
+  // WHEN the DLPF is narrower than fs/2 (cfg 3, 42 Hz) THEN the noise goes through the filter and
+  // the per-sample sigma drops below N sqrt(fs)
+  p.lowpass_latency.dlpf_cfg = 3;
+  SensorModel m3(p, fs, 13);
+  s2 = 0;
+  for (int k = 0; k < n; ++k) s2 += std::pow(m3.step(SensorTruth{k / fs, {}, {}}).gyro_radps[1] * kDegPerRad, 2);
+  const DlpfSetting d = mpu6050_dlpf(3);
+  const LowpassDesign lp = design_lowpass(d.gyro_bandwidth_hz, d.gyro_delay_s, fs);
+  // variance gain of the IIR + two-tap delay: sum of squared impulse response
+  double gain2 = 0, u_prev = 0;
+  std::vector<double> u;
+  for (int k = 0; k < 400; ++k) {
+    const double uk = lp.pole * u_prev + (1 - lp.pole) * (k == 0 ? 1.0 : 0.0);
+    u.push_back(uk);
+    u_prev = uk;
+  }
+  for (int k = 0; k < 400; ++k) {
+    const double a = k - lp.delay_whole_samples >= 0 ? u[k - lp.delay_whole_samples] : 0.0;
+    const double b = k - lp.delay_whole_samples - 1 >= 0 ? u[k - lp.delay_whole_samples - 1] : 0.0;
+    const double h = (1 - lp.delay_frac) * a + lp.delay_frac * b;
+    gain2 += h * h;
+  }
+  const double want3 = 0.005 * std::sqrt(fs) * std::sqrt(gain2);
+  EXPECT_NEAR(std::sqrt(s2 / n), want3, 0.02 * want3);
+  EXPECT_LT(want3, 0.9 * 0.005 * std::sqrt(fs));
+}

@@ -62,7 +62,8 @@ struct RateRandomWalkParams {
   bool operator==(const RateRandomWalkParams&) const = default;
 };
 
-/// 4 white_noise: angle random walk, per-sample sigma = N sqrt(fs).
+/// 4 white_noise: angle random walk N; per-sample sigma = N sqrt(fs), or N sqrt(2 B) when the DLPF
+/// bandwidth B is above fs/2 (the chip samples its registers without anti-aliasing: docs/effects.md).
 struct WhiteNoiseParams {
   bool enabled = true;
   Eigen::Vector3d density_dps_rthz = Eigen::Vector3d::Zero();  // N, deg/s/sqrt(Hz)
@@ -377,6 +378,7 @@ class SensorModel {
   NormalStream rng_gm_, rng_rrw_, rng_white_, rng_jitter_, rng_accel_white_;
   // precomputed constants (rad/s)
   Eigen::Vector3d gm_phi_, gm_drive_, rrw_step_, white_sigma_, accel_white_sigma_;
+  bool gyro_white_after_filter_ = false, accel_white_after_filter_ = false;  // aliased noise
   // changing state
   Eigen::Vector3d b_gm_ = Eigen::Vector3d::Zero(), b_rrw_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d w_prev_ = Eigen::Vector3d::Zero(), f_prev_ = Eigen::Vector3d::Zero();
