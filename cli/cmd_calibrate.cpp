@@ -1,6 +1,7 @@
 // driftless calibrate: the pan/tilt calibration of paper section 4, on a recorded log + rig plan
 // or on the twin's simulated rig; writes calib.yaml (docs/calibration.md).
 #include <cmath>
+#include <fstream>
 #include <memory>
 #include <string>
 
@@ -10,13 +11,14 @@
 #include "estimator/calibration.hpp"
 #include "estimator/log.hpp"
 #include "twin/calib/calib_file.hpp"
+#include "twin/calib/prior.hpp"
 #include "twin/calib/rig_plan.hpp"
 
 namespace driftless::cli {
 namespace {
 
 struct Options {
-  std::string scenario, log, plan, out, method = "least_squares", save_log, save_plan;
+  std::string scenario, log, plan, out, method = "least_squares", save_log, save_plan, prior_out;
 };
 
 est::CalibMethod parse_method(const std::string& m) {
@@ -48,6 +50,16 @@ void print_summary(const est::CalibFit& fit, const twin::calib::RigConditions& r
   }
 }
 
+// --prior-out: the calibrated errors as a twin model-config file
+void write_prior(const Options& o) {
+  if (o.prior_out.empty()) return;
+  const twin::calib::CalibFile c = twin::calib::load_calib(o.out);
+  std::ofstream f(o.prior_out);
+  f << twin::calib::model_prior_yaml(c);
+  if (!f) throw std::runtime_error("cannot write --prior-out " + o.prior_out);
+  fmt::print("wrote {} (model prior)\n", o.prior_out);
+}
+
 int run_from_log(const Options& o) {
   log::Metadata meta;
   const std::vector<Sample> samples = log::read_all(o.log, &meta);
@@ -70,6 +82,7 @@ int run_from_log(const Options& o) {
   twin::calib::save_calib(o.out, fit, rig);
   print_summary(fit, rig, rep);
   fmt::print("wrote {}\n", o.out);
+  write_prior(o);
   return 0;
 }
 
@@ -93,6 +106,9 @@ const bool registered = register_command(40, [](CLI::App& app) {
   cmd->add_option("--out", o->out, "Output calibration file (calib.yaml)")->required();
   cmd->add_option("--method", o->method,
                   "least_squares (Earth rate removed, default) or top_to_top (the paper's averaging)");
+  cmd->add_option("--prior-out", o->prior_out,
+                  "Also write the calibrated errors as a twin model-config file (model: block with "
+                  "scale %, misalignment %, mounting deg, stop errors deg) for simulate --model");
   cmd->add_option("--save-log", o->save_log, "With --scenario: also write the simulated rig log");
   cmd->add_option("--save-plan", o->save_plan, "With --scenario: also write its rig plan");
   scen->excludes(logo)->excludes(plano);
