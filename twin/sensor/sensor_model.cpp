@@ -146,22 +146,22 @@ LowpassDesign design_lowpass(double bandwidth_hz, double delay_s, double fs) {
   return d;
 }
 
-Eigen::Vector3d SensorModel::Lowpass::apply(const Eigen::Vector3d& x) {
-  const int n = d.delay_whole_samples;
+Eigen::Vector3d LowpassFilter::apply(const Eigen::Vector3d& x) {
+  const int n = d_.delay_whole_samples;
   const int size = n + 2;
-  if (!primed) {  // start in steady state at the first input
-    u = x;
-    hist.assign(size, x);
-    head = 0;
-    primed = true;
+  if (!primed_) {  // start in steady state at the first input
+    u_ = x;
+    hist_.assign(static_cast<std::size_t>(size), x);
+    head_ = 0;
+    primed_ = true;
   } else {
-    u = d.pole * u + (1.0 - d.pole) * x;
-    head = (head + 1) % size;
-    hist[head] = u;
+    u_ = d_.pole * u_ + (1.0 - d_.pole) * x;
+    head_ = head_ + 1 == size ? 0 : head_ + 1;
+    hist_[static_cast<std::size_t>(head_)] = u_;
   }
-  const Eigen::Vector3d& a = hist[(head - n + size) % size];
-  const Eigen::Vector3d& b = hist[(head - n - 1 + 2 * size) % size];
-  return (1.0 - d.delay_frac) * a + d.delay_frac * b;
+  const Eigen::Vector3d& a = hist_[static_cast<std::size_t>((head_ - n + size) % size)];
+  const Eigen::Vector3d& b = hist_[static_cast<std::size_t>((head_ - n - 1 + 2 * size) % size)];
+  return (1.0 - d_.delay_frac) * a + d_.delay_frac * b;
 }
 
 // ---- temperature ----
@@ -386,11 +386,9 @@ SensorModel::SensorModel(const SensorParams& params, double sample_rate_hz, std:
   const auto& p = params_;
   if (p.lowpass_latency.enabled) {
     const DlpfSetting d = mpu6050_dlpf(p.lowpass_latency.dlpf_cfg);
-    lp_gyro_ = design_lowpass(d.gyro_bandwidth_hz, d.gyro_delay_s, fs_hz_);
-    lp_accel_ = design_lowpass(d.accel_bandwidth_hz, d.accel_delay_s, fs_hz_);
+    gyro_filter_ = LowpassFilter(design_lowpass(d.gyro_bandwidth_hz, d.gyro_delay_s, fs_hz_));
+    accel_filter_ = LowpassFilter(design_lowpass(d.accel_bandwidth_hz, d.accel_delay_s, fs_hz_));
   }
-  gyro_filter_.d = lp_gyro_;
-  accel_filter_.d = lp_accel_;
   if (p.adc_missing_codes.enabled) {
     missing_lut_.assign(65536, 0);
     for (int c : inst_.missing_codes) missing_lut_[static_cast<std::size_t>(c - kCodeMin)] = 1;
@@ -409,8 +407,20 @@ SensorModel::SensorModel(const SensorParams& params, double sample_rate_hz, std:
     gm_drive_[i] = sigma_gm[i] * std::sqrt(1.0 - gm_phi_[i] * gm_phi_[i]);
   }
   rrw_step_ = p.rate_random_walk.k_dps_rts * (kRadPerDeg * std::sqrt(dt_s_));
-  white_sigma_ = p.white_noise.density_dps_rthz * (kRadPerDeg * std::sqrt(fs_hz_));
-  accel_white_sigma_ = p.accel_white_noise.density_mps2_rthz * std::sqrt(fs_hz_);
+  // white noise: without the DLPF, band-limited to fs/2 (sigma = N sqrt(fs)). With it, the chip's
+  // noise reaches the DLPF bandwidth B and the register is sampled without further filtering: when
+  // 2B >= fs the noise aliases into a white sequence of sigma = N sqrt(2B) added after the filter;
+  // otherwise it is added before the filter, which colours it (long-tau density stays N)
+  double gyro_noise_bw_hz = 0.5 * fs_hz_, accel_noise_bw_hz = 0.5 * fs_hz_;
+  if (p.lowpass_latency.enabled) {
+    const DlpfSetting d = mpu6050_dlpf(p.lowpass_latency.dlpf_cfg);
+    gyro_white_after_filter_ = 2.0 * d.gyro_bandwidth_hz >= fs_hz_;
+    accel_white_after_filter_ = 2.0 * d.accel_bandwidth_hz >= fs_hz_;
+    if (gyro_white_after_filter_) gyro_noise_bw_hz = d.gyro_bandwidth_hz;
+    if (accel_white_after_filter_) accel_noise_bw_hz = d.accel_bandwidth_hz;
+  }
+  white_sigma_ = p.white_noise.density_dps_rthz * (kRadPerDeg * std::sqrt(2.0 * gyro_noise_bw_hz));
+  accel_white_sigma_ = p.accel_white_noise.density_mps2_rthz * std::sqrt(2.0 * accel_noise_bw_hz);
   if (p.bias_instability.enabled && p.bias_instability.stationary_start)
     b_gm_ = sigma_gm.cwiseProduct(normal3(rng_gm_));
 }
@@ -439,14 +449,23 @@ SensorReading SensorModel::step(const SensorTruth& truth) {
 
   // 12, 5, 6, 7, 1, 8: the deterministic chain
   Eigen::Vector3d y = gyro_deterministic_radps(p, inst_, w, f, temp_c);
-  // 2, 3: the slowly moving bias; 4: white noise
+  // 2, 3: the slowly moving bias; 4: white noise (drawn here, added around the DLPF below)
   const Eigen::Vector3d b_moving = b_gm_ + b_rrw_;
   y += b_moving;
-  if (p.white_noise.enabled) y += white_sigma_.cwiseProduct(normal3(rng_white_));
+  Eigen::Vector3d n_white = Eigen::Vector3d::Zero();
+  if (p.white_noise.enabled) n_white = white_sigma_.cwiseProduct(normal3(rng_white_));
   r.bias_radps = inst_.bias_radps + inst_.bias_tc_radps_per_degc * dT + b_moving;
 
-  // 11a: DLPF, then 10, 9: the ADC
-  if (p.lowpass_latency.enabled) y = gyro_filter_.apply(y);
+  // 11a: DLPF (white noise before or after it, see the constructor), then 10, 9: the ADC
+  if (p.lowpass_latency.enabled) {
+    if (gyro_white_after_filter_) {
+      y = gyro_filter_.apply(y) + n_white;
+    } else {
+      y = gyro_filter_.apply(y + n_white);
+    }
+  } else {
+    y += n_white;
+  }
   if (p.adc_missing_codes.enabled) {
     auto missing = [this](int c) { return missing_lut_[static_cast<std::size_t>(c - kCodeMin)] != 0; };
     for (int i = 0; i < 3; ++i) r.gyro_radps[i] = gyro_adc_axis_radps(p, y[i], missing);
@@ -457,8 +476,14 @@ SensorReading SensorModel::step(const SensorTruth& truth) {
 
   // accelerometer: mounting, scale, bias, noise, DLPF, ADC
   Eigen::Vector3d a = accel_deterministic_mps2(p, inst_, f);
-  if (p.accel_white_noise.enabled) a += accel_white_sigma_.cwiseProduct(normal3(rng_accel_white_));
-  if (p.lowpass_latency.enabled) a = accel_filter_.apply(a);
+  Eigen::Vector3d n_accel = Eigen::Vector3d::Zero();
+  if (p.accel_white_noise.enabled) n_accel = accel_white_sigma_.cwiseProduct(normal3(rng_accel_white_));
+  if (p.lowpass_latency.enabled) {
+    a = accel_white_after_filter_ ? Eigen::Vector3d(accel_filter_.apply(a) + n_accel)
+                                  : accel_filter_.apply(a + n_accel);
+  } else {
+    a += n_accel;
+  }
   for (int i = 0; i < 3; ++i) r.accel_mps2[i] = accel_adc_axis_mps2(p.accel_quantization, a[i]);
 
   // temperature register: T = code / 340 + 36.53

@@ -62,7 +62,8 @@ struct RateRandomWalkParams {
   bool operator==(const RateRandomWalkParams&) const = default;
 };
 
-/// 4 white_noise: angle random walk, per-sample sigma = N sqrt(fs).
+/// 4 white_noise: angle random walk N; per-sample sigma = N sqrt(fs), or N sqrt(2 B) when the DLPF
+/// bandwidth B is above fs/2 (the chip samples its registers without anti-aliasing: docs/effects.md).
 struct WhiteNoiseParams {
   bool enabled = true;
   Eigen::Vector3d density_dps_rthz = Eigen::Vector3d::Zero();  // N, deg/s/sqrt(Hz)
@@ -279,6 +280,22 @@ struct LowpassDesign {
 /// Designs the filter: pole from the bandwidth (impulse invariance), delay topped up to delay_s.
 LowpassDesign design_lowpass(double bandwidth_hz, double delay_s, double sample_rate_hz);
 
+/// Runs a LowpassDesign on a 3-vector, one call per sample; starts in steady state at its first input.
+class LowpassFilter {
+ public:
+  explicit LowpassFilter(const LowpassDesign& d = {}) : d_(d) {}
+  /// Filters one sample.
+  Eigen::Vector3d apply(const Eigen::Vector3d& x);
+  const LowpassDesign& design() const { return d_; }
+
+ private:
+  LowpassDesign d_;
+  Eigen::Vector3d u_ = Eigen::Vector3d::Zero();
+  std::vector<Eigen::Vector3d> hist_;  // ring of past u, size n + 2
+  int head_ = 0;
+  bool primed_ = false;
+};
+
 /// The run-to-run part of a sensor, drawn once from the seed, in internal units (rad, rad/s, m/s^2).
 struct SensorInstance {
   Eigen::Vector3d mounting_rotvec_rad = Eigen::Vector3d::Zero();        // rotation vector, nominal<-sensor
@@ -346,31 +363,22 @@ class SensorModel {
   /// The parameters with this run's draws fixed (for compare / diagnose --apply).
   SensorParams realised() const { return realised_params(params_, inst_); }
   double sample_rate_hz() const { return fs_hz_; }
-  const LowpassDesign& gyro_lowpass() const { return lp_gyro_; }
-  const LowpassDesign& accel_lowpass() const { return lp_accel_; }
+  const LowpassDesign& gyro_lowpass() const { return gyro_filter_.design(); }
+  const LowpassDesign& accel_lowpass() const { return accel_filter_.design(); }
 
  private:
-  struct Lowpass {  // run-time state of a LowpassDesign on a 3-vector
-    LowpassDesign d;
-    Eigen::Vector3d u = Eigen::Vector3d::Zero();
-    std::vector<Eigen::Vector3d> hist;  // ring of past u, size n + 2
-    int head = 0;
-    bool primed = false;
-    Eigen::Vector3d apply(const Eigen::Vector3d& x);
-  };
-
   SensorParams params_;
   double fs_hz_, dt_s_;
   SensorInstance inst_;
   TemperatureModel temp_;
-  LowpassDesign lp_gyro_, lp_accel_;
-  Lowpass gyro_filter_, accel_filter_;
+  LowpassFilter gyro_filter_, accel_filter_;
   std::vector<std::uint8_t> missing_lut_;  // 65536 flags, code + 32768
 
   // per-step noise streams, one per effect
   NormalStream rng_gm_, rng_rrw_, rng_white_, rng_jitter_, rng_accel_white_;
   // precomputed constants (rad/s)
   Eigen::Vector3d gm_phi_, gm_drive_, rrw_step_, white_sigma_, accel_white_sigma_;
+  bool gyro_white_after_filter_ = false, accel_white_after_filter_ = false;  // aliased noise
   // changing state
   Eigen::Vector3d b_gm_ = Eigen::Vector3d::Zero(), b_rrw_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d w_prev_ = Eigen::Vector3d::Zero(), f_prev_ = Eigen::Vector3d::Zero();

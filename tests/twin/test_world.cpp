@@ -1,0 +1,135 @@
+// The box model: loads cleanly, applies the box parameters, drives the base exactly, and its
+// end stops stop, overshoot and settle.
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "estimator/sample.hpp"
+#include "tests/twin/mujoco_fixture.hpp"
+#include "twin/flip_schedule.hpp"
+#include "twin/world.hpp"
+
+namespace driftless::twin {
+namespace {
+
+using testing::MujocoTest;
+
+class WorldTest : public MujocoTest {};
+
+TEST_F(WorldTest, InlineXmlLoadsAndBadXmlNamesTheProblem) {
+  auto m = load_xml("<mujoco><worldbody><body><joint type='hinge'/><geom size='0.1'/></body></worldbody></mujoco>");
+  EXPECT_EQ(m->nv, 1);
+  try {
+    load_mjcf_string("<mujoco><worldbody><body><jont/></body></worldbody></mujoco>");
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("jont"), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(WorldTest, ShippedModelHasTheNamedParts) {
+  World w(BoxParams{});
+  const mjModel* m = w.model();
+  for (const char* cam : {"cam_overview", "cam_side", "cam_track", "cam_closeup"}) {
+    EXPECT_GE(mj_name2id(m, mjOBJ_CAMERA, cam), 0) << cam;
+  }
+  for (const char* s : {"gyro1", "accel1", "gyro2", "accel2"}) EXPECT_GE(mj_name2id(m, mjOBJ_SENSOR, s), 0) << s;
+  for (const char* b : {"box", "platform1", "platform2", "pantilt_pan", "pantilt_tilt", "vehicle", "ship"}) {
+    EXPECT_GE(mj_name2id(m, mjOBJ_BODY, b), 0) << b;
+  }
+  EXPECT_EQ(m->nu, 2);
+  EXPECT_NEAR(m->opt.timestep, 0.001, 0);
+}
+
+TEST_F(WorldTest, BoxParamsPatchAxesStopsAndMotor) {
+  BoxParams b;
+  b.hinge2_axis = Eigen::Vector3d(0, 2, 0);  // normalised by the model
+  b.stop1_error_deg = Eigen::Vector2d(0.3, -0.2);
+  b.motor.kp_nm_per_rad = 0.1;
+  World w(b);
+  const mjModel* m = w.model();
+  const int j1 = mj_name2id(m, mjOBJ_JOINT, "hinge1"), j2 = mj_name2id(m, mjOBJ_JOINT, "hinge2");
+  EXPECT_NEAR(m->jnt_axis[3 * j2 + 1], 1.0, 1e-12);
+  EXPECT_NEAR(m->jnt_range[2 * j1 + 0], (-90 + 0.3) * kRadPerDeg, 1e-12);
+  EXPECT_NEAR(m->jnt_range[2 * j1 + 1], (90 - 0.2) * kRadPerDeg, 1e-12);
+  EXPECT_NEAR(m->actuator_gainprm[mjNGAIN * 0], 0.1, 1e-15);
+  EXPECT_NEAR(b.stop_rad(1, +1), (90 - 0.2) * kRadPerDeg, 1e-15);
+}
+
+TEST_F(WorldTest, BadBoxParamsAreRejectedWithTheFieldName) {
+  BoxParams b;
+  b.hinge2_axis = Eigen::Vector3d(0, 0, 3);  // parallel to hinge 1
+  EXPECT_THROW(b.validate(), std::invalid_argument);
+  b = BoxParams{};
+  b.stop_dampratio = 0.2;
+  try {
+    b.validate();
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("stop_dampratio"), std::string::npos);
+  }
+}
+
+// GIVEN a static box, WHEN the motor drives platform 1 from its - stop onto its + stop,
+// THEN the platform overshoots into the compliant stop, settles on it, and never passes it by more
+// than a small penetration
+TEST_F(WorldTest, EndStopOvershootAndSettling) {
+  BoxParams b;
+  b.stop1_error_deg = Eigen::Vector2d(0, 0.2);
+  World w(b);
+  mjModel* m = w.model();
+  mjData* d = w.data();
+  const double stop = b.stop_rad(1, +1);
+  w.set_platform(1, b.stop_rad(1, -1));
+  w.set_platform(2, b.stop_rad(2, +1));
+  const double overtravel = b.motor.overtravel_deg * kRadPerDeg;
+  TrapezoidProfile ref(0.0, -(b.end_stop_deg * kRadPerDeg + overtravel), b.end_stop_deg * kRadPerDeg + overtravel,
+                       b.motor.max_speed_dps * kRadPerDeg, b.motor.max_accel_dps2 * kRadPerDeg);
+  w.set_motor_reference(2, 93 * kRadPerDeg);
+  double peak = -10, t_hit = -1, max_rate = 0;
+  double t = 0;
+  for (int n = 0; n < 4000; ++n, t += m->opt.timestep) {
+    w.set_base(Eigen::Vector3d::Zero(), Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
+    w.set_motor_reference(1, ref.angle_rad(t));
+    mj_step1(m, d);
+    w.drive_base(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
+    mj_step2(m, d);
+    const double q = w.platform_angle_rad(1);
+    peak = std::max(peak, q);
+    max_rate = std::max(max_rate, std::abs(w.platform_rate_radps(1)));
+    if (t_hit < 0 && q >= stop) t_hit = t;
+  }
+  // the motor's speed limit holds (servo lag adds a little)
+  EXPECT_LT(max_rate, 1.1 * b.motor.max_speed_dps * kRadPerDeg);
+  EXPECT_GT(max_rate, 0.9 * b.motor.max_speed_dps * kRadPerDeg);
+  ASSERT_GT(t_hit, 0) << "platform never reached its stop";
+  const double overshoot_deg = (peak - stop) * kDegPerRad;
+  EXPECT_GT(overshoot_deg, 0.005) << "no overshoot into the stop";
+  EXPECT_LT(overshoot_deg, 0.5);
+  // settled: at rest on the stop, pressed in by the motor torque only slightly
+  EXPECT_LT(std::abs(w.platform_rate_radps(1)), 1e-9);
+  EXPECT_NEAR(w.platform_angle_rad(1), stop, 0.02 * kRadPerDeg);
+  EXPECT_GE(w.platform_angle_rad(1), stop);
+}
+
+// GIVEN a prescribed base acceleration, WHEN the drive applies its force, THEN MuJoCo's qacc of
+// the box equals it (the drive imposes the trajectory's dynamics)
+TEST_F(WorldTest, DriveImposesTheBaseAcceleration) {
+  World w(BoxParams{});
+  mjModel* m = w.model();
+  mjData* d = w.data();
+  const Eigen::Vector3d a(0.7, -1.3, 2.1), dw(0.4, -0.2, 0.9);
+  w.set_base(Eigen::Vector3d(1, 2, 3), Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized())),
+             Eigen::Vector3d(0.5, 0, 0), Eigen::Vector3d(0.1, 0.2, -0.3));
+  mj_step1(m, d);
+  w.drive_base(a, dw);
+  mj_forward(m, d);  // recompute qacc with the drive force in place
+  const int dof = m->jnt_dofadr[mj_name2id(m, mjOBJ_JOINT, "drive_x")];
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_NEAR(d->qacc[dof + k], a[k], 1e-6);
+    EXPECT_NEAR(d->qacc[dof + 3 + k], dw[k], 1e-6);
+  }
+}
+
+}  // namespace
+}  // namespace driftless::twin

@@ -1,0 +1,94 @@
+#include "twin/flip_schedule.hpp"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include "estimator/sample.hpp"
+
+namespace driftless::twin {
+
+void FlipScheduleParams::validate(double end_stop_deg) const {
+  if (!(standstill_s > 0 && std::isfinite(standstill_s))) {
+    throw std::invalid_argument("flip_schedule.standstill_s must be > 0 s");
+  }
+  if (!(flip_angle_deg > 0 && flip_angle_deg <= end_stop_deg)) {
+    throw std::invalid_argument("flip_schedule.flip_angle_deg must be in (0, end_stop_deg = " +
+                                std::to_string(end_stop_deg) + "] deg");
+  }
+  if (!(settle_rate_dps > 0)) throw std::invalid_argument("flip_schedule.settle_rate_dps must be > 0 deg/s");
+}
+
+TrapezoidProfile::TrapezoidProfile(double t0, double from, double to, double vmax, double amax)
+    : t0_(t0), from_(from), to_(to), dir_(to >= from ? 1.0 : -1.0), a_(amax) {
+  const double d = std::abs(to - from);
+  v_ = std::min(vmax, std::sqrt(d * amax));
+  t_acc_ = v_ > 0 ? v_ / amax : 0.0;
+  t_cruise_ = v_ > 0 ? (d - v_ * v_ / amax) / v_ : 0.0;
+}
+
+double TrapezoidProfile::angle_rad(double t) const {
+  const double tau = t - t0_;
+  if (tau <= 0) return from_;
+  if (tau >= 2 * t_acc_ + t_cruise_) return to_;
+  const double d_acc = 0.5 * a_ * t_acc_ * t_acc_;
+  double s;
+  if (tau <= t_acc_) {
+    s = 0.5 * a_ * tau * tau;
+  } else if (tau <= t_acc_ + t_cruise_) {
+    s = d_acc + v_ * (tau - t_acc_);
+  } else {
+    const double u = tau - t_acc_ - t_cruise_;
+    s = d_acc + v_ * t_cruise_ + v_ * u - 0.5 * a_ * u * u;
+  }
+  return from_ + dir_ * s;
+}
+
+FlipController::FlipController(const FlipScheduleParams& p, const BoxParams& box)
+    : p_(p), box_(box), flip_rad_(p.flip_angle_deg * kRadPerDeg),
+      on_stops_(std::abs(p.flip_angle_deg - box.end_stop_deg) < 1e-9),
+      next_flip_s_(p.enabled ? p.standstill_s : std::numeric_limits<double>::infinity()) {
+  p_.validate(box.end_stop_deg);
+  for (int i = 1; i <= 2; ++i) {
+    ref_[i - 1] = target_for(i, +1);
+    profile_[i - 1] = TrapezoidProfile(0, ref_[i - 1], ref_[i - 1], 1, 1);
+  }
+}
+
+double FlipController::target_for(int, int sign) const {
+  // on stops: the reference runs past the stop by the overtravel, so the motor presses on it
+  if (on_stops_) return sign * (box_.end_stop_deg + box_.motor.overtravel_deg) * kRadPerDeg;
+  return sign * flip_rad_;
+}
+
+double FlipController::initial_angle_rad(int i) const {
+  return on_stops_ ? box_.stop_rad(i, +1) : flip_rad_;
+}
+
+double FlipController::reference_rad(int i) const { return ref_[i - 1]; }
+
+void FlipController::update(double t, const Eigen::Vector2d& rate) {
+  const double vmax = box_.motor.max_speed_dps * kRadPerDeg;
+  const double amax = box_.motor.max_accel_dps2 * kRadPerDeg;
+  const double settle = p_.settle_rate_dps * kRadPerDeg;
+  for (int k = 0; k < 2; ++k) {
+    ref_[k] = profile_[k].angle_rad(t);
+    // settled: the reference arrived and the platform has come to rest
+    if (moving_[k] && t >= profile_[k].end_s() && std::abs(rate[k]) < settle) {
+      moving_[k] = false;
+      ++flips_;
+      next_flip_s_ = t + p_.standstill_s;
+    }
+  }
+  if (!any_moving() && t >= next_flip_s_) {
+    // Fig. 3: platform 2 flips after (+,+) and (-,-), platform 1 after (+,-) and (-,+)
+    const int k = flips_ % 2 == 0 ? 1 : 0;
+    sign_[k] = -sign_[k];
+    profile_[k] = TrapezoidProfile(t, ref_[k], target_for(k + 1, sign_[k]), vmax, amax);
+    moving_[k] = true;
+    next_flip_s_ = std::numeric_limits<double>::infinity();
+  }
+}
+
+}  // namespace driftless::twin
