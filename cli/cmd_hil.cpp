@@ -19,7 +19,7 @@ namespace driftless::cli {
 namespace {
 
 struct HilOptions {
-  std::string source, switch_to, out_dir, estimator_config, scenario;
+  std::string source, switch_to, out_dir, estimator_config, scenario, emu_sensor;
   double at_s = kNaN;
   double duration_s = kNaN;
   double rate_hz = 100.0;
@@ -47,6 +47,7 @@ int run_hil(const HilOptions& o) {
   ro.work_dir = o.out_dir;
   ro.seed = o.seed;
   ro.scenario = o.scenario;
+  ro.emu_sensor = o.emu_sensor;
   auto first = hil::make_source_rig(o.source, ro);
   std::unique_ptr<hil::SourceRig> second;
   if (!o.switch_to.empty()) second = hil::make_source_rig(o.switch_to, ro);
@@ -126,6 +127,8 @@ int run_hil(const HilOptions& o) {
              st.switched ? fmt::format(", switched at t={:.6f} s", st.t_switch_s) : "");
   fmt::print("bias 1 [deg/s]: {}  sigma {}\n", vec3(filter.bias1_dps()), vec3(sig.head<3>()));
   fmt::print("bias 2 [deg/s]: {}  sigma {}\n", vec3(filter.bias2_dps()), vec3(sig.tail<3>()));
+  fmt::print("filter: {} updates, {} rejected by the NIS gate, {} source switches\n", filter.counters().updates,
+             filter.counters().rejected, filter.counters().source_switches);
   fmt::print("log: {}\n", log_path.string());
   if (!st.complete) throw std::runtime_error("hil: " + st.end_reason + "; the log so far is " + log_path.string() +
                                              " (complete: false)");
@@ -149,6 +152,9 @@ const bool registered = register_command(60, [](CLI::App& app) {
   cmd->add_option("--standstill", o->standstill_s, "Flip schedule hold time at each position, s")->default_val(10.0);
   cmd->add_option("--baud", o->baud, "Serial link speed, bit/s")->default_val(921600);
   cmd->add_option("--scenario", o->scenario, "twin: scenario YAML file or built-in name (default: the built-in default)");
+  cmd->add_option("--emu-sensor", o->emu_sensor,
+                  "emu-i2c: drive the emulated chips with the twin's sensor model preset (mpu6050, ideal) "
+                  "instead of the built-in biases + white noise");
   cmd->add_option("--seed", o->seed, "Seed of the emulators and the twin")->default_val(1);
   cmd->add_option("--estimator-config", o->estimator_config, "Estimator configuration (key: value, docs/estimator.md)");
   cmd->add_option("--print-every", o->print_every_s, "Terminal line every this much session time, s")->default_val(10.0);

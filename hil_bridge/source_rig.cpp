@@ -10,6 +10,7 @@
 #include "hil_bridge/serial/firmware_emulator.hpp"
 #include "hil_bridge/serial/serial_source.hpp"
 #if DRIFTLESS_HIL_WITH_TWIN
+#include "hil_bridge/twin/sensor_model_generator.hpp"
 #include "hil_bridge/twin/twin_source.hpp"
 #endif
 
@@ -83,7 +84,7 @@ struct EmuI2cRig final : SourceRig {
   std::unique_ptr<Clock> clk;
   VirtualClock* vclk = nullptr;
   std::unique_ptr<EmulatedMotors> emotors;
-  std::unique_ptr<BoxAtRestGenerator> gen;
+  std::unique_ptr<ImuGenerator> gen;
   std::unique_ptr<Mpu6050Emulator> chip1, chip2;
   std::unique_ptr<EmulatedI2cBus> bus;
   std::unique_ptr<DescribedI2cSource> src;
@@ -140,7 +141,16 @@ std::unique_ptr<SourceRig> make_source_rig(const std::string& spec, const RigOpt
     BoxAtRestGenerator::Params gp = opt.emulated_box;
     gp.sample_rate_hz = opt.sample_rate_hz;
     gp.seed = opt.seed;
-    rig->gen = std::make_unique<BoxAtRestGenerator>(gp, rig->emotors.get());
+    if (opt.emu_sensor.empty()) {
+      rig->gen = std::make_unique<BoxAtRestGenerator>(gp, rig->emotors.get());
+    } else {
+#if DRIFTLESS_HIL_WITH_TWIN
+      const twin::SensorParams sp = twin::sensor_preset(opt.emu_sensor);
+      rig->gen = std::make_unique<SensorModelGenerator>(sp, sp, opt.sample_rate_hz, opt.seed, gp, rig->emotors.get());
+#else
+      throw std::invalid_argument("hil: --emu-sensor needs the twin library, which this build lacks");
+#endif
+    }
     rig->chip1 = std::make_unique<Mpu6050Emulator>(0, *rig->gen, *rig->clk);
     rig->chip2 = std::make_unique<Mpu6050Emulator>(1, *rig->gen, *rig->clk);
     rig->bus = std::make_unique<EmulatedI2cBus>(*rig->clk, rig->vclk);

@@ -26,6 +26,8 @@ struct RigOptions {
   std::string scenario;          // twin: scenario YAML (empty: the built-in default)
   std::uint64_t seed = 1;        // emulators and the twin
   BoxAtRestGenerator::Params emulated_box;  // what emu-i2c / emu-serial measure
+  std::string emu_sensor;        // emu-i2c: a twin sensor-model preset ("mpu6050", "ideal")
+                                 // instead of the built-in bias + white-noise generator
 };
 
 /// A ready-to-configure source and its helpers. Owns everything it points to.

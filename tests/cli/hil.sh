@@ -30,6 +30,15 @@ grep -q "sample interval: 0.010000 .. 0.010000 s" "$out/b.check" || fail "switch
 [ "$(grep -c '^# event: t=49.990000 switch: replay:.* -> emu-i2c' "$out/b/log.csv")" = 1 ] || fail "switch: no event line"
 grep -q "^50.000000," "$out/b/log.csv" || fail "switch: no row at t = 50 s"
 
+# the twin, then emulated hardware from t = 20 s; and emu-i2c driven by the twin's sensor model
+"$bin" hil --source twin --switch-to emu-i2c --at 20 --duration 40 --out "$out/t" > "$out/t.txt"
+"$bin" check --log "$out/t/log.csv" > "$out/t.check"
+grep -q "4000 rows" "$out/t.check" || fail "twin switch: expected 4000 rows: $(head -1 "$out/t.check")"
+grep -q "sample interval: 0.010000 .. 0.010000 s" "$out/t.check" || fail "twin switch: a sample was lost or duplicated"
+grep -q "^# event: t=19.990000 switch: twin:default -> emu-i2c" "$out/t/log.csv" || fail "twin switch: no event line"
+"$bin" hil --source emu-i2c --emu-sensor mpu6050 --duration 30 --out "$out/m" > /dev/null
+grep -q "complete: true" "$out/m/log.csv" || fail "emu-i2c with the mpu6050 sensor model: log not complete"
+
 # the serial link against the emulated microcontroller on a pty, 1.5 s in real time
 "$bin" hil --source emu-serial --out "$out/c" --duration 1.5 > "$out/c.txt"
 "$bin" check --log "$out/c/log.csv" > "$out/c.check"
