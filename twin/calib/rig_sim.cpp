@@ -284,11 +284,10 @@ RigRun run_rig(const CalibScenario& cs, const std::function<bool(double)>& progr
   const Eigen::Vector3d earth = earth_rate_enu_radps(sc.latitude_deg);
 
   // sensors: the scenario's sensor blocks over the MPU6050 preset
-  const std::string file = sc.name;
   SensorModel sensor[2] = {
-      SensorModel(parse_sensor_params(sc.model.sensor1, mpu6050_defaults(), file), sc.sample_rate_hz,
+      SensorModel(sc.model.sensor1, sc.sample_rate_hz,
                   derive_seed(sc.seed, 1)),
-      SensorModel(parse_sensor_params(sc.model.sensor2, mpu6050_defaults(), file), sc.sample_rate_hz,
+      SensorModel(sc.model.sensor2, sc.sample_rate_hz,
                   derive_seed(sc.seed, 2))};
 
   // initial state: the box on the table, platforms pressed onto their first stops
