@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "estimator/log.hpp"
 #include "estimator/sample.hpp"
 
 namespace driftless::hil {
@@ -73,6 +74,11 @@ class SampleSource {
   virtual double sample_rate_hz() const = 0;
   /// Optional Sample fields this source fills (SampleField bits).
   virtual std::uint32_t fields() const = 0;
+  /// False when the source cannot know the platform angles (bare sensors on I2C): the live loop
+  /// then takes them from the motors' end-stop switches.
+  virtual bool knows_platforms() const { return true; }
+  /// Adds what the source knows about the box to the log metadata (hinge axes, latitude...).
+  virtual void describe(log::Metadata& meta) const { meta.set("source", name()); }
 
   /// Checks the settings and probes the device (opens it, reads its identity).
   virtual Status configure() = 0;

@@ -1,5 +1,7 @@
 #include "hil_bridge/i2c/i2c_source.hpp"
 
+#include "hil_bridge/raw_sample.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -118,7 +120,7 @@ Status I2cSource::activate() {
   }
   ready_.clear();
   n_next_ = 0;
-  saturated_ = {false, false};
+  saturation_ = SaturationTracker();
   if (p_.use_fifo) {
     if (reset_fifos("start") != ReadStatus::kPending) {
       return Status::DeviceError(bus_.name() + ": cannot reset the FIFOs");
@@ -218,53 +220,15 @@ void I2cSource::check_stall() {
   last_data_host_s_ = now;  // report once per stall period
 }
 
-void I2cSource::saturation(int sensor, bool now_saturated, const RawRecord& r) {
-  const auto i = static_cast<std::size_t>(sensor);
-  const double t = t_of(n_next_);
-  if (now_saturated) ++saturated_count_[i];
-  if (now_saturated && !saturated_[i]) {
-    std::string axes;
-    for (int a = 0; a < 3; ++a) {
-      if (is_saturated(r.gyro[static_cast<std::size_t>(a)])) axes += "xyz"[a];
-    }
-    report(EventKind::kSaturation, t,
-           "sensor " + std::to_string(sensor + 1) + " gyro " + axes + " saturated at +-" +
-               std::to_string(static_cast<int>(gyro_full_scale_dps(p_.gyro_fs_sel))) +
-               " deg/s full scale: saturated axes are written empty");
-  } else if (!now_saturated && saturated_[i]) {
-    report(EventKind::kSaturation, t,
-           "sensor " + std::to_string(sensor + 1) + " gyro back in range after " +
-               std::to_string(saturated_count_[i]) + " saturated samples");
-    saturated_count_[i] = 0;
-  }
-  saturated_[i] = now_saturated;
-}
-
 void I2cSource::emit(const RawRecord& r1, const RawRecord& r2) {
   Sample s;
   s.t_s = t_of(n_next_);
-  const double glsb = gyro_lsb_per_dps(p_.gyro_fs_sel);
-  const double alsb = accel_lsb_per_g(p_.accel_fs_sel);
   const RawRecord* recs[2] = {&r1, &r2};
   for (int k = 0; k < 2; ++k) {
-    const RawRecord& r = *recs[k];
-    Eigen::Vector3d g, a;
-    bool sat = false;
-    for (int i = 0; i < 3; ++i) {
-      const auto u = static_cast<std::size_t>(i);
-      // a clipped reading is not a measurement of the rate: leave it empty
-      if (is_saturated(r.gyro[u])) {
-        g[i] = kNaN;
-        sat = true;
-      } else {
-        g[i] = r.gyro[u] / glsb;
-      }
-      a[i] = r.accel[u] / alsb * kStandardGravityMps2;
+    const int mask = fill_from_raw(k, *recs[k], p_.gyro_fs_sel, p_.accel_fs_sel, s);
+    if (std::string msg = saturation_.update(k, mask, p_.gyro_fs_sel); !msg.empty()) {
+      report(EventKind::kSaturation, s.t_s, std::move(msg));
     }
-    saturation(k, sat, r);
-    (k == 0 ? s.gyro1_dps : s.gyro2_dps) = g;
-    (k == 0 ? s.accel1_mps2 : s.accel2_mps2) = a;
-    (k == 0 ? s.temp1_c : s.temp2_c) = temp_c_from_raw(r.temp);
   }
   ready_.push_back(s);
   ++n_next_;

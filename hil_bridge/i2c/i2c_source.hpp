@@ -11,6 +11,7 @@
 #include "hil_bridge/clock.hpp"
 #include "hil_bridge/i2c/mpu6050_regs.hpp"
 #include "hil_bridge/i2c/transport.hpp"
+#include "hil_bridge/raw_sample.hpp"
 #include "hil_bridge/source.hpp"
 
 namespace driftless::hil {
@@ -44,6 +45,9 @@ class I2cSource final : public SampleSource {
   std::string name() const override { return "i2c:" + bus_.name(); }
   double sample_rate_hz() const override { return p_.sample_rate_hz; }
   std::uint32_t fields() const override { return kFieldAccel | kFieldTemp; }
+  bool knows_platforms() const override { return false; }
+  /// Host-clock time (Clock seconds) at which the sample stamped t_s was due: for latency figures.
+  double host_time_of(double t_s) const { return t0_host_s_ + t_s + 1.0 / p_.sample_rate_hz; }
 
   Status configure() override;
   Status activate() override;
@@ -61,7 +65,6 @@ class I2cSource final : public SampleSource {
   ReadStatus reset_fifos(const std::string& why);
   void check_stall();
   void emit(const mpu6050::RawRecord& r1, const mpu6050::RawRecord& r2);
-  void saturation(int sensor, bool now_saturated, const mpu6050::RawRecord& r);
   /// Index of the sample the device produces next, from the host clock.
   std::uint64_t expected_index() const;
   double t_of(std::uint64_t n) const { return static_cast<double>(n) / p_.sample_rate_hz; }
@@ -77,8 +80,7 @@ class I2cSource final : public SampleSource {
   int errors_in_row_ = 0;
   std::deque<Sample> ready_;
   std::uint64_t samples_ = 0;
-  std::array<bool, 2> saturated_{false, false};
-  std::array<std::uint64_t, 2> saturated_count_{0, 0};
+  SaturationTracker saturation_;
 };
 
 }  // namespace driftless::hil

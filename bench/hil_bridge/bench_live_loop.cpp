@@ -1,0 +1,136 @@
+// The live loop at 1 kHz from the emulated I2C bus with the estimator and the log writer in the
+// loop. Two figures:
+//  - LiveLoop1kHzRealtime: wall-clock run; per-sample latency = time the estimate is updated
+//    minus the time the sample was due on the bus (p50, p99, max, us), and whether the loop kept
+//    up (no FIFO overflow, no sample lost);
+//  - LiveLoopEmulatedI2cAfap: the same loop on a virtual clock: samples per second of CPU.
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <vector>
+
+#include <unistd.h>
+
+#include <benchmark/benchmark.h>
+
+#include "estimator/filter.hpp"
+#include "estimator/log.hpp"
+#include "hil_bridge/i2c/emulated_bus.hpp"
+#include "hil_bridge/i2c/i2c_source.hpp"
+#include "hil_bridge/live_loop.hpp"
+
+namespace driftless::hil {
+namespace {
+
+log::Metadata meta_1khz() {
+  log::Metadata m;
+  m.set("sample_rate_hz", "1000");
+  m.set("latitude_deg", "52.0");
+  return m;
+}
+
+std::filesystem::path temp_log() {
+  return std::filesystem::temp_directory_path() / ("driftless-bench-hil-" + std::to_string(::getpid()) + ".csv");
+}
+
+template <class ClockT>
+struct Rig {
+  ClockT clock;
+  EmulatedMotors motors{clock, {}};
+  BoxAtRestGenerator gen;
+  Mpu6050Emulator chip1{0, gen, clock}, chip2{1, gen, clock};
+  EmulatedI2cBus bus;
+  I2cSource src;
+  FlipSchedule schedule{{5.0, 10.0}};
+  Rig()
+      : gen(params(), &motors),
+        bus(clock, virtual_clock()),
+        src(bus, clock, source_params()) {
+    bus.attach(0x68, &chip1);
+    bus.attach(0x69, &chip2);
+  }
+  VirtualClock* virtual_clock() {
+    if constexpr (std::is_same_v<ClockT, VirtualClock>) return &clock;
+    return nullptr;
+  }
+  static BoxAtRestGenerator::Params params() {
+    BoxAtRestGenerator::Params p;
+    p.sample_rate_hz = 1000.0;
+    return p;
+  }
+  static I2cSourceParams source_params() {
+    I2cSourceParams p;
+    p.sample_rate_hz = 1000.0;
+    p.reset_wait_s = 0.0;
+    return p;
+  }
+};
+
+void LiveLoop1kHzRealtime(benchmark::State& state) {
+  const double duration_s = static_cast<double>(state.range(0));
+  std::vector<double> latency_us;
+  LiveStats st;
+  for (auto _ : state) {
+    Rig<SteadyClock> rig;
+    if (!rig.src.configure().ok()) state.SkipWithError("configure failed");
+    est::DriftlessFilter filter(est::EstimatorConfig{}, meta_1khz());
+    log::LogWriter writer(temp_log(), meta_1khz(), rig.src.fields());
+    LiveParams lp;
+    lp.duration_s = duration_s;
+    LiveLoop loop(lp, rig.clock, &writer, &filter);
+    loop.set_motors(&rig.src, &rig.motors, &rig.schedule);
+    latency_us.clear();
+    latency_us.reserve(static_cast<std::size_t>(duration_s * 1000.0) + 10);
+    // session time = source time here (the first sample is t = 0 on both)
+    loop.on_sample([&](const Sample& s, SampleSource&) {
+      latency_us.push_back((rig.clock.now_s() - rig.src.host_time_of(s.t_s)) * 1e6);
+    });
+    std::atomic<bool> stop{false};
+    st = loop.run(rig.src, nullptr, stop);
+    writer.finish(st.complete);
+  }
+  std::filesystem::remove(temp_log());
+  std::sort(latency_us.begin(), latency_us.end());
+  auto pct = [&](double p) {
+    return latency_us.empty() ? NAN : latency_us[static_cast<std::size_t>(p * static_cast<double>(latency_us.size() - 1))];
+  };
+  state.counters["samples"] = static_cast<double>(st.samples);
+  state.counters["lost"] = static_cast<double>(st.lost_samples);
+  state.counters["faults"] = static_cast<double>(st.faults);
+  state.counters["kept_up"] = st.samples == static_cast<std::uint64_t>(duration_s * 1000.0) && st.lost_samples == 0;
+  state.counters["p50_us"] = pct(0.50);
+  state.counters["p99_us"] = pct(0.99);
+  state.counters["max_us"] = latency_us.empty() ? NAN : latency_us.back();
+}
+BENCHMARK(LiveLoop1kHzRealtime)->Arg(5)->Iterations(1)->Unit(benchmark::kSecond);
+
+void LiveLoopEmulatedI2cAfap(benchmark::State& state) {
+  const double duration_s = 20.0;
+  std::uint64_t samples = 0;
+  for (auto _ : state) {
+    Rig<VirtualClock> rig;
+    if (!rig.src.configure().ok()) state.SkipWithError("configure failed");
+    est::DriftlessFilter filter(est::EstimatorConfig{}, meta_1khz());
+    log::LogWriter writer(temp_log(), meta_1khz(), rig.src.fields());
+    LiveParams lp;
+    lp.duration_s = duration_s;
+    LiveLoop loop(lp, rig.clock, &writer, &filter);
+    loop.set_motors(&rig.src, &rig.motors, &rig.schedule);
+    std::atomic<bool> stop{false};
+    const LiveStats st = loop.run(rig.src, nullptr, stop);
+    writer.finish(st.complete);
+    samples += st.samples;
+  }
+  std::filesystem::remove(temp_log());
+  state.SetItemsProcessed(static_cast<std::int64_t>(samples));
+  state.counters["us_per_sample"] =
+      benchmark::Counter(static_cast<double>(samples), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+BENCHMARK(LiveLoopEmulatedI2cAfap)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+}  // namespace driftless::hil
+
+BENCHMARK_MAIN();

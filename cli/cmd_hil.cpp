@@ -1,0 +1,165 @@
+// driftless hil: run the estimator live on a source of samples (the twin, a replayed log, two
+// MPU-6050s on I2C, the box's microcontroller on a serial link, or their emulators), record a
+// measurement log, and optionally switch sources mid-run without restarting the estimator.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+
+#include <fmt/core.h>
+
+#include "cli/command.hpp"
+#include "estimator/filter.hpp"
+#include "estimator/log.hpp"
+#include "hil_bridge/live_loop.hpp"
+#include "hil_bridge/source_rig.hpp"
+
+namespace driftless::cli {
+namespace {
+
+struct HilOptions {
+  std::string source, switch_to, out_dir, estimator_config, scenario, emu_sensor;
+  double at_s = kNaN;
+  double duration_s = kNaN;
+  double rate_hz = 100.0;
+  double standstill_s = 10.0;
+  double print_every_s = 10.0;
+  int baud = 921600;
+  std::uint64_t seed = 1;
+  bool realtime = false;
+};
+
+std::string vec3(const Eigen::Vector3d& v) { return fmt::format("{:+.4f} {:+.4f} {:+.4f}", v.x(), v.y(), v.z()); }
+
+int run_hil(const HilOptions& o) {
+  if (!o.switch_to.empty() && std::isnan(o.at_s)) {
+    throw std::invalid_argument("hil: --switch-to needs --at T (session time of the switch, s)");
+  }
+  if (o.switch_to.empty() && !std::isnan(o.at_s)) throw std::invalid_argument("hil: --at needs --switch-to SOURCE");
+  std::filesystem::create_directories(o.out_dir);
+
+  hil::RigOptions ro;
+  ro.realtime = o.realtime;
+  ro.sample_rate_hz = o.rate_hz;
+  ro.standstill_s = o.standstill_s;
+  ro.baud = o.baud;
+  ro.work_dir = o.out_dir;
+  ro.seed = o.seed;
+  ro.scenario = o.scenario;
+  ro.emu_sensor = o.emu_sensor;
+  auto first = hil::make_source_rig(o.source, ro);
+  std::unique_ptr<hil::SourceRig> second;
+  if (!o.switch_to.empty()) second = hil::make_source_rig(o.switch_to, ro);
+  const bool hardware = o.source.rfind("i2c:", 0) == 0 || o.source.rfind("serial:", 0) == 0 ||
+                        o.source == "emu-serial";
+  if (std::isnan(o.duration_s) && !hardware && o.source.rfind("replay:", 0) != 0 && o.source != "twin") {
+    throw std::invalid_argument("hil: " + o.source + " streams forever: give --duration S (s)");
+  }
+
+  // every device is checked before anything runs: a missing one is one clear error
+  for (hil::SourceRig* rig : {first.get(), second.get()}) {
+    if (!rig) continue;
+    if (std::string err = rig->start(); !err.empty()) throw std::runtime_error(err);
+    const hil::Status s = rig->source->configure();
+    if (!s.ok()) throw std::runtime_error(s.message);
+  }
+
+  log::Metadata meta;
+  meta.set("sample_rate_hz", fmt::format("{}", first->source->sample_rate_hz()));
+  meta.set("latitude_deg", "52.0");
+  first->source->describe(meta);
+  if (second) {
+    meta.set("switch_to", second->source->name());
+    meta.set("switch_at_s", fmt::format("{}", o.at_s));
+  }
+  std::uint32_t fields = first->source->fields() | (second ? second->source->fields() : 0u);
+
+  est::EstimatorConfig cfg;
+  if (!o.estimator_config.empty()) {
+    std::ifstream in(o.estimator_config);
+    if (!in) throw std::runtime_error(o.estimator_config + ": cannot open the estimator configuration");
+    cfg = est::parse_estimator_config(in, o.estimator_config, cfg);
+  }
+  est::DriftlessFilter filter(cfg, meta);
+
+  const std::filesystem::path log_path = std::filesystem::path(o.out_dir) / "log.csv";
+  log::LogWriter writer(log_path, meta, fields);
+
+  hil::LiveParams lp;
+  if (!std::isnan(o.duration_s)) lp.duration_s = o.duration_s;
+  lp.switch_at_s = o.at_s;
+  hil::SteadyClock wall;
+  hil::LiveLoop loop(lp, wall, &writer, &filter);
+  loop.set_motors(first->source, first->motors, first->schedule);
+  if (second) loop.set_motors(second->source, second->motors, second->schedule);
+  // the terminal view: bias estimates as they converge
+  double next_print = 0.0;
+  double last_flush = wall.now_s();
+  std::uint64_t updates_seen = 0;
+  fmt::print("driftless hil: {} -> {}{}\n", first->source->name(), log_path.string(),
+             second ? fmt::format(" (switch to {} at t={} s)", second->source->name(), o.at_s) : "");
+  fmt::print("{:>10}  {:<29}  {:<29}  {:>7}  {}\n", "t [s]", "b1 [deg/s] (x y z)", "b2 [deg/s] (x y z)", "updates",
+             "source");
+  loop.on_sample([&](const Sample& s, hil::SampleSource& src) {
+    const bool new_update = filter.counters().updates != updates_seen;
+    updates_seen = filter.counters().updates;
+    if (s.t_s >= next_print || (o.realtime && new_update)) {
+      fmt::print("{:>10.2f}  {:<29}  {:<29}  {:>7}  {}\n", s.t_s, vec3(filter.bias1_dps()), vec3(filter.bias2_dps()),
+                 filter.counters().updates, src.name());
+      std::fflush(stdout);
+      next_print = std::floor(s.t_s / o.print_every_s + 1.0) * o.print_every_s;
+    }
+    // rows reach the disk at least twice a second
+    if (wall.now_s() - last_flush > 0.5) {
+      writer.flush();
+      last_flush = wall.now_s();
+    }
+  });
+  loop.on_event([&](double t, const std::string& text) { fmt::print("{:>10.2f}  event: {}\n", t, text); });
+
+  const hil::LiveStats st = loop.run(*first->source, second ? second->source : nullptr, stop_requested());
+  writer.finish(st.complete, st.end_reason);
+
+  const Eigen::Matrix<double, 6, 1> sig = filter.sigma_dps();
+  fmt::print("done: {} ({} rows, t = {:.3f} .. {:.3f} s, {} events, {} faults, {} samples reported lost, {} gaps{})\n",
+             st.end_reason, st.samples, st.t_first_s, st.t_last_s, st.events, st.faults, st.lost_samples, st.gaps,
+             st.switched ? fmt::format(", switched at t={:.6f} s", st.t_switch_s) : "");
+  fmt::print("bias 1 [deg/s]: {}  sigma {}\n", vec3(filter.bias1_dps()), vec3(sig.head<3>()));
+  fmt::print("bias 2 [deg/s]: {}  sigma {}\n", vec3(filter.bias2_dps()), vec3(sig.tail<3>()));
+  fmt::print("filter: {} updates, {} rejected by the NIS gate, {} source switches\n", filter.counters().updates,
+             filter.counters().rejected, filter.counters().source_switches);
+  fmt::print("log: {}\n", log_path.string());
+  if (!st.complete) throw std::runtime_error("hil: " + st.end_reason + "; the log so far is " + log_path.string() +
+                                             " (complete: false)");
+  return 0;
+}
+
+const bool registered = register_command(60, [](CLI::App& app) {
+  auto* cmd = app.add_subcommand(
+      "hil", "Run the estimator live on the twin, a replayed log, MPU-6050s on I2C, the box's serial link or "
+             "their emulators; record a measurement log; switch sources mid-run (docs/hil.md)");
+  auto o = std::make_shared<HilOptions>();
+  cmd->add_option("--source", o->source, std::string("Source of samples: ") + hil::source_spec_help())->required();
+  cmd->add_option("--switch-to", o->switch_to, "Second source, taken over at --at (same spellings)");
+  cmd->add_option("--at", o->at_s, "Session time of the switch-over, s");
+  cmd->add_option("--out", o->out_dir, "Output directory (log.csv is written there)")->required();
+  cmd->add_flag("--realtime", o->realtime,
+                "Pace the twin, replays and emu-i2c by the wall clock (default: as fast as possible; "
+                "hardware and emu-serial always run in real time)");
+  cmd->add_option("--duration", o->duration_s, "Session time to run, s (default: until the source ends)");
+  cmd->add_option("--rate", o->rate_hz, "Sample rate of i2c, serial and emulated sources, Hz")->default_val(100.0);
+  cmd->add_option("--standstill", o->standstill_s, "Flip schedule hold time at each position, s")->default_val(10.0);
+  cmd->add_option("--baud", o->baud, "Serial link speed, bit/s")->default_val(921600);
+  cmd->add_option("--scenario", o->scenario, "twin: scenario YAML file or built-in name (default: the built-in default)");
+  cmd->add_option("--emu-sensor", o->emu_sensor,
+                  "emu-i2c: drive the emulated chips with the twin's sensor model preset (mpu6050, ideal) "
+                  "instead of the built-in biases + white noise");
+  cmd->add_option("--seed", o->seed, "Seed of the emulators and the twin")->default_val(1);
+  cmd->add_option("--estimator-config", o->estimator_config, "Estimator configuration (key: value, docs/estimator.md)");
+  cmd->add_option("--print-every", o->print_every_s, "Terminal line every this much session time, s")->default_val(10.0);
+  return [o] { return run_hil(*o); };
+});
+
+}  // namespace
+}  // namespace driftless::cli

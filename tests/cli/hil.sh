@@ -1,0 +1,56 @@
+#!/usr/bin/env bash
+# driftless hil end to end: emulated I2C run, a switch-over from a replayed log to emulated I2C,
+# the emulated serial link over a pty, and one clear error for a missing device.
+# usage: bash hil.sh <path-to-driftless> <source-dir>
+set -euo pipefail
+bin=$1
+out=$(mktemp -d)
+trap 'rm -rf "$out"' EXIT
+fail() { echo "FAIL: $*" >&2; exit 1; }
+
+# GIVEN emulated sensors, WHEN hil runs 120 s as fast as possible, THEN a complete valid log
+"$bin" hil --source emu-i2c --out "$out/a" --duration 120 --print-every 60 > "$out/a.txt"
+"$bin" check --log "$out/a/log.csv" > "$out/a.check"
+grep -q "12000 rows" "$out/a.check" || fail "emu-i2c: expected 12000 rows: $(head -1 "$out/a.check")"
+grep -q "complete: true" "$out/a/log.csv" || fail "emu-i2c: log not complete"
+# the emulated box's biases are b1 = (0.5, -0.3, 0.8), b2 = (-0.6, 0.4, 0.2) deg/s
+awk '/^bias 1/ { ok = ($4 - 0.5)^2 < 4e-4 && ($5 + 0.3)^2 < 4e-4 && ($6 - 0.8)^2 < 4e-4 }
+     END { exit !ok }' "$out/a.txt" || fail "emu-i2c: bias 1 did not converge: $(grep '^bias 1' "$out/a.txt")"
+awk '/^bias 2/ { ok = ($4 + 0.6)^2 < 4e-4 && ($5 - 0.4)^2 < 4e-4 && ($6 - 0.2)^2 < 4e-4 }
+     END { exit !ok }' "$out/a.txt" || fail "emu-i2c: bias 2 did not converge: $(grep '^bias 2' "$out/a.txt")"
+# the same seed gives a byte-identical log
+"$bin" hil --source emu-i2c --out "$out/a2" --duration 120 > /dev/null
+cmp -s "$out/a/log.csv" "$out/a2/log.csv" || fail "emu-i2c: same seed, different log"
+
+# switch-over: replay the first log, then emulated hardware from t = 50 s
+"$bin" hil --source "replay:$out/a/log.csv" --switch-to emu-i2c --at 50 --duration 100 --out "$out/b" > "$out/b.txt"
+"$bin" check --log "$out/b/log.csv" > "$out/b.check"
+grep -q "10000 rows" "$out/b.check" || fail "switch: expected 10000 rows: $(head -1 "$out/b.check")"
+grep -q "sample interval: 0.010000 .. 0.010000 s" "$out/b.check" || fail "switch: a sample was lost or duplicated"
+[ "$(grep -c '^# event: t=49.990000 switch: replay:.* -> emu-i2c' "$out/b/log.csv")" = 1 ] || fail "switch: no event line"
+grep -q "^50.000000," "$out/b/log.csv" || fail "switch: no row at t = 50 s"
+
+# the twin, then emulated hardware from t = 20 s; and emu-i2c driven by the twin's sensor model
+"$bin" hil --source twin --switch-to emu-i2c --at 20 --duration 40 --out "$out/t" > "$out/t.txt"
+"$bin" check --log "$out/t/log.csv" > "$out/t.check"
+grep -q "4000 rows" "$out/t.check" || fail "twin switch: expected 4000 rows: $(head -1 "$out/t.check")"
+grep -q "sample interval: 0.010000 .. 0.010000 s" "$out/t.check" || fail "twin switch: a sample was lost or duplicated"
+grep -q "^# event: t=19.990000 switch: twin:default -> emu-i2c" "$out/t/log.csv" || fail "twin switch: no event line"
+"$bin" hil --source emu-i2c --emu-sensor mpu6050 --duration 30 --out "$out/m" > /dev/null
+grep -q "complete: true" "$out/m/log.csv" || fail "emu-i2c with the mpu6050 sensor model: log not complete"
+
+# the serial link against the emulated microcontroller on a pty, 1.5 s in real time
+"$bin" hil --source emu-serial --out "$out/c" --duration 1.5 > "$out/c.txt"
+"$bin" check --log "$out/c/log.csv" > "$out/c.check"
+grep -q "150 rows" "$out/c.check" || fail "emu-serial: expected 150 rows: $(head -1 "$out/c.check")"
+
+# a missing device: one clear error, non-zero exit, no log
+for src in i2c:/dev/i2c-77 serial:/dev/ttyNoSuchPort; do
+  if "$bin" hil --source "$src" --out "$out/d" > "$out/d.txt" 2> "$out/d.err"; then fail "$src: exit 0"; fi
+  [ "$(wc -l < "$out/d.err")" = 1 ] || fail "$src: expected one error line, got: $(cat "$out/d.err")"
+  grep -q "${src#*:}" "$out/d.err" || fail "$src: error does not name the device: $(cat "$out/d.err")"
+  [ ! -e "$out/d/log.csv" ] || fail "$src: a log was written"
+done
+# a bad switch request is refused before anything runs
+if "$bin" hil --source emu-i2c --switch-to emu-serial --out "$out/e" --duration 1 2> "$out/e.err"; then fail "--switch-to without --at accepted"; fi
+echo "hil: ok"

@@ -1,0 +1,283 @@
+// The live loop: GIVEN a source (emulated I2C sensors, a replayed log), WHEN it runs with the
+// estimator, a log writer, faults and a switch-over, THEN the log is a valid driftless log with
+// one row per sample, monotonic time, an event line per fault / gap / switch, and the same
+// filter object carries its state across the switch.
+#include <unistd.h>
+
+#include <array>
+#include <atomic>
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "estimator/filter.hpp"
+#include "estimator/log.hpp"
+#include "hil_bridge/i2c/emulated_bus.hpp"
+#include "hil_bridge/i2c/i2c_source.hpp"
+#include "hil_bridge/live_loop.hpp"
+#include "hil_bridge/replay_source.hpp"
+
+namespace driftless::hil {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path temp_file(const std::string& name) {
+  return fs::temp_directory_path() / ("driftless-live-" + std::to_string(::getpid()) + "-" + name);
+}
+
+// two emulated MPU-6050s on an emulated bus, a box at rest with emulated motors
+struct EmuRig {
+  VirtualClock clock;
+  EmulatedMotors motors{clock, {}};
+  BoxAtRestGenerator gen;
+  Mpu6050Emulator chip1{0, gen, clock}, chip2{1, gen, clock};
+  EmulatedI2cBus bus{clock, &clock};
+  I2cSource src;
+  FlipSchedule schedule{{5.0, 10.0}};
+  explicit EmuRig(std::uint64_t seed = 1)
+      : gen(params(seed), &motors), src(bus, clock, I2cSourceParams{}) {
+    bus.attach(0x68, &chip1);
+    bus.attach(0x69, &chip2);
+  }
+  static BoxAtRestGenerator::Params params(std::uint64_t seed) {
+    BoxAtRestGenerator::Params p;
+    p.seed = seed;
+    return p;
+  }
+};
+
+log::Metadata box_meta() {
+  log::Metadata m;
+  m.set("sample_rate_hz", "100");
+  m.set("latitude_deg", "52.0");
+  return m;
+}
+
+struct Result {
+  LiveStats stats;
+  std::vector<Sample> rows;
+  std::vector<log::Event> events;
+  log::Metadata meta;
+};
+
+Result read_back(const fs::path& path, LiveStats stats) {
+  Result r;
+  r.stats = stats;
+  log::LogReader reader(path);
+  Sample s;
+  while (reader.next(s)) r.rows.push_back(s);
+  r.events = reader.events();
+  r.meta = reader.metadata();
+  return r;
+}
+
+int events_with(const Result& r, const std::string& word) {
+  int n = 0;
+  for (const auto& e : r.events) n += e.text.find(word) != std::string::npos;
+  return n;
+}
+
+TEST(LiveLoop, EmulatedI2cRunConvergesAndLogsEveryRow) {
+  // GIVEN emulated sensors with known biases and the flip schedule
+  EmuRig rig;
+  ASSERT_TRUE(rig.src.configure().ok());
+  const fs::path path = temp_file("converge.csv");
+  est::DriftlessFilter filter(est::EstimatorConfig{}, box_meta());
+  {
+    log::LogWriter writer(path, box_meta(), rig.src.fields());
+    LiveParams lp;
+    lp.duration_s = 120.0;
+    LiveLoop loop(lp, rig.clock, &writer, &filter);
+    loop.set_motors(&rig.src, &rig.motors, &rig.schedule);
+    std::atomic<bool> stop{false};
+    // WHEN it runs for 120 s
+    const LiveStats st = loop.run(rig.src, nullptr, stop);
+    writer.finish(st.complete, st.end_reason);
+    EXPECT_TRUE(st.complete);
+    EXPECT_EQ(st.samples, 12000u);
+  }
+  // THEN every sample is a row, 10 ms apart, and the estimate is near the emulated biases
+  const Result r = read_back(path, {});
+  ASSERT_EQ(r.rows.size(), 12000u);
+  for (std::size_t i = 1; i < r.rows.size(); ++i) ASSERT_NEAR(r.rows[i].t_s - r.rows[i - 1].t_s, 0.01, 1e-9);
+  EXPECT_TRUE(r.meta.complete());
+  EXPECT_GE(filter.counters().updates, 8u);
+  const auto& truth = EmuRig::params(1).bias_dps;
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(filter.bias1_dps()[i], truth[0][i], 0.02) << "axis " << i;
+    EXPECT_NEAR(filter.bias2_dps()[i], truth[1][i], 0.02) << "axis " << i;
+  }
+  fs::remove(path);
+}
+
+TEST(LiveLoop, SwitchOverKeepsTheEstimatorAndLosesNoSample) {
+  // GIVEN a recorded log (the "simulation") and emulated hardware
+  const fs::path rec = temp_file("recorded.csv");
+  {
+    EmuRig rig(7);
+    ASSERT_TRUE(rig.src.configure().ok());
+    log::LogWriter writer(rec, box_meta(), rig.src.fields());
+    LiveParams lp;
+    lp.duration_s = 60.0;
+    LiveLoop loop(lp, rig.clock, &writer, nullptr);
+    loop.set_motors(&rig.src, &rig.motors, &rig.schedule);
+    std::atomic<bool> stop{false};
+    writer.finish(loop.run(rig.src, nullptr, stop).complete);
+  }
+  VirtualClock replay_clock;
+  ReplaySource replay(replay_clock, {rec.string(), false, 1.0});
+  ASSERT_TRUE(replay.configure().ok());
+  EmuRig hw(8);
+  ASSERT_TRUE(hw.src.configure().ok());
+
+  // WHEN the loop switches from the replay to the hardware at T = 40 s
+  const fs::path path = temp_file("switch.csv");
+  est::DriftlessFilter filter(est::EstimatorConfig{}, box_meta());
+  Eigen::Matrix<double, 6, 1> before = Eigen::Matrix<double, 6, 1>::Constant(kNaN), after = before;
+  std::uint64_t updates_before = 0;
+  std::string first_source_of_switch;
+  LiveStats st;
+  {
+    log::LogWriter writer(path, box_meta(), hw.src.fields());
+    LiveParams lp;
+    lp.duration_s = 80.0;
+    lp.switch_at_s = 40.0;
+    LiveLoop loop(lp, hw.clock, &writer, &filter);
+    loop.set_motors(&hw.src, &hw.motors, &hw.schedule);
+    loop.on_sample([&](const Sample& s, SampleSource& src) {
+      if (&src == &replay) {
+        before = filter.bias_dps();
+        updates_before = filter.counters().updates;
+      } else if (std::isnan(after[0])) {
+        after = filter.bias_dps();
+        first_source_of_switch = src.name();
+      }
+      (void)s;
+    });
+    std::atomic<bool> stop{false};
+    st = loop.run(replay, &hw.src, stop);
+    writer.finish(st.complete, st.end_reason);
+  }
+  const Result r = read_back(path, st);
+
+  // THEN rows run 0 .. 79.99 s every 10 ms: none lost, none duplicated, time monotonic
+  ASSERT_EQ(r.rows.size(), 8000u);
+  for (std::size_t i = 0; i < r.rows.size(); ++i) ASSERT_NEAR(r.rows[i].t_s, i * 0.01, 1e-6) << i;
+  EXPECT_EQ(st.samples_first, 4000u);
+  EXPECT_EQ(st.samples_second, 4000u);
+  EXPECT_NEAR(st.t_switch_s, 40.0, 1e-9);
+  // AND one event line marks the switch, right after the row at 39.99 s
+  ASSERT_EQ(events_with(r, "switch:"), 1);
+  for (const auto& e : r.events) {
+    if (e.text.find("switch:") != std::string::npos) {
+      EXPECT_NEAR(e.t_s, 39.99, 1e-6);
+    }
+  }
+  // AND the same filter ran on: it had converged before, kept its estimate across, and went on
+  EXPECT_GE(updates_before, 3u);
+  EXPECT_EQ(first_source_of_switch, hw.src.name());
+  EXPECT_TRUE(before.isApprox(after)) << before.transpose() << "\n" << after.transpose();
+  EXPECT_GT(filter.counters().updates, updates_before);
+  EXPECT_EQ(filter.counters().source_switches, 1u);
+  fs::remove(rec);
+  fs::remove(path);
+}
+
+TEST(LiveLoop, FaultsBecomeEventLinesAndGapsNeverCloseSilently) {
+  // GIVEN emulated sensors that suffer NACKs, a FIFO overflow, an unplugged sensor and saturation
+  EmuRig rig;
+  rig.gen = BoxAtRestGenerator(
+      [] {
+        BoxAtRestGenerator::Params p;
+        p.extra_rate_dps = [](double t) { return Eigen::Vector3d(0, 0, t > 30.0 && t < 30.5 ? 400.0 : 0.0); };
+        return p;
+      }(),
+      &rig.motors);
+  ASSERT_TRUE(rig.src.configure().ok());
+  const fs::path path = temp_file("faults.csv");
+  LiveStats st;
+  {
+    log::LogWriter writer(path, box_meta(), rig.src.fields());
+    LiveParams lp;
+    lp.duration_s = 60.0;
+    LiveLoop loop(lp, rig.clock, &writer, nullptr);
+    loop.set_motors(&rig.src, &rig.motors, &rig.schedule);
+    const double t0 = rig.clock.now_s();
+    loop.on_sample([&, done = std::array<bool, 3>{}](const Sample& s, SampleSource&) mutable {
+      if (s.t_s > 10.0 && !done[0]) {
+        rig.bus.fail_next(0x68, 2, I2cResult::kNack);
+        done[0] = true;
+      }
+      if (s.t_s > 20.0 && !done[1]) {
+        rig.clock.advance(1.5);  // the host stalls: the FIFO overflows
+        done[1] = true;
+      }
+      if (s.t_s > 40.0 && !done[2]) {
+        const double now = rig.clock.now_s();
+        rig.bus.unplug(0x69, now, now + 2.0);
+        done[2] = true;
+      }
+    });
+    (void)t0;
+    std::atomic<bool> stop{false};
+    st = loop.run(rig.src, nullptr, stop);
+    writer.finish(st.complete, st.end_reason);
+  }
+  const Result r = read_back(path, st);
+  // THEN each fault has its event line
+  // 2 NACKs, then 5 failed transactions before the unplugged sensor counts as gone
+  EXPECT_EQ(events_with(r, "bus-error"), 2 + 5);
+  EXPECT_EQ(events_with(r, "fifo-overflow"), 2);  // the stall, and the restart after reconnecting
+  EXPECT_EQ(events_with(r, "disconnected"), 1);
+  EXPECT_EQ(events_with(r, "reconnected"), 1);
+  EXPECT_EQ(events_with(r, "saturation"), 4);
+  EXPECT_GE(events_with(r, "gap:"), 2);
+  // AND every jump in time is reported as lost samples, no more and no fewer
+  std::uint64_t skipped = 0;
+  for (std::size_t i = 1; i < r.rows.size(); ++i) {
+    const double dt = r.rows[i].t_s - r.rows[i - 1].t_s;
+    ASSERT_GT(dt, 0.0);
+    skipped += static_cast<std::uint64_t>(std::llround(dt / 0.01)) - 1;
+  }
+  EXPECT_EQ(skipped, st.lost_samples);
+  EXPECT_EQ(r.rows.size() + skipped, 6000u);
+  EXPECT_TRUE(st.complete);
+  fs::remove(path);
+}
+
+TEST(LiveLoop, DeviceGoneForGoodLeavesAnIncompleteButValidLog) {
+  EmuRig rig;
+  ASSERT_TRUE(rig.src.configure().ok());
+  const fs::path path = temp_file("gone.csv");
+  LiveStats st;
+  {
+    log::LogWriter writer(path, box_meta(), rig.src.fields());
+    LiveParams lp;
+    lp.duration_s = 60.0;
+    lp.give_up_after_s = 3.0;
+    LiveLoop loop(lp, rig.clock, &writer, nullptr);
+    loop.on_sample([&, done = false](const Sample& s, SampleSource&) mutable {
+      if (s.t_s > 5.0 && !done) {
+        rig.bus.unplug_adapter(rig.clock.now_s(), 1e9);
+        done = true;
+      }
+    });
+    std::atomic<bool> stop{false};
+    st = loop.run(rig.src, nullptr, stop);
+    writer.finish(st.complete, st.end_reason);
+  }
+  EXPECT_FALSE(st.complete);
+  EXPECT_NE(st.end_reason.find("lost"), std::string::npos);
+  const Result r = read_back(path, st);
+  EXPECT_FALSE(r.meta.complete());
+  EXPECT_NEAR(static_cast<double>(r.rows.size()), 500.0, 2.0);
+  EXPECT_EQ(events_with(r, "gave up"), 1);
+  fs::remove(path);
+}
+
+}  // namespace
+}  // namespace driftless::hil
