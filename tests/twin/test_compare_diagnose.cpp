@@ -1,0 +1,167 @@
+// GIVEN a "measured" log with one hidden effect and a model lacking it, WHEN compared,
+// THEN that effect ranks first with its parameter within 20 %, and applying it removes the
+// systematic residual. Logs: closed-form pan/tilt kinematics + the SensorModel (seeded).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <set>
+#include <string>
+
+#include "tests/twin/compare_test_log.hpp"
+#include "twin/compare/compare.hpp"
+
+namespace driftless::twin {
+namespace {
+
+constexpr double kDuration = 150.0;
+
+// the log's sensor: MPU6050 defaults with the run-to-run draws fixed at zero, noise kept
+SensorParams base_sensor() {
+  SensorParams p = deterministic_part(mpu6050_defaults());
+  p.white_noise.enabled = true;
+  p.bias_instability.enabled = true;
+  p.rate_random_walk.enabled = true;
+  p.quantization.enabled = true;
+  p.constant_bias.value_dps = Eigen::Vector3d(1.5, -2.0, 0.7);
+  return p;
+}
+
+CompareResult run(const SensorParams& log1, const SensorParams& log2, const SensorParams& model1,
+                  const SensorParams& model2, std::uint64_t seed) {
+  const auto lg = testlog::make_log(log1, log2, kDuration, seed);
+  const Replay rp = replay_samples(lg.samples, lg.meta, lg.fields, ReplayOptions{}, "test.csv");
+  CompareModel m = default_compare_model();
+  m.sensor = {model1, model2};
+  m.source = "test model";
+  return compare(rp, m, CompareOptions{});
+}
+
+const FittedParam* find_param(const Candidate& c, const std::string& name) {
+  for (const auto& p : c.params)
+    if (p.name == name) return &p;
+  return nullptr;
+}
+
+TEST(CompareDiagnose, CleanLogIsConsistentWithNoise) {
+  // GIVEN logs whose sensors match the model exactly (noise only)
+  int consistent = 0;
+  const int seeds = 3;
+  for (int seed = 1; seed <= seeds; ++seed) {
+    const SensorParams p = base_sensor();
+    // WHEN compared
+    const CompareResult res = run(p, p, p, p, static_cast<std::uint64_t>(seed));
+    if (res.verdict == "consistent_with_noise") ++consistent;
+    else ADD_FAILURE() << "seed " << seed << ": " << res.statement;
+  }
+  // THEN every seed is consistent with the noise model
+  EXPECT_EQ(consistent, seeds);
+}
+
+TEST(CompareDiagnose, ScaleFactorFoundAndApplied) {
+  // GIVEN sensor 1 with scale errors of +3 % (x) and -2 % (z), and a model without scale errors
+  SensorParams truth = base_sensor();
+  truth.scale_factor.value_pct = Eigen::Vector3d(3.0, 0.0, -2.0);
+  const SensorParams model = base_sensor();
+  // WHEN diagnosed
+  const CompareResult res = run(truth, model, model, model, 11);
+  // THEN scale_factor ranks first, within 20 % of the truth
+  ASSERT_EQ(res.verdict, "missing_effect") << res.statement;
+  const Candidate& best = res.ranking.front();
+  EXPECT_EQ(best.effect, "scale_factor") << res.statement;
+  EXPECT_EQ(best.sensor, "1");
+  const auto* px = find_param(best, "s1.x.value_pct");
+  const auto* pz = find_param(best, "s1.z.value_pct");
+  ASSERT_TRUE(px && pz) << res.statement;
+  EXPECT_NEAR(px->value, 3.0, 0.6);
+  EXPECT_NEAR(pz->value, -2.0, 0.4);
+  // AND after applying it the systematic residual falls >= 5x or to within 10 % of the floor
+  CompareModel m = default_compare_model();
+  m.sensor = {model, model};
+  apply_candidate(m, best);
+  const auto lg = testlog::make_log(truth, model, kDuration, 11);
+  const Replay rp = replay_samples(lg.samples, lg.meta, lg.fields, ReplayOptions{}, "test.csv");
+  const CompareResult again = compare(rp, m, CompareOptions{});
+  for (int c : {0, 2}) {
+    const auto& before = res.channels[c];
+    const auto& after = again.channels[c];
+    EXPECT_TRUE(after.systematic_rms_dps * 5.0 <= before.systematic_rms_dps ||
+                after.rms_dps <= 1.1 * after.noise_floor_dps)
+        << channel_name(c) << " systematic " << before.systematic_rms_dps << " -> " << after.systematic_rms_dps;
+  }
+  EXPECT_EQ(again.verdict, "consistent_with_noise") << again.statement;
+}
+
+TEST(CompareDiagnose, GSensitivityFound) {
+  // GIVEN sensor 2 with a g-sensitivity of 0.1 deg/s/g on its y axis from gravity along z
+  SensorParams truth = base_sensor();
+  truth.g_sensitivity.matrix_dps_per_g(1, 2) = 0.1;
+  truth.g_sensitivity.matrix_dps_per_g(0, 0) = -0.1;
+  const SensorParams model = base_sensor();
+  const CompareResult res = run(model, truth, model, model, 5);
+  ASSERT_EQ(res.verdict, "missing_effect") << res.statement;
+  const Candidate& best = res.ranking.front();
+  EXPECT_EQ(best.effect, "g_sensitivity") << res.statement;
+  const auto* p = find_param(best, "s2.matrix_dps_per_g[y][z]");
+  ASSERT_NE(p, nullptr) << res.statement;
+  EXPECT_NEAR(p->value, 0.1, 0.02);
+}
+
+TEST(CompareDiagnose, TemperatureBiasCoefficientFound) {
+  // GIVEN sensor 1 self-heating by 5 degC (tau 100 s) with a bias tempco of 0.1 deg/s/degC on x
+  SensorParams model = base_sensor();
+  model.temperature.warmup_rise_degc = 5.0;
+  model.temperature.warmup_tau_s = 100.0;
+  SensorParams truth = model;
+  truth.temperature.bias_tc_dps_per_degc = Eigen::Vector3d(0.1, 0.0, 0.0);
+  const CompareResult res = run(truth, model, model, model, 7);
+  ASSERT_EQ(res.verdict, "missing_effect") << res.statement;
+  const Candidate& best = res.ranking.front();
+  EXPECT_EQ(best.effect, "temperature") << res.statement;
+  const auto* p = find_param(best, "s1.x.bias_tc_dps_per_degc");
+  ASSERT_NE(p, nullptr) << res.statement;
+  EXPECT_NEAR(p->value, 0.1, 0.02);
+}
+
+TEST(CompareDiagnose, MisalignmentFound) {
+  // GIVEN sensor 1 with a 2 % cross-axis coupling of y into x and 1.5 % of x into z
+  SensorParams truth = base_sensor();
+  truth.misalignment.matrix_pct(0, 1) = 2.0;
+  truth.misalignment.matrix_pct(2, 0) = 1.5;
+  const SensorParams model = base_sensor();
+  const CompareResult res = run(truth, model, model, model, 9);
+  ASSERT_EQ(res.verdict, "missing_effect") << res.statement;
+  const Candidate& best = res.ranking.front();
+  EXPECT_EQ(best.effect, "misalignment") << res.statement;
+  const auto* p = find_param(best, "s1.matrix_pct[x][y]");
+  ASSERT_NE(p, nullptr) << res.statement;
+  EXPECT_NEAR(p->value, 2.0, 0.4);
+}
+
+TEST(CompareDiagnose, TwoHiddenEffectsOnePerRound) {
+  // GIVEN a scale error on sensor 1 and a g-sensitivity on sensor 2, model lacking both
+  SensorParams t1 = base_sensor(), t2 = base_sensor();
+  t1.scale_factor.value_pct = Eigen::Vector3d(0.0, 3.0, 0.0);
+  t2.g_sensitivity.matrix_dps_per_g(1, 2) = 0.1;
+  const SensorParams model = base_sensor();
+  const auto lg = testlog::make_log(t1, t2, kDuration, 21);
+  const Replay rp = replay_samples(lg.samples, lg.meta, lg.fields, ReplayOptions{}, "test.csv");
+  CompareModel m = default_compare_model();
+  m.sensor = {model, model};
+  // WHEN diagnosed twice, applying the winner in between
+  const CompareResult r1 = compare(rp, m, CompareOptions{});
+  ASSERT_EQ(r1.verdict, "missing_effect") << r1.statement;
+  apply_candidate(m, r1.ranking.front());
+  const CompareResult r2 = compare(rp, m, CompareOptions{});
+  ASSERT_EQ(r2.verdict, "missing_effect") << r2.statement;
+  apply_candidate(m, r2.ranking.front());
+  const CompareResult r3 = compare(rp, m, CompareOptions{});
+  // THEN the two rounds found the two effects, and the third finds nothing
+  std::set<std::string> found{r1.ranking.front().effect, r2.ranking.front().effect};
+  EXPECT_TRUE(found.count("scale_factor")) << r1.statement << " / " << r2.statement;
+  EXPECT_TRUE(found.count("g_sensitivity")) << r1.statement << " / " << r2.statement;
+  EXPECT_EQ(r3.verdict, "consistent_with_noise") << r3.statement;
+}
+
+}  // namespace
+}  // namespace driftless::twin

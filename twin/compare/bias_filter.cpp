@@ -1,0 +1,163 @@
+#include "twin/compare/bias_filter.hpp"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace driftless::twin {
+
+void ChannelNoise::validate() const {
+  auto check = [](bool ok, const char* what) {
+    if (!ok) throw std::invalid_argument(std::string("ChannelNoise: ") + what);
+  };
+  check(white_dps_rthz > 0 && std::isfinite(white_dps_rthz), "white_dps_rthz must be > 0 deg/s/rtHz");
+  check(gm_sigma_dps >= 0 && std::isfinite(gm_sigma_dps), "gm_sigma_dps must be >= 0 deg/s");
+  check(gm_tau_s > 0 && std::isfinite(gm_tau_s), "gm_tau_s must be > 0 s");
+  check(rrw_dps_rts >= 0 && std::isfinite(rrw_dps_rts), "rrw_dps_rts must be >= 0 deg/s/rts");
+  check(turn_on_sigma_dps > 0, "turn_on_sigma_dps must be > 0 deg/s");
+}
+
+BiasWhitener::BiasWhitener(const BlockSeries& blocks, const ChannelNoise& noise) {
+  noise.validate();
+  const std::size_t m = blocks.t_s.size();
+  steps_.resize(m);
+  used_.assign(m, 0);
+  const double white_var_rate = noise.white_dps_rthz * noise.white_dps_rthz * blocks.sample_rate_hz;
+  const double gm_var = noise.gm_sigma_dps * noise.gm_sigma_dps;
+  const double rrw_var = noise.rrw_dps_rts * noise.rrw_dps_rts;
+  // state [constant + random walk, Gauss-Markov]
+  double p00 = noise.turn_on_sigma_dps * noise.turn_on_sigma_dps, p01 = 0.0, p11 = gm_var;
+  bool first = true;
+  for (std::size_t j = 0; j < m; ++j) {
+    Step& st = steps_[j];
+    const double dt = j == 0 ? 0.0 : blocks.t_s[j] - blocks.t_s[j - 1];
+    st.phi = std::exp(-dt / noise.gm_tau_s);
+    st.q_rw = rrw_var * dt;
+    st.q_gm = gm_var * (1.0 - st.phi * st.phi);
+    // predict
+    st.pp00 = p00 + st.q_rw;
+    st.pp01 = st.phi * p01;
+    st.pp11 = st.phi * st.phi * p11 + st.q_gm;
+    if (blocks.count[j] > 0) {
+      const double r = white_var_rate / blocks.count[j];
+      st.s = st.pp00 + 2 * st.pp01 + st.pp11 + r;
+      st.k0 = (st.pp00 + st.pp01) / st.s;
+      st.k1 = (st.pp01 + st.pp11) / st.s;
+      p00 = st.pp00 - st.k0 * st.k0 * st.s;
+      p01 = st.pp01 - st.k0 * st.k1 * st.s;
+      p11 = st.pp11 - st.k1 * st.k1 * st.s;
+      // the first observed block only fixes the turn-on bias (diffuse prior)
+      if (!first) {
+        used_[j] = 1;
+        ++n_used_;
+      }
+      first = false;
+    } else {
+      st.s = 0.0;
+      st.k0 = st.k1 = 0.0;
+      p00 = st.pp00;
+      p01 = st.pp01;
+      p11 = st.pp11;
+    }
+    st.pf00 = p00;
+    st.pf01 = p01;
+    st.pf11 = p11;
+  }
+  final_sigma_ = std::sqrt(std::max(0.0, p00));
+}
+
+void BiasWhitener::whiten(std::span<const double> z, std::span<double> out) const {
+  double x0 = 0.0, x1 = 0.0;
+  for (std::size_t j = 0; j < steps_.size(); ++j) {
+    const Step& st = steps_[j];
+    x1 *= st.phi;
+    if (st.s > 0.0) {
+      const double nu = z[j] - x0 - x1;
+      x0 += st.k0 * nu;
+      x1 += st.k1 * nu;
+      out[j] = used_[j] ? nu / std::sqrt(st.s) : 0.0;
+    } else {
+      out[j] = 0.0;
+    }
+  }
+}
+
+double BiasWhitener::neg2_loglik(std::span<const double> z) const {
+  double x0 = 0.0, x1 = 0.0, acc = 0.0;
+  for (std::size_t j = 0; j < steps_.size(); ++j) {
+    const Step& st = steps_[j];
+    x1 *= st.phi;
+    if (st.s > 0.0) {
+      const double nu = z[j] - x0 - x1;
+      x0 += st.k0 * nu;
+      x1 += st.k1 * nu;
+      if (used_[j]) acc += std::log(st.s) + nu * nu / st.s;
+    }
+  }
+  return acc;
+}
+
+std::vector<double> BiasWhitener::smooth(std::span<const double> z) const {
+  const std::size_t m = steps_.size();
+  std::vector<double> xf0(m), xf1(m), out(m);
+  double x0 = 0.0, x1 = 0.0;
+  for (std::size_t j = 0; j < m; ++j) {
+    const Step& st = steps_[j];
+    x1 *= st.phi;
+    if (st.s > 0.0) {
+      const double nu = z[j] - x0 - x1;
+      x0 += st.k0 * nu;
+      x1 += st.k1 * nu;
+    }
+    xf0[j] = x0;
+    xf1[j] = x1;
+  }
+  if (m == 0) return out;
+  // Rauch-Tung-Striebel backward pass: C = Pf F^T Pp_next^{-1}
+  double s0 = xf0[m - 1], s1 = xf1[m - 1];
+  out[m - 1] = s0 + s1;
+  for (std::size_t jj = m - 1; jj-- > 0;) {
+    const Step& st = steps_[jj];
+    const Step& nx = steps_[jj + 1];
+    const double det = nx.pp00 * nx.pp11 - nx.pp01 * nx.pp01;
+    // Pf F^T with F = diag(1, phi)
+    const double a00 = st.pf00, a01 = st.pf01 * nx.phi, a10 = st.pf01, a11 = st.pf11 * nx.phi;
+    double c00, c01, c10, c11;
+    if (det > 1e-300) {
+      const double i00 = nx.pp11 / det, i01 = -nx.pp01 / det, i11 = nx.pp00 / det;
+      c00 = a00 * i00 + a01 * i01;
+      c01 = a00 * i01 + a01 * i11;
+      c10 = a10 * i00 + a11 * i01;
+      c11 = a10 * i01 + a11 * i11;
+    } else {
+      // degenerate (no GM part): scalar smoother on the first state
+      c00 = nx.pp00 > 0 ? a00 / nx.pp00 : 1.0;
+      c01 = c10 = 0.0;
+      c11 = nx.pp11 > 0 ? a11 / nx.pp11 : 0.0;
+    }
+    const double xp0 = xf0[jj], xp1 = xf1[jj] * nx.phi;
+    const double d0 = s0 - xp0, d1 = s1 - xp1;
+    s0 = xf0[jj] + c00 * d0 + c01 * d1;
+    s1 = xf1[jj] + c10 * d0 + c11 * d1;
+    out[jj] = s0 + s1;
+  }
+  return out;
+}
+
+void block_means(std::span<const double> x, std::span<const std::uint8_t> mask,
+                 std::size_t block_len, std::span<double> out) {
+  for (std::size_t j = 0; j < out.size(); ++j) {
+    double acc = 0.0;
+    int cnt = 0;
+    const std::size_t a = j * block_len, b = std::min(x.size(), a + block_len);
+    for (std::size_t k = a; k < b; ++k) {
+      if (mask[k] && std::isfinite(x[k])) {
+        acc += x[k];
+        ++cnt;
+      }
+    }
+    out[j] = cnt > 0 ? acc / cnt : 0.0;
+  }
+}
+
+}  // namespace driftless::twin

@@ -1,0 +1,67 @@
+// The nuisance bias of one gyro channel as a random process (turn-on constant + random walk +
+// first-order Gauss-Markov) observed in white noise, on block means of the residual.
+// A forward Kalman filter whitens any column (innovations / sqrt(s)): generalised least squares
+// of a residual on regressors is then ordinary least squares on whitened columns, and the
+// filter's innovations give the exact Gaussian log-likelihood (docs/compare.md).
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace driftless::twin {
+
+/// Noise model of one channel. Units: deg/s, s.
+struct ChannelNoise {
+  double white_dps_rthz = 0.005;   // N, angle random walk density, deg/s/sqrt(Hz)
+  double gm_sigma_dps = 0.0;       // bias instability: Gauss-Markov steady-state sigma, deg/s
+  double gm_tau_s = 100.0;         // its correlation time, s
+  double rrw_dps_rts = 0.0;        // K, rate random walk, deg/s/sqrt(s)
+  double turn_on_sigma_dps = 1e3;  // prior sigma of the constant (turn-on) bias, deg/s (diffuse)
+  /// Throws std::invalid_argument naming the field on a bad value.
+  void validate() const;
+};
+
+/// Block layout: block j holds count[j] samples (0 = missing) at time t_s[j].
+struct BlockSeries {
+  std::vector<double> t_s;           // s, block centre times
+  std::vector<std::uint16_t> count;  // samples averaged in each block (0 = no data)
+  double sample_rate_hz = 100.0;     // Hz, of the samples inside the blocks
+};
+
+/// Precomputed gains of the whitening filter for one noise model and block layout.
+class BiasWhitener {
+ public:
+  BiasWhitener(const BlockSeries& blocks, const ChannelNoise& noise);
+  /// Whitened innovations of `z` (block means): out[j] = nu_j / sqrt(s_j), 0 where excluded.
+  void whiten(std::span<const double> z, std::span<double> out) const;
+  /// -2 log-likelihood of z under the model (the diffuse first block left out).
+  double neg2_loglik(std::span<const double> z) const;
+  /// Smoothed bias (RTS) given z: the nuisance estimate, deg/s, per block.
+  std::vector<double> smooth(std::span<const double> z) const;
+  /// Which blocks enter fits (data present, not the diffuse first one).
+  const std::vector<std::uint8_t>& used() const { return used_; }
+  std::size_t used_count() const { return n_used_; }
+  /// Posterior sigma of the constant (random-walk) state at the end, deg/s.
+  double final_bias_sigma_dps() const { return final_sigma_; }
+
+ private:
+  struct Step {
+    double phi;         // GM transition
+    double q_rw, q_gm;  // process noise variances
+    double k0, k1;      // Kalman gain for the two states (0 when no data)
+    double s;           // innovation variance
+    // RTS smoother: filtered and predicted covariances
+    double pf00, pf01, pf11, pp00, pp01, pp11;
+  };
+  std::vector<Step> steps_;
+  std::vector<std::uint8_t> used_;
+  std::size_t n_used_ = 0;
+  double final_sigma_ = 0.0;
+};
+
+/// Block means of a per-sample series over the blocks (NaN or masked samples skipped).
+void block_means(std::span<const double> x, std::span<const std::uint8_t> mask,
+                 std::size_t block_len, std::span<double> out);
+
+}  // namespace driftless::twin

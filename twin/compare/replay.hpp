@@ -1,0 +1,76 @@
+// Log-driven kinematics replay: what each gyro should have sensed, rebuilt from a measurement
+// log's reference motion (ref_q, ref_p), platform angles and metadata (docs/compare.md).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "estimator/log.hpp"
+#include "estimator/sample.hpp"
+
+namespace driftless::twin {
+
+/// How a log is replayed. Units: Hz, deg, deg/s, s.
+struct ReplayOptions {
+  double model_sample_rate_hz = kNaN;   // Hz; the model's rate, NaN = accept the log's rate
+  bool resample = false;                // a log at another rate is resampled (else refused)
+  double default_latitude_deg = 52.0;   // deg; used (and stated) when the log has no latitude_deg
+  double flip_rate_threshold_dps = 0.5; // deg/s; a platform turning faster than this is flipping
+  double flip_guard_s = 0.05;           // s; samples this close to a flip count as flipping
+  double static_rate_limit_dps = 0.5;   // deg/s; without ref_q, larger gyro swings mean "moving"
+  /// Throws std::invalid_argument naming the field on a bad value.
+  void validate() const;
+};
+
+/// Per-sample truth rebuilt from a log, plus what was measured. Sensor index s = 0, 1.
+struct Replay {
+  std::size_t size() const { return t_s.size(); }
+
+  std::vector<double> t_s;                               // s, log time
+  std::array<std::vector<Eigen::Vector3d>, 2> gyro_dps;  // measured, sensor axes, deg/s
+  std::array<std::vector<Eigen::Vector3d>, 2> w_radps;   // ideal inertial rate y_i, sensor axes
+  std::array<std::vector<Eigen::Vector3d>, 2> f_mps2;    // specific force, sensor axes
+  std::array<std::vector<Eigen::Vector3d>, 2> dw_radps2; // d(w_radps)/dt, sensor axes
+  // d(y_i)/d(latitude) per rad of latitude: the Earth-rate part's sensitivity, sensor axes
+  std::array<std::vector<Eigen::Vector3d>, 2> dw_dlat_radps;
+  std::vector<Eigen::Vector3d> w_body_radps;             // box inertial rate, box axes
+  std::vector<Eigen::Vector3d> f_body_mps2;              // box specific force, box axes
+  std::array<std::vector<double>, 2> plat_deg;           // as logged; NaN when unknown
+  std::array<std::vector<double>, 2> plat_rate_dps;      // by central differences; NaN unknown
+  std::array<std::vector<double>, 2> temp_c;             // logged die temperature, NaN if absent
+  std::vector<std::uint8_t> usable;    // gyro finite and the truth is known
+  std::vector<std::uint8_t> flipping;  // a platform moves, or its angle is unknown
+  std::array<std::vector<float>, 2> since_flip_s;       // s since platform i last stopped (inf)
+  std::array<std::vector<std::int8_t>, 2> last_flip_dir; // +1/-1: direction of that flip, 0 none
+  std::array<std::vector<std::int8_t>, 2> rest_side;     // +1/-1 platform at rest on that side, 0
+
+  std::array<Eigen::Vector3d, 2> hinge_axis{Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitX()};
+  double latitude_deg = kNaN;
+  double sample_rate_hz = kNaN;   // Hz, of the replayed series (after any resampling)
+  double log_rate_hz = kNaN;      // Hz, as found in the log
+  bool resampled = false;
+  bool has_ref_q = false, has_ref_p = false, has_accel = false, has_temp = false;
+  log::Metadata meta;
+  std::string log_path;
+  std::size_t rows_missing_gyro = 0;
+  std::vector<std::string> notes;  // assumptions and conversions, said in the report
+};
+
+/// Replays a log file. Throws std::runtime_error with an actionable message when the log
+/// cannot be replayed (moving box without ref_q, rate mismatch without resampling, ...).
+Replay replay_log(const std::filesystem::path& path, const ReplayOptions& opt);
+
+/// Replays samples already in memory (tests, bridges); `where` names the source in messages.
+Replay replay_samples(const std::vector<Sample>& samples, const log::Metadata& meta,
+                      std::uint32_t fields, const ReplayOptions& opt, const std::string& where);
+
+/// Rotation of platform s's sensor frame in box axes: R_i = Rot(a_i, theta_i).
+Eigen::Matrix3d platform_rotation(const Eigen::Vector3d& axis, double angle_deg);
+
+}  // namespace driftless::twin

@@ -1,0 +1,341 @@
+#include "twin/compare/report.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#include <fmt/core.h>
+
+namespace driftless::twin {
+namespace {
+
+std::string esc_json(const std::string& s) {
+  std::string o;
+  for (char c : s) {
+    switch (c) {
+      case '"': o += "\\\""; break;
+      case '\\': o += "\\\\"; break;
+      case '\n': o += "\\n"; break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) o += fmt::format("\\u{:04x}", c);
+        else o += c;
+    }
+  }
+  return o;
+}
+std::string num(double v) { return std::isfinite(v) ? fmt::format("{:.9g}", v) : "null"; }
+
+std::string esc_html(const std::string& s) {
+  std::string o;
+  for (char c : s) {
+    if (c == '<') o += "&lt;";
+    else if (c == '>') o += "&gt;";
+    else if (c == '&') o += "&amp;";
+    else o += c;
+  }
+  return o;
+}
+
+std::string base64(const std::string& in) {
+  static const char* t = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string o;
+  std::size_t i = 0;
+  for (; i + 2 < in.size(); i += 3) {
+    const unsigned v = (static_cast<unsigned char>(in[i]) << 16) | (static_cast<unsigned char>(in[i + 1]) << 8) |
+                       static_cast<unsigned char>(in[i + 2]);
+    o += t[(v >> 18) & 63]; o += t[(v >> 12) & 63]; o += t[(v >> 6) & 63]; o += t[v & 63];
+  }
+  if (i + 1 == in.size()) {
+    const unsigned v = static_cast<unsigned char>(in[i]) << 16;
+    o += t[(v >> 18) & 63]; o += t[(v >> 12) & 63]; o += "==";
+  } else if (i + 2 == in.size()) {
+    const unsigned v = (static_cast<unsigned char>(in[i]) << 16) | (static_cast<unsigned char>(in[i + 1]) << 8);
+    o += t[(v >> 18) & 63]; o += t[(v >> 12) & 63]; o += t[(v >> 6) & 63]; o += '=';
+  }
+  return o;
+}
+
+std::string read_file(const std::filesystem::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+// runs gnuplot on a script; returns the PNG bytes or "" when gnuplot is missing/failed
+std::string gnuplot_png(const std::filesystem::path& dir, const std::string& stem, const std::string& script) {
+  const auto gp = dir / (stem + ".gp");
+  const auto png = dir / (stem + ".png");
+  {
+    std::ofstream f(gp);
+    f << "set terminal pngcairo size 900,420 font 'sans,9'\nset output '" << png.string() << "'\n" << script;
+  }
+  const std::string cmd = fmt::format("gnuplot '{}' > /dev/null 2>&1", gp.string());
+  if (std::system(cmd.c_str()) != 0) {
+    // pngcairo may be absent in gnuplot-nox: fall back to the plain png terminal
+    std::string s2 = script;
+    std::ofstream f(gp);
+    f << "set terminal png size 900,420\nset output '" << png.string() << "'\n" << s2;
+    f.close();
+    if (std::system(cmd.c_str()) != 0) return {};
+  }
+  return read_file(png);
+}
+
+void candidate_json(std::ostringstream& o, const Candidate& c) {
+  o << "{\"effect\": \"" << esc_json(c.effect) << "\", \"sensor\": \"" << esc_json(c.sensor) << "\", \"axis\": \""
+    << esc_json(c.axis) << "\", \"kind\": \"" << c.kind << "\", \"testable\": " << (c.testable ? "true" : "false")
+    << ", \"applicable\": " << (c.applicable ? "true" : "false") << ", \"params\": [";
+  for (std::size_t i = 0; i < c.params.size(); ++i) {
+    const auto& p = c.params[i];
+    o << (i ? ", " : "") << "{\"name\": \"" << esc_json(p.name) << "\", \"value\": " << num(p.value)
+      << ", \"sigma\": " << num(p.sigma) << ", \"unit\": \"" << esc_json(p.unit) << "\"}";
+  }
+  o << "], \"explained_fraction\": " << num(c.explained_fraction) << ", \"evidence\": " << num(c.evidence)
+    << ", \"chi2\": " << num(c.chi2) << ", \"dof\": " << c.dof << ", \"p_value\": " << num(c.p_value)
+    << ", \"note\": \"" << esc_json(c.note) << "\", \"residual_rms_after_dps\": {";
+  for (int ch = 0; ch < 6; ++ch) o << (ch ? ", " : "") << "\"" << channel_name(ch) << "\": " << num(c.rms_after_dps[ch]);
+  o << "}}";
+}
+
+}  // namespace
+
+std::string diagnosis_json(const CompareResult& r, const ReportExtras& x) {
+  std::ostringstream o;
+  o << "{\n  \"format\": \"driftless-diagnosis 1\",\n";
+  o << "  \"log\": \"" << esc_json(r.log_path) << "\",\n  \"model\": \"" << esc_json(r.model_source) << "\",\n";
+  o << "  \"verdict\": \"" << r.verdict << "\",\n  \"statement\": \"" << esc_json(r.statement) << "\",\n";
+  o << "  \"samples\": " << r.samples << ", \"samples_used\": " << r.samples_used << ", \"duration_s\": " << num(r.duration_s)
+    << ", \"sample_rate_hz\": " << num(r.sample_rate_hz) << ", \"block_s\": " << num(r.block_s)
+    << ", \"resampled\": " << (r.resampled ? "true" : "false") << ",\n";
+  o << "  \"notes\": [";
+  for (std::size_t i = 0; i < r.notes.size(); ++i) o << (i ? ", " : "") << "\"" << esc_json(r.notes[i]) << "\"";
+  o << "],\n  \"ranking\": [\n";
+  for (std::size_t i = 0; i < r.ranking.size(); ++i) {
+    o << "    ";
+    candidate_json(o, r.ranking[i]);
+    o << (i + 1 < r.ranking.size() ? ",\n" : "\n");
+  }
+  o << "  ],\n  \"residual_rms_dps\": {\n";
+  const Candidate* best = r.ranking.empty() ? nullptr : &r.ranking.front();
+  for (int c = 0; c < 6; ++c) {
+    const auto& ch = r.channels[c];
+    o << "    \"" << channel_name(c) << "\": {\"before\": " << num(ch.rms_dps)
+      << ", \"after_best\": " << num(best ? best->rms_after_dps[c] : ch.rms_dps)
+      << ", \"raw\": " << num(ch.raw_rms_dps) << ", \"noise_floor\": " << num(ch.noise_floor_dps)
+      << ", \"systematic\": " << num(ch.systematic_rms_dps);
+    if (x.after) o << ", \"after_apply\": " << num(x.after->channels[c].rms_dps) << ", \"systematic_after_apply\": " << num(x.after->channels[c].systematic_rms_dps);
+    o << "}" << (c < 5 ? ",\n" : "\n");
+  }
+  o << "  },\n  \"channels\": {\n";
+  for (int c = 0; c < 6; ++c) {
+    const auto& ch = r.channels[c];
+    o << "    \"" << channel_name(c) << "\": {\"mean_dps\": " << num(ch.mean_dps) << ", \"raw_mean_dps\": " << num(ch.raw_mean_dps)
+      << ", \"white_noise_fit_dps_rthz\": " << num(ch.white_fit_dps_rthz) << ", \"ljung_box_q\": " << num(ch.ljung_box_q)
+      << ", \"ljung_box_p\": " << num(ch.ljung_box_p) << ", \"turn_on_bias_dps\": " << num(ch.turn_on_bias_dps)
+      << ", \"adev_outside_fraction\": " << num(ch.adev_outside_fraction) << "}" << (c < 5 ? ",\n" : "\n");
+  }
+  o << "  },\n  \"regimes\": [\n";
+  for (std::size_t i = 0; i < r.regimes.size(); ++i) {
+    const auto& g = r.regimes[i];
+    o << "    {\"group\": \"" << esc_json(g.group) << "\", \"name\": \"" << esc_json(g.name) << "\", \"samples\": " << g.samples
+      << ", \"rms_dps\": [";
+    for (int c = 0; c < 6; ++c) o << (c ? ", " : "") << num(g.rms_dps[c]);
+    o << "], \"mean_dps\": [";
+    for (int c = 0; c < 6; ++c) o << (c ? ", " : "") << num(g.mean_dps[c]);
+    o << "]";
+    if (x.after) {
+      for (const auto& h : x.after->regimes) {
+        if (h.group != g.group || h.name != g.name) continue;
+        o << ", \"rms_after_apply_dps\": [";
+        for (int c = 0; c < 6; ++c) o << (c ? ", " : "") << num(h.rms_dps[c]);
+        o << "]";
+      }
+    }
+    o << "}" << (i + 1 < r.regimes.size() ? ",\n" : "\n");
+  }
+  o << "  ],\n  \"worst_windows\": [\n";
+  for (std::size_t i = 0; i < r.worst_windows.size(); ++i) {
+    const auto& w = r.worst_windows[i];
+    o << "    {\"t0_s\": " << num(w.t0_s) << ", \"t1_s\": " << num(w.t1_s) << ", \"worst_channel\": \"" << channel_name(w.worst_channel)
+      << "\", \"rms_over_floor\": " << num(w.worst_ratio) << "}" << (i + 1 < r.worst_windows.size() ? ",\n" : "\n");
+  }
+  o << "  ],\n  \"correlations\": [\n";
+  for (std::size_t i = 0; i < r.correlations.size(); ++i) {
+    const auto& c = r.correlations[i];
+    o << "    {\"signal\": \"" << esc_json(c.signal) << "\", \"channel\": \"" << channel_name(c.channel) << "\", \"rho\": " << num(c.rho)
+      << ", \"z\": " << num(c.z) << "}" << (i + 1 < r.correlations.size() ? ",\n" : "\n");
+  }
+  o << "  ]";
+  if (x.after) {
+    o << ",\n  \"after_apply\": {\"model\": \"" << esc_json(x.after_model) << "\", \"applied\": \"" << esc_json(x.applied)
+      << "\", \"verdict\": \"" << x.after->verdict << "\", \"statement\": \"" << esc_json(x.after->statement) << "\"}";
+  }
+  o << "\n}\n";
+  return o.str();
+}
+
+void write_report(const CompareResult& r, const std::filesystem::path& dir, const ReportExtras& x) {
+  std::filesystem::create_directories(dir);
+  {
+    std::ofstream f(dir / "diagnosis.json");
+    if (!f) throw std::runtime_error(fmt::format("cannot write {}", (dir / "diagnosis.json").string()));
+    f << diagnosis_json(r, x);
+  }
+  const auto plot_dir = dir / "plots";
+  std::filesystem::create_directories(plot_dir);
+  std::vector<std::pair<std::string, std::string>> plots;  // title, png bytes
+  // 1: block residual and smoothed nuisance bias over time
+  {
+    std::ofstream d(plot_dir / "residual.dat");
+    for (std::size_t b = 0; b < r.block_t_s.size(); ++b) {
+      d << fmt::format("{:.3f}", r.block_t_s[b]);
+      for (int c = 0; c < 6; ++c) d << ' ' << num(r.block_residual_dps[c][b]) << ' ' << num(r.block_bias_dps[c][b]);
+      d << '\n';
+    }
+    std::string s = "set multiplot layout 2,1\nset xlabel 't (s)'\nset ylabel 'residual (deg/s)'\nset key outside right\nset datafile missing 'null'\n";
+    for (int sn = 0; sn < 2; ++sn) {
+      s += fmt::format("set title 'sensor {}: block-mean residual after the nuisance fit (points) and smoothed bias (lines)'\nplot ", sn + 1);
+      for (int a = 0; a < 3; ++a) {
+        const int c = sn * 3 + a;
+        s += fmt::format("'{}' u 1:{} w d t '{}', '' u 1:{} w l lw 2 t 'bias {}'{}", (plot_dir / "residual.dat").string(), 2 + 2 * c,
+                         channel_name(c), 3 + 2 * c, channel_name(c), a < 2 ? ", " : "\n");
+      }
+    }
+    s += "unset multiplot\n";
+    plots.push_back({"Residual over time", gnuplot_png(plot_dir, "residual", s)});
+  }
+  // 2: windowed rms
+  {
+    std::ofstream d(plot_dir / "windows.dat");
+    for (const auto& w : r.windows) {
+      d << fmt::format("{:.3f}", 0.5 * (w.t0_s + w.t1_s));
+      for (int c = 0; c < 6; ++c) d << ' ' << num(w.rms_dps[c]);
+      d << '\n';
+    }
+    std::string s = "set xlabel 't (s)'\nset ylabel 'rms (deg/s)'\nset key outside right\nset title 'windowed residual rms'\nplot ";
+    for (int c = 0; c < 6; ++c)
+      s += fmt::format("'{}' u 1:{} w lp t '{}'{}", (plot_dir / "windows.dat").string(), 2 + c, channel_name(c), c < 5 ? ", " : "\n");
+    plots.push_back({"Windowed residual RMS", gnuplot_png(plot_dir, "windows", s)});
+  }
+  // 3: ADEV of the residual vs the model
+  {
+    std::ofstream d(plot_dir / "adev.dat");
+    std::size_t np = 0;
+    for (const auto& ch : r.channels) np = std::max(np, ch.adev.points.size());
+    for (std::size_t i = 0; i < np; ++i) {
+      for (int c = 0; c < 6; ++c) {
+        const auto& ch = r.channels[c];
+        if (i < ch.adev.points.size()) d << num(ch.adev.points[i].tau_s) << ' ' << num(ch.adev.points[i].adev) << ' ' << num(ch.adev_model[i]) << ' ';
+        else d << "null null null ";
+      }
+      d << '\n';
+    }
+    std::string s = "set logscale xy\nset xlabel 'tau (s)'\nset ylabel 'ADEV (deg/s)'\nset key outside right\nset datafile missing 'null'\nset title 'Allan deviation of the residual (points) and of the model noise (lines)'\nplot ";
+    for (int c = 0; c < 6; ++c)
+      s += fmt::format("'{0}' u {1}:{2} w p t '{3}', '' u {1}:{4} w l dt 2 t '{3} model'{5}", (plot_dir / "adev.dat").string(), 1 + 3 * c,
+                       2 + 3 * c, channel_name(c), 3 + 3 * c, c < 5 ? ", " : "\n");
+    plots.push_back({"Allan deviation", gnuplot_png(plot_dir, "adev", s)});
+  }
+  // 4: regimes
+  {
+    std::ofstream d(plot_dir / "regimes.dat");
+    for (std::size_t i = 0; i < r.regimes.size(); ++i) {
+      d << '"' << r.regimes[i].group << ": " << r.regimes[i].name << '"';
+      for (int c = 0; c < 6; ++c) d << ' ' << num(r.regimes[i].rms_dps[c]);
+      d << '\n';
+    }
+    std::string s = "set style data histograms\nset style fill solid 0.8\nset xtics rotate by -30\nset ylabel 'rms (deg/s)'\nset key outside right\nset title 'residual rms by regime'\nplot ";
+    for (int c = 0; c < 6; ++c)
+      s += fmt::format("'{}' u {}:xtic(1) t '{}'{}", (plot_dir / "regimes.dat").string(), 2 + c, channel_name(c), c < 5 ? ", " : "\n");
+    plots.push_back({"Residual by regime", gnuplot_png(plot_dir, "regimes", s)});
+  }
+
+  std::ostringstream h;
+  h << "<!DOCTYPE html><html><head><meta charset='utf-8'><title>driftless compare</title><style>"
+       "body{font-family:sans-serif;max-width:1100px;margin:auto;padding:1em}table{border-collapse:collapse;margin:0.5em 0}"
+       "td,th{border:1px solid #bbb;padding:2px 6px;font-size:90%;text-align:right}th{background:#eee}"
+       "td.l{text-align:left}.v{font-size:120%;padding:0.5em;background:#f4f4d0}</style></head><body>\n";
+  h << "<h1>Model versus measurement</h1>\n<p>log: <code>" << esc_html(r.log_path) << "</code><br>model: <code>" << esc_html(r.model_source)
+    << "</code><br>" << r.samples << " samples, " << fmt::format("{:.1f}", r.duration_s) << " s at " << fmt::format("{:.3f}", r.sample_rate_hz)
+    << " Hz; " << r.samples_used << " used (platforms at rest)" << (r.resampled ? "; <b>resampled to the model's rate</b>" : "") << "</p>\n";
+  h << "<p class='v'><b>" << esc_html(r.verdict) << "</b>: " << esc_html(r.statement) << "</p>\n";
+  if (!r.notes.empty()) {
+    h << "<h3>Assumptions</h3><ul>";
+    for (const auto& n : r.notes) h << "<li>" << esc_html(n) << "</li>";
+    h << "</ul>\n";
+  }
+  if (x.after) {
+    h << "<h2>Before / after</h2><p>applied: " << esc_html(x.applied) << "<br>new model: <code>" << esc_html(x.after_model)
+      << "</code><br>after: <b>" << esc_html(x.after->verdict) << "</b>: " << esc_html(x.after->statement) << "</p>\n";
+    h << "<table><tr><th>channel</th><th>rms before (deg/s)</th><th>rms after</th><th>systematic before</th><th>systematic after</th><th>noise floor</th></tr>";
+    for (int c = 0; c < 6; ++c)
+      h << fmt::format("<tr><td class=l>{}</td><td>{:.5f}</td><td>{:.5f}</td><td>{:.5f}</td><td>{:.5f}</td><td>{:.5f}</td></tr>", channel_name(c),
+                       r.channels[c].rms_dps, x.after->channels[c].rms_dps, r.channels[c].systematic_rms_dps,
+                       x.after->channels[c].systematic_rms_dps, r.channels[c].noise_floor_dps);
+    h << "</table>\n<table><tr><th>regime</th><th>samples</th>";
+    for (int c = 0; c < 6; ++c) h << "<th>" << channel_name(c) << " before / after</th>";
+    h << "</tr>";
+    for (const auto& g : r.regimes) {
+      for (const auto& a : x.after->regimes) {
+        if (a.group != g.group || a.name != g.name) continue;
+        h << "<tr><td class=l>" << esc_html(g.group + ": " + g.name) << "</td><td>" << g.samples << "</td>";
+        for (int c = 0; c < 6; ++c) h << fmt::format("<td>{:.4f} / {:.4f}</td>", g.rms_dps[c], a.rms_dps[c]);
+        h << "</tr>";
+      }
+    }
+    h << "</table>\n";
+  }
+  h << "<h2>Ranking of candidate effects</h2><table><tr><th>#</th><th>effect</th><th>sensor</th><th>axis</th><th>evidence</th><th>explained</th><th>p</th><th>parameters</th></tr>";
+  for (std::size_t i = 0; i < r.ranking.size(); ++i) {
+    const auto& c = r.ranking[i];
+    std::string ps;
+    for (std::size_t k = 0; k < std::min<std::size_t>(c.params.size(), 9); ++k)
+      ps += fmt::format("{}{} = {:.4g} ± {:.2g} {}", k ? "<br>" : "", esc_html(c.params[k].name), c.params[k].value, c.params[k].sigma, esc_html(c.params[k].unit));
+    if (!c.testable) ps = esc_html(c.note);
+    h << fmt::format("<tr><td>{}</td><td class=l>{}</td><td>{}</td><td class=l>{}</td><td>{}</td><td>{:.1f} %</td><td>{:.2g}</td><td class=l>{}</td></tr>", i + 1,
+                     esc_html(c.effect), esc_html(c.sensor), esc_html(c.axis), c.testable ? fmt::format("{:.1f}", c.evidence) : "n/a",
+                     100.0 * c.explained_fraction, c.p_value, ps);
+  }
+  h << "</table>\n<h2>Residual per channel</h2><table><tr><th>channel</th><th>raw mean</th><th>raw rms</th><th>mean</th><th>rms</th><th>after best</th><th>noise floor</th><th>systematic</th><th>N fit (deg/s/&radic;Hz)</th><th>Ljung-Box p</th><th>turn-on bias</th></tr>";
+  const Candidate* best = r.ranking.empty() ? nullptr : &r.ranking.front();
+  for (int c = 0; c < 6; ++c) {
+    const auto& ch = r.channels[c];
+    h << fmt::format("<tr><td class=l>{}</td><td>{:.4f}</td><td>{:.4f}</td><td>{:.5f}</td><td>{:.5f}</td><td>{:.5f}</td><td>{:.5f}</td><td>{:.5f}</td><td>{:.5f}</td><td>{:.3g}</td><td>{:.4f}</td></tr>",
+                     channel_name(c), ch.raw_mean_dps, ch.raw_rms_dps, ch.mean_dps, ch.rms_dps, best ? best->rms_after_dps[c] : ch.rms_dps,
+                     ch.noise_floor_dps, ch.systematic_rms_dps, ch.white_fit_dps_rthz, ch.ljung_box_p, ch.turn_on_bias_dps);
+  }
+  h << "</table><p>All values in deg/s. \"mean/rms\": after the nuisance fit (turn-on bias, bias drift, the model's run-to-run effects).</p>\n";
+  h << "<h2>Worst windows</h2><table><tr><th>from (s)</th><th>to (s)</th><th>worst channel</th><th>rms / noise floor</th></tr>";
+  for (const auto& w : r.worst_windows)
+    h << fmt::format("<tr><td>{:.1f}</td><td>{:.1f}</td><td class=l>{}</td><td>{:.2f}</td></tr>", w.t0_s, w.t1_s, channel_name(w.worst_channel), w.worst_ratio);
+  h << "</table>\n<h2>By regime</h2><table><tr><th>regime</th><th>samples</th>";
+  for (int c = 0; c < 6; ++c) h << "<th>" << channel_name(c) << " rms</th>";
+  h << "</tr>";
+  for (const auto& g : r.regimes) {
+    h << "<tr><td class=l>" << esc_html(g.group + ": " + g.name) << "</td><td>" << g.samples << "</td>";
+    for (int c = 0; c < 6; ++c) h << fmt::format("<td>{:.5f}</td>", g.rms_dps[c]);
+    h << "</tr>";
+  }
+  h << "</table>\n";
+  if (!r.correlations.empty()) {
+    h << "<h2>Correlations of the residual with inputs</h2><table><tr><th>signal</th><th>channel</th><th>rho</th><th>z</th></tr>";
+    for (const auto& c : r.correlations)
+      h << fmt::format("<tr><td class=l>{}</td><td>{}</td><td>{:+.3f}</td><td>{:.1f}</td></tr>", esc_html(c.signal), channel_name(c.channel), c.rho, c.z);
+    h << "</table>\n";
+  }
+  h << "<h2>Plots</h2>\n";
+  for (const auto& [title, png] : plots) {
+    if (png.empty()) h << "<p>" << esc_html(title) << ": gnuplot not available, plot skipped (data in plots/)</p>\n";
+    else h << "<h3>" << esc_html(title) << "</h3><img alt='" << esc_html(title) << "' src='data:image/png;base64," << base64(png) << "'>\n";
+  }
+  h << "</body></html>\n";
+  std::ofstream f(dir / "report.html");
+  if (!f) throw std::runtime_error(fmt::format("cannot write {}", (dir / "report.html").string()));
+  f << h.str();
+}
+
+}  // namespace driftless::twin
