@@ -188,12 +188,9 @@ void parse_box(const Parser& P, const YAML::Node& n, BoxParams& b) {
 void parse_model(const Parser& P, const YAML::Node& n, ModelConfig& m) {
   P.check_keys(n, "model", {"box", "sensor1", "sensor2"});
   if (auto b = n["box"]) parse_box(P, b, m.box);
-  for (const char* s : {"sensor1", "sensor2"}) {
-    if (auto v = n[s]) {
-      if (!v.IsMap()) P.fail(v, std::string("model.") + s, "expected a mapping (preset, effects)");
-      (std::string(s) == "sensor1" ? m.sensor1 : m.sensor2) = YAML::Clone(v);
-    }
-  }
+  // the sensor blocks belong to the effect catalogue (docs/effects.md); it names file and line
+  if (auto v = n["sensor1"]) m.sensor1 = parse_sensor_params(v, m.sensor1, P.file());
+  if (auto v = n["sensor2"]) m.sensor2 = parse_sensor_params(v, m.sensor2, P.file());
 }
 
 void parse_motion(const Parser& P, const YAML::Node& n, MotionConfig& m) {
@@ -311,7 +308,16 @@ const char* readback_name(PlatformReadback r) {
   return r == PlatformReadback::encoder ? "encoder" : "end_stops";
 }
 
-void ModelConfig::validate() const { box.validate(); }
+void ModelConfig::validate() const {
+  box.validate();
+  for (const auto* sp : {&sensor1, &sensor2}) {
+    try {
+      sp->validate();
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(std::string(sp == &sensor1 ? "model.sensor1: " : "model.sensor2: ") + e.what());
+    }
+  }
+}
 
 void Scenario::validate() const {
   auto require = [](bool ok, const std::string& what) {
@@ -449,8 +455,10 @@ std::string emit_scenario(const Scenario& s) {
   emit_num(out, "damping_nms_per_rad", b.motor.damping_nms_per_rad);
   emit_num(out, "overtravel_deg", b.motor.overtravel_deg);
   out << YAML::EndMap << YAML::EndMap;
-  out << YAML::Key << "sensor1" << YAML::Value << s.model.sensor1;
-  out << YAML::Key << "sensor2" << YAML::Value << s.model.sensor2;
+  out << YAML::Key << "sensor1" << YAML::Value;
+  emit_sensor_params(out, s.model.sensor1);
+  out << YAML::Key << "sensor2" << YAML::Value;
+  emit_sensor_params(out, s.model.sensor2);
   out << YAML::EndMap;
 
   out << YAML::Key << "motion" << YAML::Value << YAML::BeginMap;

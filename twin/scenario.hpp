@@ -12,6 +12,7 @@
 
 #include "twin/flip_schedule.hpp"
 #include "twin/motion.hpp"
+#include "twin/sensor/sensor_model.hpp"
 #include "twin/world.hpp"
 
 namespace driftless::twin {
@@ -26,10 +27,8 @@ const char* readback_name(PlatformReadback r);
 /// The model config (`model:` block): the box and its two sensors.
 struct ModelConfig {
   BoxParams box;
-  // sensor blocks (`model.sensor1`, `model.sensor2`); schema owned by the sensor model
-  // (docs/effects.md). Until the sensor-effect catalogue is integrated they are kept as given.
-  YAML::Node sensor1 = YAML::Node(YAML::NodeType::Map);
-  YAML::Node sensor2 = YAML::Node(YAML::NodeType::Map);
+  SensorParams sensor1 = mpu6050_defaults();  // `model.sensor1`: effect catalogue, docs/effects.md
+  SensorParams sensor2 = mpu6050_defaults();  // `model.sensor2`
   void validate() const;
 };
 

@@ -12,6 +12,8 @@ namespace {
 // to far below the 1e-9 rad/s truth tolerance)
 constexpr double kFreezeRateRadps = 1e-11;
 constexpr double kFreezeAccelRadps2 = 1e-8;
+// platforms settle on their stops for this long before t = 0, s
+constexpr double kWarmupS = 1.0;
 
 std::string vec_text(const Eigen::Vector3d& v) { return fmt::format("{} {} {}", v.x(), v.y(), v.z()); }
 
@@ -31,6 +33,9 @@ Simulator::Simulator(const Scenario& scenario, SimOptions options)
       earth_enu_radps_(earth_rate_enu_radps(scenario.latitude_deg)),
       steps_per_sample_(scenario.steps_per_sample()),
       total_(scenario.total_samples()) {
+  // each sensor draws its run-to-run values and noise from its own stream of the seed
+  sensors_.emplace_back(scenario.model.sensor1, scenario.sample_rate_hz, derive_seed(scenario.seed, 1001));
+  sensors_.emplace_back(scenario.model.sensor2, scenario.sample_rate_hz, derive_seed(scenario.seed, 1002));
   // initial state: box at its t = 0 pose, both platforms at rest on their + positions
   const MotionState m0 = motion_->at(0.0);
   world_.set_base(m0.p_enu_m, m0.q_enu_from_body, m0.v_enu_mps, m0.w_body_radps);
@@ -39,13 +44,26 @@ Simulator::Simulator(const Scenario& scenario, SimOptions options)
     world_.set_motor_reference(i, flips_.reference_rad(i));
   }
   world_.pose_carrier(motion_->carrier(), m0.p_enu_m, m0.q_enu_from_body);
-  mj_forward(world_.model(), world_.data());
+  // settle the platforms on their stops before t = 0 (the box held still at its t = 0 pose), so
+  // the run starts at rest rather than with the stops' initial transient
+  mjModel* m = world_.model();
+  mjData* d = world_.data();
+  const long warmup_steps = std::lround(kWarmupS / scenario.physics_dt_s);
+  for (long n = 0; n < warmup_steps; ++n) {
+    world_.set_base(m0.p_enu_m, m0.q_enu_from_body, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
+    mj_step1(m, d);
+    world_.drive_base(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
+    mj_step2(m, d);
+  }
+  d->time = 0.0;
+  world_.set_base(m0.p_enu_m, m0.q_enu_from_body, m0.v_enu_mps, m0.w_body_radps);
+  mj_forward(m, d);
 }
 
 Simulator::~Simulator() = default;
 
 std::uint32_t Simulator::fields() {
-  return kFieldAccel | kFieldRefQ | kFieldRefP | kFieldTrueBias | kFieldTrueRate | kFieldTruePlat;
+  return kFieldAccel | kFieldTemp | kFieldRefQ | kFieldRefP | kFieldTrueBias | kFieldTrueRate | kFieldTruePlat;
 }
 
 log::Metadata Simulator::metadata() const {
@@ -64,7 +82,8 @@ log::Metadata Simulator::metadata() const {
   m.set("flip_angle_deg", fmt::format("{}", scenario_.flip_schedule.flip_angle_deg));
   m.set("standstill_s", fmt::format("{}", scenario_.flip_schedule.standstill_s));
   m.set("end_stop_deg", fmt::format("{}", scenario_.model.box.end_stop_deg));
-  m.set("sensor_model", "ideal (sensor-effect catalogue not yet integrated)");
+  m.set("sensor1_preset", scenario_.model.sensor1.preset);
+  m.set("sensor2_preset", scenario_.model.sensor2.preset);
   return m;
 }
 
@@ -143,13 +162,23 @@ void Simulator::capture_truth() {
 void Simulator::fill_sample(Sample& out) {
   out = Sample{};
   out.t_s = truth_.t_s;
-  // sensor model: ideal until the sensor-effect catalogue (twin/sensor/) is integrated
-  out.gyro1_dps = truth_.w_sensor_radps[0] * kDegPerRad;
-  out.gyro2_dps = truth_.w_sensor_radps[1] * kDegPerRad;
-  out.accel1_mps2 = truth_.f_sensor_mps2[0];
-  out.accel2_mps2 = truth_.f_sensor_mps2[1];
-  out.true_bias1_dps.setZero();
-  out.true_bias2_dps.setZero();
+  // the sensor-effect catalogue turns the truth into readings (docs/effects.md)
+  SensorReading r[2];
+  for (int i = 0; i < 2; ++i) {
+    SensorTruth st;
+    st.t_s = truth_.t_s;
+    st.w_radps = truth_.w_sensor_radps[i];
+    st.f_mps2 = truth_.f_sensor_mps2[i];
+    r[i] = sensors_[static_cast<std::size_t>(i)].step(st);
+  }
+  out.gyro1_dps = r[0].gyro_radps * kDegPerRad;
+  out.gyro2_dps = r[1].gyro_radps * kDegPerRad;
+  out.accel1_mps2 = r[0].accel_mps2;
+  out.accel2_mps2 = r[1].accel_mps2;
+  out.temp1_c = r[0].temp_c;
+  out.temp2_c = r[1].temp_c;
+  out.true_bias1_dps = r[0].bias_radps * kDegPerRad;
+  out.true_bias2_dps = r[1].bias_radps * kDegPerRad;
   out.true_rate_body_dps = truth_.w_body_radps * kDegPerRad;
   out.true_plat1_deg = truth_.plat_rad[0] * kDegPerRad;
   out.true_plat2_deg = truth_.plat_rad[1] * kDegPerRad;

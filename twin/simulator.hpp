@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -16,6 +17,7 @@
 #include "twin/flip_schedule.hpp"
 #include "twin/motion.hpp"
 #include "twin/scenario.hpp"
+#include "twin/sensor/sensor_model.hpp"
 #include "twin/world.hpp"
 
 namespace driftless::twin {
@@ -52,6 +54,8 @@ class Simulator {
   bool next(Sample& out);
   /// Truth of the last sample (rad/s, m/s^2).
   const SampleTruth& truth() const { return truth_; }
+  /// Sensor model i (1 or 2): its parameters and this run's drawn instance.
+  const SensorModel& sensor(int i) const { return sensors_[i - 1]; }
 
   const Scenario& scenario() const { return scenario_; }
   const Motion& motion() const { return *motion_; }
@@ -80,6 +84,7 @@ class Simulator {
   World world_;
   std::unique_ptr<Motion> motion_;
   FlipController flips_;
+  std::vector<SensorModel> sensors_;  // sensor 1, sensor 2
   Eigen::Vector3d earth_enu_radps_;
   long steps_per_sample_;
   std::uint64_t total_;

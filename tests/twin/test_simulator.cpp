@@ -167,3 +167,30 @@ TEST_F(SimulatorTest, PoseFromSampleSetsBoxAndPlatforms) {
 
 }  // namespace
 }  // namespace driftless::twin
+
+namespace driftless::twin {
+namespace {
+
+// GIVEN sensor 1 with only a known constant bias and sensor 2 ideal, WHEN simulated, THEN the
+// log's gyro columns are truth + bias and true_bias carries exactly that bias
+TEST_F(SimulatorTest, GyroColumnsAreTheSensorModelAppliedToTheTruth) {
+  Scenario sc = short_static(6);
+  sc.model.sensor1 = ideal_sensor();
+  set_effect_enabled(sc.model.sensor1, "constant_bias", true);
+  sc.model.sensor1.constant_bias.value_dps = Eigen::Vector3d(1.0, -2.0, 3.0);
+  sc.model.sensor1.constant_bias.sigma_dps = Eigen::Vector3d::Zero();
+  sc.model.sensor2 = ideal_sensor();
+  Simulator sim(sc);
+  Sample s;
+  while (sim.next(s)) {
+    const Eigen::Vector3d w1 = sim.truth().w_sensor_radps[0] * kDegPerRad;
+    const Eigen::Vector3d w2 = sim.truth().w_sensor_radps[1] * kDegPerRad;
+    ASSERT_LT((s.true_bias1_dps - Eigen::Vector3d(1, -2, 3)).norm(), 1e-12);
+    ASSERT_LT((s.gyro1_dps - s.true_bias1_dps - w1).norm(), 1e-9) << "t = " << s.t_s;
+    ASSERT_LT((s.gyro2_dps - w2).norm(), 1e-12);
+    ASSERT_LT(s.true_bias2_dps.norm(), 1e-15);
+  }
+}
+
+}  // namespace
+}  // namespace driftless::twin
