@@ -9,6 +9,7 @@
 
 #include "cli/command.hpp"
 #include "renders/render_job.hpp"
+#include "renders/twin_source.hpp"
 
 namespace driftless::cli {
 namespace {
@@ -23,6 +24,7 @@ struct RenderArgs {
   std::string preset = "ultrafast";
   int crf = 23;
   bool no_overlay = false;
+  bool no_estimate = false;
 };
 
 using ModelPtr = std::unique_ptr<mjModel, decltype(&mj_deleteModel)>;
@@ -48,25 +50,37 @@ int run_render(const RenderArgs& a) {
   p.encoder.crf = a.crf;
   p.out = a.out;
   p.overlay = !a.no_overlay;
+  p.run_estimator = !a.no_estimate;
   p.validate();
 
+  // the source: a simulation as it runs, or a log replayed in the twin's model (or an MJCF)
+  std::unique_ptr<render::FrameSource> source;
+  std::unique_ptr<render::WorldPoser> poser;
+  ModelPtr mjcf(nullptr, &mj_deleteModel);
   if (!a.scenario.empty()) {
-    throw std::invalid_argument("--scenario needs the twin simulation, which this build lacks");
+    source = std::make_unique<render::ScenarioFrameSource>(twin::load_scenario(a.scenario));
+  } else {
+    const bool is_xml = a.model.size() > 4 && a.model.substr(a.model.size() - 4) == ".xml";
+    if (is_xml) {
+      mjcf = load_mjcf(a.model);
+      poser = std::make_unique<render::BoxPoser>(mjcf.get());
+    } else {
+      // the twin's box with the log's hinge axes, or the model config's box (--model .yaml)
+      log::LogReader head(a.log);
+      twin::ModelConfig cfg;
+      cfg.box.hinge1_axis = head.metadata().hinge1_axis().normalized();
+      cfg.box.hinge2_axis = head.metadata().hinge2_axis().normalized();
+      if (!a.model.empty()) cfg = twin::load_model_config(a.model, cfg);
+      poser = std::make_unique<render::TwinPoser>(cfg.box,
+                                                  render::carrier_from_metadata(head.metadata()));
+    }
+    source = std::make_unique<render::LogFrameSource>(a.log, *poser);
   }
-  if (a.model.empty()) {
-    throw std::invalid_argument("--log needs --model FILE.xml (an MJCF model of the box)");
-  }
-  auto model = load_mjcf(a.model);
-  auto poser = std::make_shared<render::BoxPoser>(model.get());
-  render::LogFrameSource source(a.log, model.get(),
-                                [poser](const Sample& s, render::WorldPose& w) {
-                                  poser->pose(s, w);
-                                });
 
   Progress bar("render");
-  const double end = std::isnan(a.to) ? source.info().end_s : a.to;
+  const double end = std::isnan(a.to) ? source->info().end_s : a.to;
   const double begin = std::isnan(a.from) ? 0.0 : a.from;
-  const auto stats = render::render_video(source, p, [&](double t, std::uint64_t frames) {
+  const auto stats = render::render_video(*source, p, [&](double t, std::uint64_t frames) {
     if (std::isfinite(end) && end > begin) {
       bar.update(std::clamp((t - begin) / (end - begin), 0.0, 1.0),
                  fmt::format("{} frames, t = {:.1f} s", frames, t));
@@ -102,15 +116,18 @@ const bool registered = register_command(60, [](CLI::App& app) {
       "(docs/render.md)");
   auto a = std::make_shared<RenderArgs>();
   auto* scen = cmd->add_option("--scenario", a->scenario,
-                               "Scenario YAML to simulate and render (models/scenarios/*.yaml)")
-                   ->check(CLI::ExistingFile);
+                               "Scenario YAML to simulate and render (models/scenarios/*.yaml) "
+                               "or a built-in scenario name (static, pan_tilt, vehicle, ...)");
   auto* log = cmd->add_option("--log", a->log,
                               "Measurement log to replay (docs/log-format.md): base from "
                               "ref_q/ref_p, platforms from plat1_deg/plat2_deg")
                   ->check(CLI::ExistingFile);
   scen->excludes(log);
   log->excludes(scen);
-  cmd->add_option("--model", a->model, "Model for --log: an MJCF file (.xml)")
+  cmd->add_option("--model", a->model,
+                  "Model for --log: a model config YAML (its box block; default: the shipped box "
+                  "with the log's hinge axes) or an MJCF file (.xml) with a 'box' body and "
+                  "'hinge1'/'hinge2' joints")
       ->check(CLI::ExistingFile)
       ->needs(log);
   cmd->add_option("--out", a->out, "Output video file (.mp4)")->required();
@@ -137,6 +154,9 @@ const bool registered = register_command(60, [](CLI::App& app) {
   cmd->add_option("--crf", a->crf, "x264 quality, 0 (lossless) .. 51 (worst)")
       ->capture_default_str();
   cmd->add_flag("--no-overlay", a->no_overlay, "Draw the scene only (no text, no chart)");
+  cmd->add_flag("--no-estimate", a->no_estimate,
+                "Chart the residual of eq. (2) instead of running the DriftLess filter for the "
+                "bias chart and the attitude error");
   return [a, cmd] {
     if (a->scenario.empty() && a->log.empty()) {
       throw std::invalid_argument("give --scenario FILE or --log FILE (see driftless render --help)");

@@ -2,26 +2,13 @@
 
 #include <cmath>
 #include <stdexcept>
+#include <vector>
 
 #include <fmt/core.h>
 
 namespace driftless::render {
 
-void WorldPose::capture(const mjModel* m, const mjData* d) {
-  qpos.assign(d->qpos, d->qpos + m->nq);
-  mocap_pos.assign(d->mocap_pos, d->mocap_pos + 3 * m->nmocap);
-  mocap_quat.assign(d->mocap_quat, d->mocap_quat + 4 * m->nmocap);
-}
-
-void WorldPose::apply(const mjModel* m, mjData* d) const {
-  if (qpos.size() == static_cast<std::size_t>(m->nq)) {
-    std::copy(qpos.begin(), qpos.end(), d->qpos);
-  }
-  if (mocap_pos.size() == static_cast<std::size_t>(3 * m->nmocap)) {
-    std::copy(mocap_pos.begin(), mocap_pos.end(), d->mocap_pos);
-    std::copy(mocap_quat.begin(), mocap_quat.end(), d->mocap_quat);
-  }
-  // only what drawing needs: body/geom/site frames, subtree centres (tracking cameras), cameras
+void kinematics_for_drawing(const mjModel* m, mjData* d) {
   mj_kinematics(m, d);
   mj_comPos(m, d);
   mj_camlight(m, d);
@@ -29,7 +16,8 @@ void WorldPose::apply(const mjModel* m, mjData* d) const {
 
 BoxPoser::BoxPoser(const mjModel* m, const std::string& base_body, const std::string& plat1_joint,
                    const std::string& plat2_joint)
-    : m_(m) {
+    : m_(m), d_(nullptr, &mj_deleteData) {
+  if (m == nullptr) throw std::invalid_argument("BoxPoser needs a model");
   const int body = mj_name2id(m, mjOBJ_BODY, base_body.c_str());
   if (body < 0) {
     throw std::invalid_argument(
@@ -53,26 +41,13 @@ BoxPoser::BoxPoser(const mjModel* m, const std::string& base_body, const std::st
     }
     plat_adr_[i] = m->jnt_qposadr[j];
   }
+  d_.reset(mj_makeData(m));
+  kinematics_for_drawing(m, d_.get());
 }
 
-void BoxPoser::pose(const Sample& s, WorldPose& out) const {
+void BoxPoser::pose(const Sample& s) {
   const mjModel* m = m_;
-  if (out.qpos.size() != static_cast<std::size_t>(m->nq)) {
-    out.qpos.assign(m->qpos0, m->qpos0 + m->nq);
-    out.mocap_pos.clear();
-    for (int b = 0; b < m->nbody; ++b) {
-      if (m->body_mocapid[b] < 0) continue;
-      out.mocap_pos.resize(3 * m->nmocap);
-      out.mocap_quat.resize(4 * m->nmocap);
-    }
-    for (int b = 0; b < m->nbody; ++b) {
-      const int id = m->body_mocapid[b];
-      if (id < 0) continue;
-      std::copy(m->body_pos + 3 * b, m->body_pos + 3 * b + 3, out.mocap_pos.begin() + 3 * id);
-      std::copy(m->body_quat + 4 * b, m->body_quat + 4 * b + 4, out.mocap_quat.begin() + 4 * id);
-    }
-  }
-  mjtNum* q = out.qpos.data();
+  mjtNum* q = d_->qpos;
   const bool has_p = s.ref_p_enu_m.allFinite();
   Eigen::Vector4d qwxyz = s.ref_q_wxyz;
   const bool has_q = qwxyz.allFinite() && qwxyz.norm() > 0.5;
@@ -95,10 +70,12 @@ void BoxPoser::pose(const Sample& s, WorldPose& out) const {
   if (ball_adr_ >= 0 && has_q) {
     for (int k = 0; k < 4; ++k) q[ball_adr_ + k] = qwxyz[k];
   }
-  const double plat_deg[2] = {s.plat1_deg, s.plat2_deg};
+  const double plat_deg[2] = {std::isfinite(s.true_plat1_deg) ? s.true_plat1_deg : s.plat1_deg,
+                              std::isfinite(s.true_plat2_deg) ? s.true_plat2_deg : s.plat2_deg};
   for (int i = 0; i < 2; ++i) {
     if (std::isfinite(plat_deg[i])) q[plat_adr_[i]] = plat_deg[i] * kRadPerDeg;
   }
+  kinematics_for_drawing(m, d_.get());
 }
 
 }  // namespace driftless::render

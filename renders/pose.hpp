@@ -1,10 +1,9 @@
-// The world's pose for one frame (joint positions and mocap carriers), and posing the model's
-// box from a logged Sample (ref_p, ref_q, plat*_deg) for replays of logs without a simulator.
+// Posing the world for a frame: a WorldPoser owns the model's mjData and places the box, its
+// platforms and its carrier from a Sample (ref_p, ref_q, platform angles).
 #pragma once
 
-#include <functional>
+#include <memory>
 #include <string>
-#include <vector>
 
 #include <mujoco/mujoco.h>
 
@@ -12,39 +11,42 @@
 
 namespace driftless::render {
 
-/// Everything a frame needs to place bodies: mjData's qpos, mocap_pos and mocap_quat.
-struct WorldPose {
-  std::vector<mjtNum> qpos, mocap_pos, mocap_quat;
-
-  /// Copies the pose out of `d`.
-  void capture(const mjModel* m, const mjData* d);
-  /// Writes the pose into `d` and computes positions for drawing (kinematics, com, cameras).
-  void apply(const mjModel* m, mjData* d) const;
+/// Places the world from a sample and computes what drawing needs (body, site, camera frames).
+class WorldPoser {
+ public:
+  virtual ~WorldPoser() = default;
+  virtual const mjModel* model() const = 0;
+  virtual mjData* data() = 0;
+  /// Poses the world for `s` (angles in deg as logged; NaN parts keep their previous pose).
+  virtual void pose(const Sample& s) = 0;
 };
-
-/// Poses the world from a Sample; implementations know the model's joints and carriers.
-using PoseFn = std::function<void(const Sample& s, WorldPose& out)>;
 
 /// Poses a model whose base body carries either a free joint or slide joints plus a ball joint
 /// (ENU position ref_p, attitude ref_q = q_enu_from_body) and whose platforms turn on hinge
-/// joints (plat1_deg, plat2_deg). Other joints and mocap bodies keep the model's reference pose.
-class BoxPoser {
+/// joints (true_plat*_deg if present, else plat*_deg). Other joints and mocap bodies keep the
+/// model's reference pose. Works with any such MJCF (tests, user models).
+class BoxPoser final : public WorldPoser {
  public:
-  /// base_body: the box body ("box"); plat joints: the hinges ("hinge1", "hinge2"). Throws
-  /// std::invalid_argument naming what is missing.
-  explicit BoxPoser(const mjModel* m, const std::string& base_body = "box",
+  /// base_body: the box body; plat joints: the hinges. Throws std::invalid_argument naming what
+  /// is missing. `model` must outlive the poser.
+  explicit BoxPoser(const mjModel* model, const std::string& base_body = "box",
                     const std::string& plat1_joint = "hinge1",
                     const std::string& plat2_joint = "hinge2");
-  /// Fills `out` for sample `s`; NaN parts (no ref_p, no ref_q, a moving platform) keep the
-  /// reference pose or, for a platform, its last angle.
-  void pose(const Sample& s, WorldPose& out) const;
+  const mjModel* model() const override { return m_; }
+  mjData* data() override { return d_.get(); }
+  void pose(const Sample& s) override;
 
  private:
   const mjModel* m_;
-  int free_adr_ = -1;                 // qpos address of the base's free joint
+  std::unique_ptr<mjData, decltype(&mj_deleteData)> d_;
+  int free_adr_ = -1;                        // qpos address of the base's free joint
   std::vector<std::pair<int, int>> slides_;  // (qpos address, joint id) of base slides
   int ball_adr_ = -1;
   int plat_adr_[2] = {-1, -1};
 };
+
+/// Computes positions for drawing from qpos/mocap: kinematics, subtree centres (tracking
+/// cameras) and cameras/lights; cheaper than mj_forward.
+void kinematics_for_drawing(const mjModel* m, mjData* d);
 
 }  // namespace driftless::render

@@ -16,12 +16,12 @@ namespace driftless::render {
 
 // ---- log replay ----
 
-LogFrameSource::LogFrameSource(const std::filesystem::path& log, const mjModel* model,
-                               PoseFn pose, double max_gap_s)
-    : reader_(log), model_(model), pose_(std::move(pose)), max_gap_s_(max_gap_s) {
-  if (model_ == nullptr || !pose_) throw std::invalid_argument("LogFrameSource needs a model");
+LogFrameSource::LogFrameSource(const std::filesystem::path& log, WorldPoser& poser,
+                               double max_gap_s)
+    : reader_(log), poser_(poser), max_gap_s_(max_gap_s) {
   const auto& meta = reader_.metadata();
-  info_.title = log.filename().string();
+  // a simulated log names its scenario: the replay then looks exactly like the simulation
+  info_.title = meta.get("scenario").value_or(log.filename().string());
   info_.metadata = meta;
   info_.end_s = meta.get_number("duration_s", kNaN);
 }
@@ -37,11 +37,11 @@ bool LogFrameSource::fill_ahead() {
   return true;
 }
 
-bool LogFrameSource::next(Sample& sample, WorldPose& pose) {
+bool LogFrameSource::next(Sample& sample, Sample& posed) {
   if (ahead_.empty() && !fill_ahead()) return false;
   sample = ahead_.front();
   ahead_.pop_front();
-  Sample posed = sample;
+  posed = sample;
   double* deg[2] = {&posed.plat1_deg, &posed.plat2_deg};
   for (int i = 0; i < 2; ++i) {
     if (std::isfinite(*deg[i])) {
@@ -71,7 +71,6 @@ bool LogFrameSource::next(Sample& sample, WorldPose& pose) {
       *deg[i] = next_deg;  // NaN too: the poser keeps the model's reference angle
     }
   }
-  pose_(posed, pose);
   return true;
 }
 
@@ -191,8 +190,7 @@ constexpr double kSettleS = 0.3;
 
 // what a frame needs of a sample
 struct Held {
-  Sample sample;
-  WorldPose pose;
+  Sample posed;
   OverlayState overlay;
 };
 
@@ -206,9 +204,8 @@ RenderStats render_video(FrameSource& source, const RenderParams& params,
   // the GL context comes first: without it there is nothing to encode
   GlContext gl;
   stats.gl_renderer = gl.renderer();
-  SceneRenderer scene(source.model(), params.scene);
-  const mjModel* m = source.model();
-  std::unique_ptr<mjData, decltype(&mj_deleteData)> data(mj_makeData(m), &mj_deleteData);
+  WorldPoser& poser = source.poser();
+  SceneRenderer scene(poser.model(), params.scene);
 
   const int w = params.scene.width_px, h = params.scene.height_px;
   std::unique_ptr<VideoSink> sink;
@@ -241,15 +238,16 @@ RenderStats render_video(FrameSource& source, const RenderParams& params,
   auto emit = [&](const FrameInfo& f, const Held& held) {
     if (!keep_going) return;
     const double t0 = now_s();
-    held.pose.apply(m, data.get());
+    poser.pose(held.posed);
+    mjData* data = poser.data();
     data->time = f.t_s;
     auto buf = out.take_buffer();
     const double t1 = now_s();
     if (params.overlay) {
       const auto text = overlay_text(info.title, f.t_s, speed, f.realtime_flip, held.overlay);
-      scene.render(data.get(), text, charts, held.sample.t_s, buf);
+      scene.render(data, text, charts, held.posed.t_s, buf);
     } else {
-      scene.render(data.get(), OverlayText{}, {}, f.t_s, buf);
+      scene.render(data, OverlayText{}, {}, f.t_s, buf);
     }
     const double t2 = now_s();
     out.submit(std::move(buf));
@@ -262,17 +260,14 @@ RenderStats render_video(FrameSource& source, const RenderParams& params,
     if (progress && !progress(f.t_s, stats.frames)) keep_going = false;
   };
 
+  Sample sample;
   Held cur;
-  while (keep_going && source.next(cur.sample, cur.pose)) {
+  while (keep_going && source.next(sample, cur.posed)) {
     ++stats.samples;
-    const bool flip_starts =
-        tracker.update(cur.sample.t_s, cur.sample.plat1_deg, cur.sample.plat2_deg);
+    const bool flip_starts = tracker.update(sample.t_s, sample.plat1_deg, sample.plat2_deg);
     cur.overlay = overlay_state(tracker);
-    if (params.overlay) {
-      telemetry.push(cur.sample, tracker.rest_duration_s(cur.sample.t_s), cur.overlay);
-    }
-    if (!planner.push(cur.sample.t_s, flip_starts, tracker.rest_duration_s(cur.sample.t_s), cur,
-                      emit)) {
+    if (params.overlay) telemetry.push(sample, tracker.rest_duration_s(sample.t_s), cur.overlay);
+    if (!planner.push(sample.t_s, flip_starts, tracker.rest_duration_s(sample.t_s), cur, emit)) {
       break;
     }
   }

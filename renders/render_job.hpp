@@ -26,14 +26,16 @@ struct StreamInfo {
   double end_s = kNaN;     // last data time if known (progress), s
 };
 
-/// A time-ordered stream of samples, each with the world posed for it.
+/// A time-ordered stream of samples and the world they are drawn in.
 class FrameSource {
  public:
   virtual ~FrameSource() = default;
-  virtual const mjModel* model() const = 0;
+  /// The world a frame is drawn in, posed from a sample at frame time.
+  virtual WorldPoser& poser() = 0;
   virtual const StreamInfo& info() const = 0;
-  /// The next sample as logged (NaN kept) and the world's pose for it; false at the end.
-  virtual bool next(Sample& sample, WorldPose& pose) = 0;
+  /// The next sample as read (NaN kept: the overlay sees what the log says) and the sample to
+  /// pose the world from (gaps in platform angles filled); false at the end.
+  virtual bool next(Sample& sample, Sample& posed) = 0;
 };
 
 /// Replays a log: base from ref_q/ref_p, platforms from plat*_deg. A platform angle missing
@@ -41,17 +43,16 @@ class FrameSource {
 /// is read ahead, up to max_gap_s; longer gaps hold the last angle).
 class LogFrameSource final : public FrameSource {
  public:
-  LogFrameSource(const std::filesystem::path& log, const mjModel* model, PoseFn pose,
-                 double max_gap_s = 30.0);
-  const mjModel* model() const override { return model_; }
+  /// `poser` must outlive the source.
+  LogFrameSource(const std::filesystem::path& log, WorldPoser& poser, double max_gap_s = 30.0);
+  WorldPoser& poser() override { return poser_; }
   const StreamInfo& info() const override { return info_; }
-  bool next(Sample& sample, WorldPose& pose) override;
+  bool next(Sample& sample, Sample& posed) override;
 
  private:
   bool fill_ahead();
   log::LogReader reader_;
-  const mjModel* model_;
-  PoseFn pose_;
+  WorldPoser& poser_;
   double max_gap_s_;
   StreamInfo info_;
   std::deque<Sample> ahead_;  // raw samples read but not yet returned

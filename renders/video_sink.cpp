@@ -118,7 +118,14 @@ class FfmpegSink final : public VideoSink {
     std::vector<char*> argv;
     for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
     argv.push_back(nullptr);
-    const int rc = ::posix_spawn(&pid_, ffmpeg.c_str(), &fa, nullptr, argv.data(), environ);
+    // its own process group: Ctrl-C reaches only us, and we close the pipe so ffmpeg finishes
+    // the file properly
+    posix_spawnattr_t attr;
+    posix_spawnattr_init(&attr);
+    posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETPGROUP);
+    posix_spawnattr_setpgroup(&attr, 0);
+    const int rc = ::posix_spawn(&pid_, ffmpeg.c_str(), &fa, &attr, argv.data(), environ);
+    posix_spawnattr_destroy(&attr);
     posix_spawn_file_actions_destroy(&fa);
     ::close(in_pipe[0]);
     ::close(err_pipe[1]);

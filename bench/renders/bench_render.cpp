@@ -41,8 +41,7 @@ void run(benchmark::State& state, int w, int h, const char* preset, bool overlay
   std::uint64_t frames = 0;
   double wall = 0, draw = 0;
   for (auto _ : state) {
-    LogFrameSource src(bench_log(), model.get(),
-                       [&](const Sample& s, WorldPose& pose) { poser.pose(s, pose); });
+    LogFrameSource src(bench_log(), poser);
     const auto stats = render_video(src, p);
     frames += stats.frames;
     wall += stats.wall_s;

@@ -46,9 +46,6 @@ class RenderVideoTest : public ::testing::Test {
   }
   ModelPtr model_ = load_model();
   BoxPoser poser_{model_.get()};
-  PoseFn pose_fn() {
-    return [this](const Sample& s, WorldPose& w) { poser_.pose(s, w); };
-  }
 };
 
 TEST_F(RenderVideoTest, FramesSizeRateAndContentAreRight) {
@@ -56,7 +53,7 @@ TEST_F(RenderVideoTest, FramesSizeRateAndContentAreRight) {
   const auto dir = scratch_dir("frames");
   FlipSchedule sched;
   write_flip_log(dir / "run.csv", 4.0, 100.0, sched);
-  LogFrameSource src(dir / "run.csv", model_.get(), pose_fn());
+  LogFrameSource src(dir / "run.csv", poser_);
   // WHEN rendered at 20 frames/s in real time (scene only: the overlay text changes every frame)
   auto params = small_params(dir / "run.mp4");
   params.overlay = false;
@@ -78,18 +75,16 @@ TEST_F(RenderVideoTest, FramesSizeRateAndContentAreRight) {
 
   // around platform 2 (it flips during 1..2 s): still during the standstill 0..1 s, changed
   // across the flip, still again during 2.2..3.9 s
-  std::unique_ptr<mjData, decltype(&mj_deleteData)> d(mj_makeData(model_.get()), &mj_deleteData);
-  WorldPose pose;
   Sample s;
   s.plat1_deg = s.plat2_deg = 90.0;
   s.set_q_enu_from_body(Eigen::Quaterniond(
       Eigen::AngleAxisd(30.0 * kRadPerDeg, Eigen::Vector3d::UnitZ())));
   s.ref_p_enu_m.setZero();
-  poser_.pose(s, pose);
-  pose.apply(model_.get(), d.get());
+  poser_.pose(s);
+  const mjData* d = poser_.data();
   const int cam = mj_name2id(model_.get(), mjOBJ_CAMERA, "cam_fixed");
   const int body = mj_name2id(model_.get(), mjOBJ_BODY, "platform2");
-  const auto [u, v] = project(model_.get(), d.get(), cam, d->xpos + 3 * body, kW, kH);
+  const auto [u, v] = project(model_.get(), d, cam, d->xpos + 3 * body, kW, kH);
   const int half = 20;
   ASSERT_GT(u - half, 0);
   ASSERT_LT(u + half, kW);
@@ -109,7 +104,7 @@ TEST_F(RenderVideoTest, WithoutGlTheErrorIsClear) {
   setenv(kNoGlEnv, "1", 1);
   const auto dir = scratch_dir("nogl");
   write_flip_log(dir / "run.csv", 0.5, 100.0, FlipSchedule{});
-  LogFrameSource src(dir / "run.csv", model_.get(), pose_fn());
+  LogFrameSource src(dir / "run.csv", poser_);
   // WHEN rendering THEN a GlUnavailable error says why, and no output appears
   try {
     render_video(src, small_params(dir / "run.mp4"));
@@ -126,7 +121,7 @@ TEST_F(RenderVideoTest, WithoutFfmpegFramesBecomePngFiles) {
   setenv(kFfmpegEnv, "/nonexistent/ffmpeg", 1);
   const auto dir = scratch_dir("png");
   write_flip_log(dir / "run.csv", 0.5, 100.0, FlipSchedule{});
-  LogFrameSource src(dir / "run.csv", model_.get(), pose_fn());
+  LogFrameSource src(dir / "run.csv", poser_);
   // WHEN rendering 0.5 s at 20 frames/s
   const auto stats = render_video(src, small_params(dir / "run.mp4"));
   unsetenv(kFfmpegEnv);
