@@ -1,6 +1,8 @@
 // driftless calibrate: the pan/tilt calibration of paper section 4, on a recorded log + rig plan
 // or on the twin's simulated rig; writes calib.yaml (docs/calibration.md).
+#include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <memory>
 #include <string>
 
@@ -10,13 +12,15 @@
 #include "estimator/calibration.hpp"
 #include "estimator/log.hpp"
 #include "twin/calib/calib_file.hpp"
+#include "twin/calib/prior.hpp"
+#include "twin/calib/rig_sim.hpp"
 #include "twin/calib/rig_plan.hpp"
 
 namespace driftless::cli {
 namespace {
 
 struct Options {
-  std::string scenario, log, plan, out, method = "least_squares", save_log, save_plan;
+  std::string scenario, log, plan, out, method, save_log, save_plan, prior_out;
 };
 
 est::CalibMethod parse_method(const std::string& m) {
@@ -48,6 +52,16 @@ void print_summary(const est::CalibFit& fit, const twin::calib::RigConditions& r
   }
 }
 
+// --prior-out: the calibrated errors as a twin model-config file
+void write_prior(const Options& o) {
+  if (o.prior_out.empty()) return;
+  const twin::calib::CalibFile c = twin::calib::load_calib(o.out);
+  std::ofstream f(o.prior_out);
+  f << twin::calib::model_prior_yaml(c);
+  if (!f) throw std::runtime_error("cannot write --prior-out " + o.prior_out);
+  fmt::print("wrote {} (model prior)\n", o.prior_out);
+}
+
 int run_from_log(const Options& o) {
   log::Metadata meta;
   const std::vector<Sample> samples = log::read_all(o.log, &meta);
@@ -55,7 +69,7 @@ int run_from_log(const Options& o) {
   twin::calib::ExtractReport rep;
   const auto segs = twin::calib::extract_segments(samples, meta, plan, o.log, &rep);
   est::CalibFitOptions fo;
-  fo.method = parse_method(o.method);
+  fo.method = parse_method(o.method.empty() ? "least_squares" : o.method);
   const est::CalibFit fit = est::fit_calibration(segs, fo);
   twin::calib::RigConditions rig;
   rig.source = "log " + o.log + ", plan " + o.plan;
@@ -70,6 +84,57 @@ int run_from_log(const Options& o) {
   twin::calib::save_calib(o.out, fit, rig);
   print_summary(fit, rig, rep);
   fmt::print("wrote {}\n", o.out);
+  write_prior(o);
+  return 0;
+}
+
+int run_from_scenario(const Options& o) {
+  const twin::calib::CalibScenario cs = twin::calib::load_calib_scenario(o.scenario);
+  twin::calib::RigRun run;
+  {
+    Progress progress("calibration rig");
+    run = twin::calib::run_rig(cs, [&](double f) {
+      progress.update(f);
+      return !stop_requested().load();
+    });
+    progress.done();
+  }
+  if (!o.save_log.empty()) {
+    log::LogWriter w(o.save_log, run.meta,
+                     kFieldAccel | kFieldTemp | kFieldRefQ | kFieldRefP | kFieldTrueBias |
+                         kFieldTrueRate | kFieldTruePlat);
+    for (const auto& s : run.samples) w.write(s);
+    w.finish(true);
+    fmt::print("wrote {} (rig log)\n", o.save_log);
+  }
+  if (!o.save_plan.empty()) {
+    twin::calib::save_rig_plan(o.save_plan, run.plan);
+    fmt::print("wrote {} (rig plan)\n", o.save_plan);
+  }
+  twin::calib::ExtractReport rep;
+  const auto segs = twin::calib::extract_segments(run.samples, run.meta, run.plan, o.scenario, &rep);
+  est::CalibFitOptions fo;
+  fo.method = parse_method(o.method.empty() ? cs.rig.method : o.method);
+  const est::CalibFit fit = est::fit_calibration(segs, fo);
+  twin::calib::RigConditions rig;
+  rig.source = "scenario " + o.scenario + " (the twin's pan/tilt rig)";
+  rig.latitude_deg = rep.latitude_deg;
+  rig.sample_rate_hz = rep.sample_rate_hz;
+  rig.earth_rate_removed = rep.earth_rate_removed && fo.method == est::CalibMethod::kLeastSquares;
+  rig.mean_temp_c = rep.mean_temp_c;
+  rig.hinge1_axis = run.meta.hinge1_axis();
+  rig.hinge2_axis = run.meta.hinge2_axis();
+  rig.plan = run.plan;
+  rig.samples_used = rep.samples_used;
+  twin::calib::save_calib(o.out, fit, rig);
+  print_summary(fit, rig, rep);
+  double worst = 0.0;
+  for (int i = 0; i < 2; ++i)
+    for (int p = 0; p < 2; ++p)
+      worst = std::max(worst, (fit.fit[i][p].M - run.true_M.M(i, p)).cwiseAbs().maxCoeff());
+  fmt::print("  against the twin's true M (sensor model + MuJoCo rest angles): max |dM| = {:.2e}\n", worst);
+  fmt::print("wrote {}\n", o.out);
+  write_prior(o);
   return 0;
 }
 
@@ -92,7 +157,11 @@ const bool registered = register_command(40, [](CLI::App& app) {
                     ->check(CLI::ExistingFile);
   cmd->add_option("--out", o->out, "Output calibration file (calib.yaml)")->required();
   cmd->add_option("--method", o->method,
-                  "least_squares (Earth rate removed, default) or top_to_top (the paper's averaging)");
+                  "least_squares (Earth rate removed; the default) or top_to_top (the paper's averaging); "
+                  "with --scenario the default is the scenario's calibration.method");
+  cmd->add_option("--prior-out", o->prior_out,
+                  "Also write the calibrated errors as a twin model-config file (model: block with "
+                  "scale %, misalignment %, mounting deg, stop errors deg) for simulate --model");
   cmd->add_option("--save-log", o->save_log, "With --scenario: also write the simulated rig log");
   cmd->add_option("--save-plan", o->save_plan, "With --scenario: also write its rig plan");
   scen->excludes(logo)->excludes(plano);
@@ -101,9 +170,7 @@ const bool registered = register_command(40, [](CLI::App& app) {
   return [o] {
     if (o->scenario.empty() && o->log.empty())
       throw std::invalid_argument("calibrate: give --scenario FILE, or --log FILE --plan FILE");
-    if (!o->scenario.empty())
-      throw std::invalid_argument("calibrate --scenario: the simulated rig is not available in this build yet");
-    return run_from_log(*o);
+    return o->scenario.empty() ? run_from_log(*o) : run_from_scenario(*o);
   };
 });
 

@@ -71,7 +71,7 @@ TEST(EffectsNoise, NoiseAliasesWhenTheDlpfIsWiderThanNyquist) {
   SensorModel m(p, fs, 13);
   const int n = 50000;
   std::vector<double> x(n);
-  for (int k = 0; k < n; ++k) x[k] = m.step(SensorTruth{k / fs, {}, {}}).gyro_radps[1] * kDegPerRad;
+  for (int k = 0; k < n; ++k) x[k] = m.step(SensorTruth{k / fs, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()}).gyro_radps[1] * kDegPerRad;
   double s2 = 0, s11 = 0;
   for (int k = 0; k < n; ++k) {
     s2 += x[k] * x[k];
@@ -85,7 +85,7 @@ TEST(EffectsNoise, NoiseAliasesWhenTheDlpfIsWiderThanNyquist) {
   p.lowpass_latency.dlpf_cfg = 3;
   SensorModel m3(p, fs, 13);
   s2 = 0;
-  for (int k = 0; k < n; ++k) s2 += std::pow(m3.step(SensorTruth{k / fs, {}, {}}).gyro_radps[1] * kDegPerRad, 2);
+  for (int k = 0; k < n; ++k) s2 += std::pow(m3.step(SensorTruth{k / fs, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()}).gyro_radps[1] * kDegPerRad, 2);
   const DlpfSetting d = mpu6050_dlpf(3);
   const LowpassDesign lp = design_lowpass(d.gyro_bandwidth_hz, d.gyro_delay_s, fs);
   // variance gain of the IIR + two-tap delay: sum of squared impulse response

@@ -60,7 +60,7 @@ TEST(EffectsRealData, DefaultNoiseAndBiasMatchARealMpu6050) {
   SensorModel m(p, kRealRateHz, 17);
   std::vector<std::vector<double>> sim(3);
   for (std::size_t k = 0; k < real[0].size(); ++k) {
-    const SensorReading r = m.step(SensorTruth{k / kRealRateHz, {}, {0, 0, kStandardGravityMps2}});
+    const SensorReading r = m.step(SensorTruth{k / kRealRateHz, Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, kStandardGravityMps2)});
     for (int i = 0; i < 3; ++i) sim[i].push_back(r.gyro_radps[i] * kDegPerRad);
   }
   for (int i = 0; i < 3; ++i) {

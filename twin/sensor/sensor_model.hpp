@@ -20,6 +20,7 @@ class Emitter;
 namespace driftless::twin {
 
 /// Truth at one output sample, in the (nominal) sensor frame.
+/// (Pass Eigen::Vector3d::Zero(), not `{}`: an Eigen vector built from `{}` is uninitialised.)
 struct SensorTruth {
   double t_s = 0.0;
   Eigen::Vector3d w_radps = Eigen::Vector3d::Zero();  // inertial rate of the sensor frame, sensor axes
