@@ -1,5 +1,6 @@
 // The estimator's `key: value` configuration format (docs/estimator.md): a flat YAML subset
 // read with the standard library only, so the filter's own folder needs no YAML parser.
+#include <cmath>
 #include <cerrno>
 #include <cstdlib>
 #include <functional>
@@ -105,10 +106,17 @@ void set_config_value(EstimatorConfig& cfg, const std::string& key, const std::s
     cfg.standstill = to_enum(key, value, kSources);
   } else if (key == "per_sample_updates") {
     cfg.per_sample_updates = to_bool(key, value);
+  } else if (key == "gate_relock_after") {
+    const double v = to_number(key, value);
+    if (v != std::floor(v) || v < 0.0 || v > 1e6) {
+      throw std::invalid_argument("estimator config: gate_relock_after: expected a whole number >= 0, got '" +
+                                  value + "'");
+    }
+    cfg.gate_relock_after = static_cast<int>(v);
   } else if (key == "calibration_match_tolerance_deg") {
     cfg.calibration.match_tolerance_deg = to_number(key, value);
   } else {
-    std::string known = "mode, covariance_update, standstill, per_sample_updates, calibration_match_tolerance_deg";
+    std::string known = "mode, covariance_update, standstill, per_sample_updates, gate_relock_after, calibration_match_tolerance_deg";
     for (const auto& [k, p] : nums) known += ", " + k;
     throw std::invalid_argument("unknown key '" + key + "' (known: " + known + ")");
   }
@@ -154,6 +162,7 @@ void write_estimator_config(std::ostream& out, const EstimatorConfig& cfg) {
   s << "covariance_update: " << name_of(cfg.covariance_update, kCovUpdates) << "\n";
   s << "standstill: " << name_of(cfg.standstill, kSources) << "\n";
   s << "per_sample_updates: " << (cfg.per_sample_updates ? "true" : "false") << "\n";
+  s << "gate_relock_after: " << cfg.gate_relock_after << "\n";
   for (const auto& [k, p] : numeric_fields()) s << k << ": " << cfg.*p << "\n";
   s << "calibration_match_tolerance_deg: " << cfg.calibration.match_tolerance_deg << "\n";
   out << s.str();

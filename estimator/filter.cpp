@@ -78,6 +78,9 @@ void EstimatorConfig::validate() const {
   if (!finite(initial_bias_dps)) throw std::invalid_argument("estimator config: initial_bias_dps must be a number");
   positive(initial_sigma_dps, "initial_sigma_dps", "deg/s");
   positive(variance_floor_dps2, "variance_floor_dps2", "(deg/s)^2");
+  if (gate_relock_after < 0) {
+    throw std::invalid_argument("estimator config: gate_relock_after must be >= 0 (0 = never re-lock)");
+  }
   if (!(nis_gate_probability > 0.0 && nis_gate_probability <= 1.0)) {
     throw std::invalid_argument("estimator config: nis_gate_probability must be in (0, 1] (1 = no gate)");
   }
@@ -231,7 +234,19 @@ bool DriftlessFilter::update(const Eigen::Matrix<double, D, 1>& r, const Eigen::
     return false;
   }
   rec.nis = innov.dot(llt.solve(innov));
-  if (!(rec.nis <= rec.nis_gate)) return false;
+  if (!(rec.nis <= rec.nis_gate)) {
+    // an outlier is rejected once or twice; a run of rejections means the state lost lock
+    // (a bias step, another sensor after a source switch): widen P by the innovation, re-lock
+    ++consecutive_rejections_;
+    if (cfg_.gate_relock_after <= 0 || consecutive_rejections_ < cfg_.gate_relock_after ||
+        !std::isfinite(rec.nis)) {
+      return false;
+    }
+    P_.diagonal().array() += innov.squaredNorm();
+    ++counters_.relocks;
+    return update<D>(r, H, R, rec);
+  }
+  consecutive_rejections_ = 0;
   // W = (P + Q) H^T S^-1
   const Eigen::Matrix<double, 6, D> W = llt.solve(H * P_).transpose();
   x_ += W * innov;

@@ -94,6 +94,10 @@ struct EstimatorConfig {
   double initial_sigma_dps = 5.0;          // deg/s, sqrt of P0's diagonal
   double variance_floor_dps2 = 1e-14;      // (deg/s)^2, P's diagonal never drops below this
   double nis_gate_probability = 0.9999;    // chi-square probability of the NIS gate (1 = off)
+  /// after this many consecutive gate rejections the filter re-locks: P is widened by the
+  /// innovation and the update is taken (a real bias jump or a switch to other hardware,
+  /// not an outlier). 0 = never re-lock.
+  int gate_relock_after = 3;
 
   Calibration calibration;  // optional calibrated matrices (issue 4); empty = rotations
 
@@ -170,6 +174,7 @@ struct FilterCounters {
   std::uint64_t standstills_too_short = 0;
   std::uint64_t schedule_mismatches = 0;  // paper mode: measured positions differ from eq. (5)
   std::uint64_t source_switches = 0;
+  std::uint64_t relocks = 0;  // gate re-locks after gate_relock_after consecutive rejections
 };
 
 /// The streaming DriftLess filter.
@@ -232,6 +237,7 @@ class DriftlessFilter {
 
   Vector6d x_ = Vector6d::Zero();
   Matrix6d P_ = Matrix6d::Identity();
+  int consecutive_rejections_ = 0;
   double t_filter_s_ = kNaN;  // time P and x refer to
 
   // standstill tracking

@@ -205,6 +205,39 @@ TEST(FilterTest, NisGateRejectsAnOutlierStandstillAndReportsIt) {
   EXPECT_LT((f.bias_dps() - truth(p)).cwiseAbs().maxCoeff(), 0.01);
 }
 
+TEST(FilterTest, ARunOfRejectionsRelocksOntoABiasStep) {
+  // GIVEN a converged filter and then a 1 deg/s step in sensor 1's x bias (as after a switch
+  // to another sensor, or a real bias jump), far outside the gate
+  test::SynthParams p;
+  p.duration_s = 600.0;
+  p.noise_sigma_dps = 0.05;
+  EstimatorConfig cfg = quiet_config();
+  DriftlessFilter f(cfg, test::synth_metadata(p));
+  test::synth_samples(p, [&](const Sample& s) {
+    Sample x = s;
+    if (s.t_s > 250.0) x.gyro1_dps.x() += 1.0;
+    f.push(x);
+  });
+  // THEN the first updates after the step are rejected, then the filter re-locks
+  EXPECT_GE(f.counters().rejected, static_cast<std::uint64_t>(cfg.gate_relock_after - 1));
+  EXPECT_GE(f.counters().relocks, 1u);
+  // AND it ends on the new bias
+  Vector6d expect = truth(p);
+  expect[0] += 1.0;
+  EXPECT_LT((f.bias_dps() - expect).cwiseAbs().maxCoeff(), 0.02) << f.bias_dps().transpose();
+
+  // AND with re-locking off the estimate stays frozen on the old bias
+  cfg.gate_relock_after = 0;
+  DriftlessFilter frozen(cfg, test::synth_metadata(p));
+  test::synth_samples(p, [&](const Sample& s) {
+    Sample x = s;
+    if (s.t_s > 250.0) x.gyro1_dps.x() += 1.0;
+    frozen.push(x);
+  });
+  EXPECT_EQ(frozen.counters().relocks, 0u);
+  EXPECT_GT(std::fabs(frozen.bias_dps()[0] - expect[0]), 0.5);
+}
+
 TEST(FilterTest, PerSampleUpdatesAgreeWithStandstillAverages) {
   test::SynthParams p;
   p.duration_s = 60.0;
