@@ -42,6 +42,8 @@ const char* to_string(FaultKind k) {
 void FdiParams::validate() const {
   require(std::isfinite(sample_rate_hz) && sample_rate_hz > 0, "sample_rate_hz", "must be > 0 Hz");
   require(learn_s > 0, "learn_s", "must be > 0 s");
+  require(corr_window_s >= 0, "corr_window_s", "must be >= 0 s");
+  require(rate_allowance >= 0, "rate_allowance", "must be >= 0 (deg/s per deg/s)");
   require(noise_floor_dps > 0, "noise_floor_dps", "must be > 0 deg/s");
   require(stuck_s > 0, "stuck_s", "must be > 0 s");
   require(mean_drift_sigma > 0, "mean_drift_sigma", "must be > 0");
@@ -78,7 +80,59 @@ FaultDetector::FaultDetector(const FdiParams& params) : p_(params) {
 
 Eigen::Vector3d FaultDetector::residual_sigma_dps() const {
   if (sigma_[0] < 0) return Eigen::Vector3d::Constant(std::nan(""));
-  return sigma_;
+  return sigma_sample_;
+}
+
+Eigen::Vector3d FaultDetector::residual_sigma_longrun_dps() const {
+  if (sigma_[0] < 0) return Eigen::Vector3d::Constant(std::nan(""));
+  return sigma_lr_;
+}
+
+// noise scales from the learning window, each segment demeaned (the filter's estimate error is
+// constant within a segment): sigma of first differences / sqrt(2) for the noise tests, and the
+// long-run sigma, sigma_lr^2 = g0 + 2 sum_{l=1..L} (1 - l/(L+1)) g_l (Bartlett window over the
+// autocovariances g_l), for the mean test. The MPU6050's DLPF (and its fractional delay) gives a
+// lag-1 correlation near 0.5 at 100 Hz: first differences then read about 0.7 sigma and the
+// long-run sigma is about 1.4 sigma, so scaling the mean test by either made its CUSUM steps
+// twice as large as assumed (docs/fdi.md, "false alarms on a moving base").
+void FaultDetector::finish_learning() {
+  const int L = std::max(1, static_cast<int>(std::lround(p_.corr_window_s * p_.sample_rate_hz)));
+  std::vector<Eigen::Vector3d> x;
+  std::vector<double> gamma_n(static_cast<std::size_t>(L) + 1, 0.0);
+  std::vector<Eigen::Vector3d> gamma(static_cast<std::size_t>(L) + 1, Eigen::Vector3d::Zero());
+  Eigen::Vector3d diff2 = Eigen::Vector3d::Zero();
+  double n_diff = 0;
+  for (std::size_t a = 0; a < learn_.size();) {
+    std::size_t b = a;
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (; b < learn_.size() && learn_[b].first == learn_[a].first; ++b) mean += learn_[b].second;
+    const std::size_t n = b - a;
+    if (n >= static_cast<std::size_t>(2 * L + 2)) {
+      mean /= static_cast<double>(n);
+      x.clear();
+      for (std::size_t i = a; i < b; ++i) x.push_back(learn_[i].second - mean);
+      for (int l = 0; l <= L; ++l) {
+        for (std::size_t i = static_cast<std::size_t>(l); i < n; ++i) {
+          gamma[l] += x[i].cwiseProduct(x[i - l]);
+          gamma_n[l] += 1;
+        }
+      }
+      for (std::size_t i = 1; i < n; ++i) diff2 += (x[i] - x[i - 1]).cwiseAbs2() / 2.0;
+      n_diff += static_cast<double>(n - 1);
+    }
+    a = b;
+  }
+  if (gamma_n[0] < 2 || n_diff < 1) {  // only short segments so far: keep learning
+    return;
+  }
+  for (int l = 0; l <= L; ++l) gamma[l] /= gamma_n[l];
+  Eigen::Vector3d lr2 = gamma[0];
+  for (int l = 1; l <= L; ++l) lr2 += 2.0 * (1.0 - l / (L + 1.0)) * gamma[l];
+  sigma_sample_ = gamma[0].cwiseSqrt().cwiseMax(p_.noise_floor_dps);
+  sigma_lr_ = lr2.cwiseMax(0.0).cwiseSqrt().cwiseMax(p_.noise_floor_dps);
+  sigma_ = (diff2 / n_diff).cwiseSqrt().cwiseMax(p_.noise_floor_dps);
+  learn_.clear();
+  learn_.shrink_to_fit();
 }
 
 void FaultDetector::reset_alarm() {
@@ -162,15 +216,11 @@ FdiStatus FaultDetector::push(const FdiInput& in) {
   if (prev_nu_) d = (nu - *prev_nu_) / std::sqrt(2.0);
   prev_nu_ = nu;
 
-  // learn the per-sample residual noise from first differences (blind to a slowly varying mean)
+  // learn the residual noise (per sample, of differences, long-run) from the first learn_s at rest
   if (sigma_[0] < 0) {
-    if (d) {
-      learn_sum_ += d->cwiseAbs2();
-      ++learn_n_;
-    }
-    if (learn_n_ >= std::lround(p_.learn_s * p_.sample_rate_hz)) {
-      sigma_ = (learn_sum_ / static_cast<double>(learn_n_)).cwiseSqrt().cwiseMax(p_.noise_floor_dps);
-    }
+    learn_.emplace_back(segment_, nu);
+    const long need = std::lround(p_.learn_s * p_.sample_rate_hz);
+    if (++learn_n_ >= need && (learn_n_ - need) % 100 == 0) finish_learning();
     return FdiStatus::kLearning;
   }
 
@@ -183,12 +233,16 @@ FdiStatus FaultDetector::push(const FdiInput& in) {
   Eigen::Matrix<double, 3, 6> H;
   H << R1, -R2;
   const Eigen::Vector3d est_var = (H * in.bias_cov_dps2 * H.transpose()).diagonal();
+  const double rate_dps = rec.fused.norm();  // calibration residuals grow with the input rate
   long onset = -1;
   const double log_ratio = std::log(p_.noise_ratio);
   for (int j = 0; j < 3; ++j) {
-    const double z = nu[j] / sigma_[j];
+    // in long-run sigmas: the DLPF correlates neighbouring samples, so a sum of n innovations
+    // has variance n sigma_lr^2, not n sigma^2 (the mean test's false-alarm rate rests on this)
+    const double z = nu[j] / sigma_lr_[j];
     const double k = p_.mean_drift_sigma +
-                     p_.estimate_allowance * std::sqrt(std::max(0.0, est_var[j])) / sigma_[j];
+                     (p_.estimate_allowance * std::sqrt(std::max(0.0, est_var[j])) +
+                      p_.rate_allowance * rate_dps) / sigma_lr_[j];
     g_up_[j] = std::max(0.0, g_up_[j] + z - k);
     g_dn_[j] = std::max(0.0, g_dn_[j] - z - k);
     n_up_[j] = g_up_[j] > 0 ? n_up_[j] + 1 : 0;
@@ -321,7 +375,7 @@ void FaultDetector::try_classify(double t_s) {
   Eigen::Vector3d zc = Eigen::Vector3d::Zero();
   for (int j = 0; j < 3; ++j) {
     const bool excited = sxx[j] / n_total > p_.scale_min_excitation_dps * p_.scale_min_excitation_dps;
-    if (excited) zc[j] = sxy[j] / std::sqrt(sxx[j]) / sigma_[j];
+    if (excited) zc[j] = sxy[j] / std::sqrt(sxx[j]) / sigma_lr_[j];
   }
   int j_scale = 0;
   zc.cwiseAbs().maxCoeff(&j_scale);
@@ -368,7 +422,8 @@ void FaultDetector::try_isolate_mean(double t_s, bool timeout) {
     segs.back().n += 1;
     segs.back().sum += r.r - (r.R1 * bias_ref_.head<3>() - r.R2 * bias_ref_.tail<3>());
   }
-  const Eigen::Vector3d w = sigma_.cwiseAbs2().cwiseInverse();
+  // segment means of correlated noise: variance sigma_lr^2 / n
+  const Eigen::Vector3d w = sigma_lr_.cwiseAbs2().cwiseInverse();
   std::array<double, 6> cost{};
   std::array<double, 6> mag{};
   for (int h = 0; h < 6; ++h) {

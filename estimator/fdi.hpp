@@ -29,12 +29,17 @@ const char* to_string(FaultKind k);
 /// Tuning of the detector. Units: Hz, s, deg/s; dimensionless statistics say so.
 struct FdiParams {
   double sample_rate_hz = 100.0;       // Hz, nominal sample rate of the stream
-  double learn_s = 10.0;               // s of at-rest data used to learn the residual noise per axis
+  double learn_s = 20.0;               // s of at-rest data used to learn the residual noise per axis
+  double corr_window_s = 0.05;         // s, lag window of the long-run (zero-frequency) noise estimate;
+                                       // covers the DLPF's correlation (a few ms, docs/fdi.md)
   double noise_floor_dps = 1e-4;       // deg/s, lower bound on the learned per-sample residual sigma
   double stuck_s = 0.3;                // s of bit-identical output on one axis that flags it stuck
   double mean_drift_sigma = 1.0;       // CUSUM allowance k of the mean test, residual sigmas
   double mean_threshold = 30.0;        // CUSUM threshold h of the mean test (dimensionless)
   double estimate_allowance = 3.0;     // extra allowance per sigma of the filter's own estimate
+  double rate_allowance = 0.003;       // extra allowance per deg/s of box rate, deg/s per deg/s: the
+                                       // residual a calibration leaves (misalignment, scale, stop
+                                       // angles; 0.003 = 0.17 deg or 0.3 %) times the input rate
   double noise_ratio = 4.0;            // variance ratio the noise-burst CUSUM is designed for
   double noise_threshold = 40.0;       // CUSUM threshold of the noise test (log-likelihood units)
   double classify_s = 2.0;             // s of at-rest data after an alarm used to classify it
@@ -99,6 +104,9 @@ class FaultDetector {
   std::optional<double> first_alarm_s() const { return first_alarm_s_; }
   /// Learned per-sample residual sigma per box axis, deg/s (NaN while learning).
   Eigen::Vector3d residual_sigma_dps() const;
+  /// Learned long-run residual sigma per box axis, deg/s per sample (sqrt of the zero-frequency
+  /// spectral density times the sample rate): the scale of the mean test (NaN while learning).
+  Eigen::Vector3d residual_sigma_longrun_dps() const;
   /// Forgets the fault and restarts monitoring (keeps the learned noise).
   void reset_alarm();
 
@@ -124,10 +132,13 @@ class FaultDetector {
   // stuck detector: run lengths of bit-identical values per sensor axis
   Eigen::Matrix<double, 6, 1> last_value_;
   Eigen::Matrix<int, 6, 1> run_;
-  // learning: first-difference variance per axis
-  Eigen::Vector3d learn_sum_ = Eigen::Vector3d::Zero();
+  // learning: the at-rest innovations (with their segment) of the first learn_s
+  void finish_learning();
+  std::vector<std::pair<long, Eigen::Vector3d>> learn_;
   long learn_n_ = 0;
-  Eigen::Vector3d sigma_ = Eigen::Vector3d::Constant(-1.0);
+  Eigen::Vector3d sigma_ = Eigen::Vector3d::Constant(-1.0);     // of first differences / sqrt(2)
+  Eigen::Vector3d sigma_sample_ = Eigen::Vector3d::Constant(-1.0);  // per sample
+  Eigen::Vector3d sigma_lr_ = Eigen::Vector3d::Constant(-1.0);  // long-run (mean test, isolation)
   // segment bookkeeping
   long segment_ = 0;
   bool prev_rest_ = false;

@@ -249,7 +249,7 @@ SweepJob make_job(const SweepConfig& cfg, const std::filesystem::path& log_dir) 
     std::unique_ptr<FastBox> box;
     log::Metadata meta;
     SampleSource next;
-    if (runner == "twin") {
+    if (runner == "twin" || runner == "fdi_twin") {
       sim = std::make_unique<Simulator>(setup.scenario);
       meta = sim->metadata();
       next = [&](Sample& s) { return sim->next(s); };
@@ -269,7 +269,8 @@ SweepJob make_job(const SweepConfig& cfg, const std::filesystem::path& log_dir) 
         return true;
       };
     }
-    Metrics m = runner == "fdi" ? evaluate_fdi(setup, meta, source) : evaluate_bias(setup, meta, source);
+    const bool fdi = runner == "fdi" || runner == "fdi_twin";
+    Metrics m = fdi ? evaluate_fdi(setup, meta, source) : evaluate_bias(setup, meta, source);
     if (writer) {
       Sample rest;
       while (source(rest)) {}  // the fdi runner stops at isolation: finish the log

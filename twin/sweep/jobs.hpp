@@ -50,7 +50,7 @@ Metrics evaluate_bias(const RunSetup& setup, const log::Metadata& meta, const Sa
 /// alarm, alarm delay, isolation delay, kind/sensor/axis correct, false alarm.
 Metrics evaluate_fdi(const RunSetup& setup, const log::Metadata& meta, const SampleSource& source);
 
-/// The job of a sweep's runner (fast | twin | fdi). With `log_dir` set, every run also writes its
+/// The job of a sweep's runner (fast | twin | fdi | fdi_twin). With `log_dir` set, every run also writes its
 /// samples to log_dir/run_<index>.csv (driftless-log 1) for `driftless estimate` / `allan`.
 SweepJob make_job(const SweepConfig& cfg, const std::filesystem::path& log_dir = {});
 

@@ -60,8 +60,8 @@ std::uint64_t splitmix64(std::uint64_t x) {
 
 void SweepConfig::validate() const {
   const std::string f = file.empty() ? std::string("sweep") : file.string();
-  if (runner != "fast" && runner != "twin" && runner != "fdi") {
-    throw std::invalid_argument(f + ": runner must be fast, twin or fdi (got '" + runner + "')");
+  if (runner != "fast" && runner != "twin" && runner != "fdi" && runner != "fdi_twin") {
+    throw std::invalid_argument(f + ": runner must be fast, twin, fdi or fdi_twin (got '" + runner + "')");
   }
   if (monte_carlo < 1) throw std::invalid_argument(f + ": monte_carlo must be >= 1");
   if (duration_s < 0) throw std::invalid_argument(f + ": duration_s must be >= 0 s");

@@ -37,7 +37,7 @@ struct PlotSpec {
 struct SweepConfig {
   std::string name;
   std::string description;
-  std::string runner = "fast";      // fast | twin | fdi  (docs/sweep.md)
+  std::string runner = "fast";      // fast | twin | fdi | fdi_twin  (docs/sweep.md)
   std::filesystem::path scenario;   // base scenario file (resolved), or a built-in name
   double duration_s = 0.0;          // s, overrides the scenario's duration when > 0
   int monte_carlo = 1;              // seeds per grid point
