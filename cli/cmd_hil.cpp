@@ -53,6 +53,9 @@ int run_hil(const HilOptions& o) {
     throw std::invalid_argument("hil: --twin-flips: expected scenario or bridge, got '" + o.twin_flips + "'");
   }
   ro.twin_bridge_flips = o.twin_flips == "bridge";
+  if (ro.twin_bridge_flips && o.source != "twin" && o.switch_to != "twin") {
+    throw std::invalid_argument("hil: --twin-flips bridge needs the twin source (--source twin or --switch-to twin)");
+  }
   auto first = hil::make_source_rig(o.source, ro);
   std::unique_ptr<hil::SourceRig> second;
   if (!o.switch_to.empty()) second = hil::make_source_rig(o.switch_to, ro);

@@ -84,6 +84,9 @@ for src in i2c:/dev/i2c-77 serial:/dev/ttyNoSuchPort; do
   grep -q "${src#*:}" "$out/d.err" || fail "$src: error does not name the device: $(cat "$out/d.err")"
   [ ! -e "$out/d/log.csv" ] || fail "$src: a log was written"
 done
+# --twin-flips bridge without the twin is refused
+if "$bin" hil --source emu-i2c --twin-flips bridge --out "$out/g" --duration 1 2> "$out/g.err"; then fail "--twin-flips without twin accepted"; fi
+grep -q "needs the twin source" "$out/g.err" || fail "--twin-flips without twin: $(cat "$out/g.err")"
 # a bad switch request is refused before anything runs
 if "$bin" hil --source emu-i2c --switch-to emu-serial --out "$out/e" --duration 1 2> "$out/e.err"; then fail "--switch-to without --at accepted"; fi
 echo "hil: ok"
