@@ -2,6 +2,7 @@
 #include "twin/sweep/jobs.hpp"
 
 #include <cmath>
+#include <fstream>
 #include <memory>
 #include <random>
 #include <sstream>
@@ -117,7 +118,15 @@ RunSetup SetupBuilder::build(const RunSpec& spec) const {
   return s;
 }
 
-Metrics evaluate_bias(const RunSetup& setup, const log::Metadata& meta, const SampleSource& source) {
+Metrics evaluate_bias(const RunSetup& setup, const log::Metadata& meta, const SampleSource& source,
+                      const std::filesystem::path& attitude_csv) {
+  std::ofstream att_out;
+  if (!attitude_csv.empty()) {
+    att_out.open(attitude_csv);
+    if (!att_out) throw std::runtime_error("sweep: cannot write " + attitude_csv.string());
+    att_out << "t_s,err_driftless_deg,err_zeroed_deg\n";
+  }
+  double next_att_out_s = 0.0;
   est::DriftlessFilter filter(setup.estimator, meta);
   const double eval_start =
       setup.eval_start_s >= 0 ? setup.eval_start_s : 0.25 * setup.scenario.duration_s;
@@ -167,6 +176,11 @@ Metrics evaluate_bias(const RunSetup& setup, const log::Metadata& meta, const Sa
         att_t0 = s.t_s;
         err_dl0 = e_dl;
         err_zero0 = e_zero;
+      }
+      if (att_out.is_open() && s.t_s >= next_att_out_s) {
+        att_out << s.t_s << ',' << Eigen::AngleAxisd(e_dl).angle() * kDegPerRad << ','
+                << Eigen::AngleAxisd(e_zero).angle() * kDegPerRad << '\n';
+        next_att_out_s += 1.0;
       }
       att_t1 = s.t_s;
       err_dl1 = e_dl;
@@ -322,7 +336,9 @@ SweepJob make_job(const SweepConfig& cfg, const std::filesystem::path& log_dir) 
       };
     }
     const bool fdi = runner == "fdi" || runner == "fdi_twin";
-    Metrics m = fdi ? evaluate_fdi(setup, meta, source) : evaluate_bias(setup, meta, source);
+    const std::filesystem::path att_csv =
+        log_dir.empty() ? std::filesystem::path{} : log_dir / ("attitude_" + std::to_string(spec.index) + ".csv");
+    Metrics m = fdi ? evaluate_fdi(setup, meta, source) : evaluate_bias(setup, meta, source, att_csv);
     if (writer) {
       Sample rest;
       while (source(rest)) {}  // the fdi runner stops at isolation: finish the log

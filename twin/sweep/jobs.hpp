@@ -43,15 +43,19 @@ using SampleSource = std::function<bool(Sample&)>;
 
 /// Runs `source` through a DriftlessFilter built from `setup` and scores the bias estimate
 /// against the true_bias columns: bias_err_rms_dph (all six components over t >= eval start),
-/// per-component RMS, max, final, mean NEES/6, NIS mean, updates and rejections.
-Metrics evaluate_bias(const RunSetup& setup, const log::Metadata& meta, const SampleSource& source);
+/// per-component RMS, max, final, mean NEES/6, NIS mean, updates and rejections, attitude drift
+/// with DriftLess and with the bias zeroed once. With `attitude_csv` set, also writes the attitude
+/// error angles (deg) once per second: t_s,err_driftless_deg,err_zeroed_deg.
+Metrics evaluate_bias(const RunSetup& setup, const log::Metadata& meta, const SampleSource& source,
+                      const std::filesystem::path& attitude_csv = {});
 
 /// Runs the source with the planted fault through the filter and the fault detector; metrics:
 /// alarm, alarm delay, isolation delay, kind/sensor/axis correct, false alarm.
 Metrics evaluate_fdi(const RunSetup& setup, const log::Metadata& meta, const SampleSource& source);
 
 /// The job of a sweep's runner (fast | twin | fdi | fdi_twin). With `log_dir` set, every run also writes its
-/// samples to log_dir/run_<index>.csv (driftless-log 1) for `driftless estimate` / `allan`.
+/// samples to log_dir/run_<index>.csv (driftless-log 1) for `driftless estimate` / `allan`, and
+/// (runners fast, twin) its attitude errors to log_dir/attitude_<index>.csv.
 SweepJob make_job(const SweepConfig& cfg, const std::filesystem::path& log_dir = {});
 
 }  // namespace driftless::twin::sweep
