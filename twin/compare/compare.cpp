@@ -205,22 +205,32 @@ double median_abs(std::vector<double> v) {
   return std::abs(*mid);
 }
 
-// Ljung-Box portmanteau of a whitened series (entries with used = 0 skipped)
-std::pair<double, double> ljung_box(const std::vector<double>& x, int lags) {
+// Ljung-Box portmanteau of a whitened series: Q, its p-value on lags - fitted degrees of
+// freedom, and the effect size sum rho_h^2 - lags/m (about the fraction of the residual's
+// variance its own past predicts, debiased: white noise gives ~0 on average)
+struct Portmanteau {
+  double q = 0.0, p = 1.0, excess = 0.0;
+};
+Portmanteau ljung_box(const std::vector<double>& x, int lags, int fitted) {
   const std::size_t m = x.size();
-  if (m < static_cast<std::size_t>(lags) * 4) return {0.0, 1.0};
+  if (m < static_cast<std::size_t>(lags) * 4) return {};
   const double mean = std::accumulate(x.begin(), x.end(), 0.0) / static_cast<double>(m);
   double c0 = 0.0;
   for (double v : x) c0 += (v - mean) * (v - mean);
-  double q = 0.0;
+  double q = 0.0, r2 = 0.0;
   for (int h = 1; h <= lags; ++h) {
     double ch = 0.0;
     for (std::size_t k = static_cast<std::size_t>(h); k < m; ++k) ch += (x[k] - mean) * (x[k - h] - mean);
     const double rho = ch / c0;
     q += rho * rho / static_cast<double>(m - static_cast<std::size_t>(h));
+    r2 += rho * rho;
   }
   q *= static_cast<double>(m) * static_cast<double>(m + 2);
-  return {q, 1.0 - est::chi2_cdf(q, lags)};
+  Portmanteau out;
+  out.q = q;
+  out.p = 1.0 - est::chi2_cdf(q, std::max(1, lags - fitted));
+  out.excess = r2 - static_cast<double>(lags) / static_cast<double>(m);
+  return out;
 }
 
 std::string axes_text(const std::vector<int>& axes) {
@@ -246,7 +256,10 @@ void CompareOptions::validate() const {
   if (!(window_s >= 0)) throw std::invalid_argument("CompareOptions.window_s must be >= 0 s");
   if (worst_windows < 0) throw std::invalid_argument("CompareOptions.worst_windows must be >= 0");
   pos(whiteness_alpha, "whiteness_alpha");
-  if (ljung_box_lags < 1) throw std::invalid_argument("CompareOptions.ljung_box_lags must be >= 1");
+  if (ljung_box_lags < 2) throw std::invalid_argument("CompareOptions.ljung_box_lags must be >= 2");
+  if (!(min_effect_fraction >= 0 && min_effect_fraction < 1)) {
+    throw std::invalid_argument("CompareOptions.min_effect_fraction must be in [0, 1)");
+  }
   pos(correlation_z, "correlation_z");
   replay.validate();
 }
@@ -267,14 +280,17 @@ CompareResult compare(const Replay& r, const CompareModel& model, const CompareO
   out.duration_s = r.t_s.back() - r.t_s.front();
 
   // ---- predict, residual ----
-  std::array<SensorPrediction, 2> pred{predict_sensor(r, 0, model.sensor[0]),
-                                       predict_sensor(r, 1, model.sensor[1])};
+  // platforms resting on stops: the model's stop errors plus the servo's press into the stop
+  // (the MuJoCo box settled on them); logs with an encoder read the true angle instead
+  const Eigen::Matrix2d settled = r.encoder_readback ? Eigen::Matrix2d::Zero() : settled_stop_offsets_deg(model.box);
+  std::array<SensorPrediction, 2> pred{predict_sensor(r, 0, model.sensor[0], model.box, model.time_offset_s, settled),
+                                       predict_sensor(r, 1, model.sensor[1], model.box, model.time_offset_s, settled)};
   if (!r.has_temp) {
     out.notes.push_back("the log has no temperature columns: the model's temperature curve is used");
   }
   const Inputs in{r, pred, model.sensor};
   std::vector<std::uint8_t> mask(n);
-  for (std::size_t k = 0; k < n; ++k) mask[k] = r.usable[k] && !r.flipping[k];
+  for (std::size_t k = 0; k < n; ++k) mask[k] = r.usable[k] && !r.flipping[k] && !r.rough[k];
   std::array<std::vector<double>, 6> resid;
   for (int c = 0; c < 6; ++c) {
     resid[c].resize(n);
@@ -587,7 +603,8 @@ CompareResult compare(const Replay& r, const CompareModel& model, const CompareO
     Candidate cd;
     cd.effect = def.effect;
     cd.kind = def.kind;
-    cd.applicable = def.kind == "regression" || cd.effect == "earth_rate" || cd.effect == "end_stop_error";
+    cd.applicable = def.kind == "regression" || cd.effect == "earth_rate" || cd.effect == "end_stop_error" ||
+                    cd.effect == "time_offset";
     std::vector<std::string> sensors_used;
     double ev_sum = 0, gain_sum = 0, jn_sum = 0;
     int dof = 0;
@@ -712,7 +729,13 @@ CompareResult compare(const Replay& r, const CompareModel& model, const CompareO
     std::vector<double> wz(mb), wsel;
     W.whiten(zr, wz);
     for (std::size_t b = 0; b < mb; ++b) if (W.used()[b]) wsel.push_back(wz[b]);
-    std::tie(cs.ljung_box_q, cs.ljung_box_p) = ljung_box(wsel, opt.ljung_box_lags);
+    // the forward filter's innovations are white under the model whatever the nuisance; the
+    // fitted white density takes one degree of freedom
+    const Portmanteau lb = ljung_box(wsel, opt.ljung_box_lags, 1);
+    cs.ljung_box_q = lb.q;
+    cs.ljung_box_p = lb.p;
+    cs.autocorrelation_excess = lb.excess;
+    cs.white = !(lb.p < opt.whiteness_alpha / 6.0 && lb.excess > opt.min_effect_fraction);
     // turn-on bias
     double bsum = 0; std::size_t bn = 0;
     for (std::size_t b = 0; b < mb; ++b) if (blocks.count[b]) { bsum += bias[b]; ++bn; }
@@ -1223,7 +1246,8 @@ CompareResult compare(const Replay& r, const CompareModel& model, const CompareO
         if (sxx <= 1e-300 || syy <= 0) continue;
         const double rho = sxy / std::sqrt(sxx * syy);
         const double z = rho * std::sqrt(static_cast<double>(ch[c].m));
-        if (std::abs(z) > opt.correlation_z) out.correlations.push_back({sg.name, c, rho, z});
+        // significant and material: a long log makes a negligible correlation significant
+        if (std::abs(z) > opt.correlation_z && rho * rho >= opt.min_effect_fraction) out.correlations.push_back({sg.name, c, rho, z});
       }
     }
     std::sort(out.correlations.begin(), out.correlations.end(), [](const Correlation& a, const Correlation& b) { return std::abs(a.z) > std::abs(b.z); });
@@ -1272,7 +1296,7 @@ CompareResult compare(const Replay& r, const CompareModel& model, const CompareO
   out.ranking = cands;
   const Candidate* best = out.ranking.empty() ? nullptr : &out.ranking.front();
   bool white_ok = true;
-  for (const auto& cs : out.channels) white_ok = white_ok && cs.ljung_box_p >= opt.whiteness_alpha / 6.0;
+  for (const auto& cs : out.channels) white_ok = white_ok && cs.white;
   auto fmt_params = [](const Candidate& cd) {
     std::string s;
     for (std::size_t i = 0; i < std::min<std::size_t>(cd.params.size(), 6); ++i) {
@@ -1295,7 +1319,7 @@ CompareResult compare(const Replay& r, const CompareModel& model, const CompareO
                          channel_name(out.correlations[i].channel), out.correlations[i].rho);
     std::string bad;
     for (int c = 0; c < 6; ++c)
-      if (out.channels[c].ljung_box_p < opt.whiteness_alpha / 6.0) bad += (bad.empty() ? "" : ", ") + channel_name(c);
+      if (!out.channels[c].white) bad += (bad.empty() ? "" : ", ") + channel_name(c);
     out.statement = fmt::format("unexplained structure: no candidate effect explains the residual{}{}",
                                 bad.empty() ? "" : "; not white on " + bad,
                                 sig.empty() ? "" : "; it correlates with " + sig);
@@ -1310,8 +1334,7 @@ void apply_candidate(CompareModel& model, const Candidate& c) {
   if (!c.applicable) {
     throw std::runtime_error(fmt::format(
         "{} cannot be written into the model file: {}", c.effect,
-        c.effect == "time_offset" ? "shift the log's t column by the fitted offset instead"
-        : c.effect == "flip_transient" ? "it is a property of the platform motors (box block), lengthen the settle margin instead"
+        c.effect == "flip_transient" ? "it is a property of the platform motors (box block), lengthen the settle margin instead"
                                        : "no model key holds it"));
   }
   auto sensor_of = [](const std::string& name) { return name.size() > 2 && name[0] == 's' ? name[1] - '1' : -1; };
@@ -1463,6 +1486,32 @@ void apply_candidate(CompareModel& model, const Candidate& c) {
                                fmt::format("{:+.3f} deg", d));
     }
     model.latitude_deg += d;
+    return;
+  }
+  if (e == "end_stop_error") {
+    // model.box.stopI_error_deg = [at -stop, at +stop]; one value per sensor and side
+    for (int s = 0; s < 2; ++s) {
+      Eigen::Vector2d& err = s == 0 ? model.box.stop1_error_deg : model.box.stop2_error_deg;
+      for (int col : {kEndMinus, kEndPlus}) {
+        for (const auto& f : c.fit) {
+          if (f.channel / 3 != s || f.column != col) continue;
+          err[col == kEndPlus ? 1 : 0] += f.beta;
+          break;  // shared by the sensor's three channels
+        }
+      }
+    }
+    return;
+  }
+  if (e == "time_offset") {
+    for (const auto& f : c.fit) {
+      if (f.column != kDelay) continue;
+      model.time_offset_s += f.beta;
+      break;  // shared by all six channels
+    }
+    if (!(std::abs(model.time_offset_s) <= 1.0)) {
+      throw std::runtime_error(fmt::format("time_offset: fitted offset {:.4f} s is outside the model's [-1, 1] s",
+                                           model.time_offset_s));
+    }
     return;
   }
   throw std::runtime_error(fmt::format("{}: the model's box block (twin-core) holds it; set it by hand: {}", e,

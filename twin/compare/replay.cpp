@@ -148,6 +148,7 @@ Replay build(std::vector<Raw> raw, const log::Metadata& meta, std::uint32_t fiel
   out.has_ref_p = (fields & kFieldRefP) != 0;
   out.has_accel = (fields & kFieldAccel) != 0;
   out.has_temp = (fields & kFieldTemp) != 0;
+  out.encoder_readback = meta.get("platform_readback").value_or("") == "encoder";
   out.hinge_axis[0] = meta.hinge1_axis().normalized();
   out.hinge_axis[1] = meta.hinge2_axis().normalized();
 
@@ -244,6 +245,36 @@ Replay build(std::vector<Raw> raw, const log::Metadata& meta, std::uint32_t fiel
     const Eigen::Quaterniond dq = quat(a).conjugate() * quat(b);
     const Eigen::Vector3d w_eb = rotation_vector(dq) / (out.t_s[b] - out.t_s[a]);
     out.w_body_radps[k] = w_eb + R_enu_from_body[k].transpose() * earth_enu;
+  }
+  // central differences are exact only for a rate linear over [t - h, t + h]: a smooth motion
+  // leaves an error h^2/6 w'' (removed with the second difference of the estimate, giving a
+  // 5-point, 4th-order derivative), and a kink of the rate (a motor's trapezoid profile starting
+  // or ending an acceleration) leaves up to a h/4 at the kink, which no stencil removes. Those
+  // samples are marked rough: the fourth difference of the estimate flags them.
+  out.rough.assign(n, 0);
+  if (n >= 5) {
+    std::vector<Eigen::Vector3d> d1 = out.w_body_radps;
+    for (std::size_t k = 1; k + 1 < n; ++k) out.w_body_radps[k] = d1[k] - (d1[k + 1] - 2.0 * d1[k] + d1[k - 1]) / 6.0;
+    const double limit = opt.replay_error_limit_dps * kRadPerDeg;
+    const auto spread = static_cast<std::size_t>(std::ceil(opt.rough_guard_s * fs));
+    std::vector<std::uint8_t> kink(n, 0);
+    for (std::size_t k = 2; k + 2 < n; ++k) {
+      const Eigen::Vector3d d4 = d1[k + 2] - 4.0 * d1[k + 1] + 6.0 * d1[k] - 4.0 * d1[k - 1] + d1[k - 2];
+      // a kink of slope change s per sample gives |d4| ~ s and a residual error ~ s / 4
+      kink[k] = d4.cwiseAbs().maxCoeff() / 4.0 > limit;
+    }
+    for (std::size_t k = 0; k < n; ++k) {
+      if (!kink[k]) continue;
+      const std::size_t a = k >= spread ? k - spread : 0, b = std::min(n - 1, k + spread);
+      for (std::size_t i = a; i <= b; ++i) out.rough[i] = 1;
+    }
+    const auto rough_count = static_cast<std::size_t>(std::count(out.rough.begin(), out.rough.end(), 1));
+    if (rough_count > 0) {
+      out.notes.push_back(fmt::format(
+          "{} samples ({:.1f} %) where the reference rate cannot be rebuilt from ref_q to within {:.3g} deg/s "
+          "(kinks of the rate, e.g. a motion profile's acceleration steps) are left out of the fits",
+          rough_count, 100.0 * static_cast<double>(rough_count) / static_cast<double>(n), opt.replay_error_limit_dps));
+    }
   }
   // specific force in body axes: second differences of ref_p, else gravity only
   bool p_ok = out.has_ref_p;
@@ -390,6 +421,8 @@ void ReplayOptions::validate() const {
   if (!std::isnan(model_sample_rate_hz)) positive(model_sample_rate_hz, "model_sample_rate_hz");
   positive(flip_rate_threshold_dps, "flip_rate_threshold_dps");
   positive(static_rate_limit_dps, "static_rate_limit_dps");
+  positive(replay_error_limit_dps, "replay_error_limit_dps");
+  if (!(rough_guard_s >= 0)) throw std::invalid_argument("ReplayOptions.rough_guard_s must be >= 0");
   if (!(flip_guard_s >= 0)) throw std::invalid_argument("ReplayOptions.flip_guard_s must be >= 0");
   if (!(std::abs(default_latitude_deg) <= 90)) {
     throw std::invalid_argument("ReplayOptions.default_latitude_deg must be within [-90, 90] deg");
