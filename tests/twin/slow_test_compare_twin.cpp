@@ -155,7 +155,10 @@ TEST(CompareTwinEffects, TemperatureScaleCoefficient) {
 TEST(CompareTwinEffects, MountingMisalignment) {
   Case c;  // 0.8 deg about x (not the hinge axis z of platform 1)
   c.seed = 17;
-  c.plant = [](Scenario& s) { s.model.sensor1.mounting_misalignment.angles_deg = Eigen::Vector3d(0.8, 0, 0); };
+  c.plant = [](Scenario& s) {
+    s.model.sensor1.mounting_misalignment.enabled = true;
+    s.model.sensor1.mounting_misalignment.angles_deg = Eigen::Vector3d(0.8, 0, 0);
+  };
   c.model_setup = [](Scenario& s) { s.model.sensor1.mounting_misalignment.enabled = false; };
   c.effect = "mounting_misalignment";
   c.param = "s1.angles_deg[x]";

@@ -35,6 +35,7 @@ enum Col : int {
   kFlip0, kFlip1, kFlip2, kFlip3,  // flip transients, deg/s: dir * 1[bin after the stop]
   kNumCols
 };
+constexpr double kRestAngleSigmaDeg = 0.01;  // deg, prior spread of a rest angle on a stop
 constexpr double kFlipBins[5] = {0.0, 0.25, 0.5, 1.0, 2.0};  // s after a platform stops
 
 struct Inputs {
@@ -91,6 +92,10 @@ double prior_sigma(const SensorParams& p, int j, int col) {
       return p.mounting_misalignment.enabled ? p.mounting_misalignment.sigma_deg[col - kMount0] : 0.0;
     case kTempBias: return p.temperature.enabled ? p.temperature.bias_tc_sigma_dps_per_degc[j] : 0.0;
     case kTempScale: return p.temperature.enabled ? p.temperature.scale_tc_sigma_pct_per_degc[j] : 0.0;
+    // a platform's rest angle on a stop is known to about this: how hard the servo presses it
+    // into the stop (the twin's MuJoCo press, ~0.006 deg, is the model's mean) differs between
+    // boxes and simulators
+    case kEndPlus: case kEndMinus: return kRestAngleSigmaDeg;
     default: return 0.0;
   }
 }
@@ -465,6 +470,10 @@ CompareResult compare(const Replay& r, const CompareModel& model, const CompareO
           cd.fit.push_back({c, xcols[q], sv.beta[static_cast<Eigen::Index>(q)], sv.sd[static_cast<Eigen::Index>(q)]});
   };
 
+  // systematic candidates; evaluated again once the white level is refitted without the
+  // strongest supported one (a large missing effect would otherwise inflate the fitted noise
+  // density and hide itself and others)
+  auto evaluate_systematic = [&]() {
   // per-channel regression effects, aggregated over channels with positive evidence
   struct PerChannelDef {
     const char* effect;
@@ -676,6 +685,38 @@ CompareResult compare(const Replay& r, const CompareModel& model, const CompareO
       }
     }
     cands.push_back(cd);
+  }
+
+  };
+  evaluate_systematic();
+  for (int pass = 0; pass < 2; ++pass) {
+    const Candidate* top = nullptr;
+    for (const auto& cd : cands)
+      if (cd.testable && !cd.fit.empty() && cd.kind != "adc" && cd.evidence > opt.evidence_threshold &&
+          (!top || cd.evidence > top->evidence))
+        top = &cd;
+    if (!top) break;
+    bool changed = false;
+    for (int c = 0; c < 6; ++c) {
+      Chan& C = ch[c];
+      std::vector<double> zr = nuisance_residual(C);
+      bool touched = false;
+      for (const auto& f : top->fit) {
+        if (f.channel != c) continue;
+        const int i = C.index(f.column);
+        if (i < 0) continue;
+        touched = true;
+        for (std::size_t b = 0; b < mb; ++b) zr[b] -= C.raw_cols(static_cast<Eigen::Index>(b), i) * f.beta;
+      }
+      if (!touched) continue;
+      const double before = C.noise.white_dps_rthz;
+      fit_white(C, zr);
+      if (std::abs(C.noise.white_dps_rthz / before - 1.0) > 0.02) changed = true;
+      build_gram(C);
+    }
+    if (!changed) break;
+    cands.clear();
+    evaluate_systematic();
   }
 
   // ---- full-rate residual after the nuisance fit (for rms, regimes, windows, ADEV) ----

@@ -24,9 +24,12 @@ struct ReplayOptions {
   double flip_rate_threshold_dps = 0.5; // deg/s; a platform turning faster than this is flipping
   double flip_guard_s = 0.05;           // s; samples this close to a flip count as flipping
   double static_rate_limit_dps = 0.5;   // deg/s; without ref_q, larger gyro swings mean "moving"
-  double replay_error_limit_dps = 0.01; // deg/s; samples whose rebuilt rate may be off by more
-                                        // (kinks of the rate between samples) are left out
-  double rough_guard_s = 0.03;          // s; samples this close to such a kink are left out too
+  double replay_error_limit_dps = 0.01; // deg/s; a kink of the rate whose spike in the second
+                                        // difference of the interval mean rates exceeds this ...
+  double kink_ratio = 8.0;              // ... and this many times its +-0.5 s neighbourhood's mean
+                                        // is left out (the rate cannot be rebuilt there)
+  double rough_guard_s = 0.03;          // s; samples this close to such a kink (plus the FIR's
+                                        // half length) are left out too
   /// Throws std::invalid_argument naming the field on a bad value.
   void validate() const;
 };
