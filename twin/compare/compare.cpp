@@ -304,6 +304,46 @@ CompareResult compare(const Replay& r, const CompareModel& model, const CompareO
       resid[c][k] = r.usable[k] ? r.gyro_dps[s][k][j] - pred[s].gyro_dps[k][j] : kNaN;
     }
   }
+  // a platform that leaves its stop while the log says it rests (lifted by a box acceleration
+  // the servo cannot hold, or bouncing after a flip) turns the sensor about the hinge axis only:
+  // the residual along the hinge jumps between samples far beyond the noise while the other
+  // axes do not. Those bursts are left out (no model here predicts them) and counted.
+  for (int s = 0; s < 2; ++s) {
+    const Eigen::Vector3d a = r.hinge_axis[s];
+    std::vector<double> dh(n, 0.0), doff(n, 0.0);
+    std::vector<double> sample;
+    for (std::size_t k = 1; k < n; ++k) {
+      if (!mask[k] || !mask[k - 1]) continue;
+      Eigen::Vector3d d;
+      for (int j = 0; j < 3; ++j) d[j] = resid[s * 3 + j][k] - resid[s * 3 + j][k - 1];
+      dh[k] = std::abs(a.dot(d));
+      doff[k] = (d - a * a.dot(d)).norm();
+      if (k % 3 == 0) sample.push_back(dh[k]);
+    }
+    if (sample.size() < 20) continue;
+    const double sd = 1.4826 * median_abs(sample);  // robust spread of the hinge differences
+    const auto guard = static_cast<std::size_t>(std::ceil(0.1 * fs));
+    std::vector<std::uint8_t> bad(n, 0);
+    for (std::size_t k = 1; k < n; ++k) {
+      if (!(dh[k] > 12.0 * sd && dh[k] > 3.0 * doff[k])) continue;
+      const std::size_t lo = k >= guard ? k - guard : 0, hi = std::min(n - 1, k + guard);
+      for (std::size_t i = lo; i <= hi; ++i) bad[i] = 1;
+    }
+    std::size_t cnt = 0;
+    for (std::size_t k = 0; k < n; ++k) {
+      if (bad[k] && mask[k]) {
+        mask[k] = 0;
+        ++cnt;
+      }
+    }
+    if (cnt > 0) {
+      out.notes.push_back(fmt::format(
+          "{} samples where platform {} turned about its hinge while the log says it rests (gyro {} jumps "
+          "along the hinge axis beyond 12x its noise, the other axes do not: the platform left its stop) are "
+          "left out of the fits",
+          cnt, s + 1, s + 1));
+    }
+  }
   out.samples_used = static_cast<std::size_t>(std::count(mask.begin(), mask.end(), 1));
   if (out.samples_used < 50) {
     throw std::runtime_error(fmt::format("{}: only {} samples with both platforms at rest and known "
@@ -706,7 +746,9 @@ CompareResult compare(const Replay& r, const CompareModel& model, const CompareO
         const int i = C.index(f.column);
         if (i < 0) continue;
         touched = true;
-        for (std::size_t b = 0; b < mb; ++b) zr[b] -= C.raw_cols(static_cast<Eigen::Index>(b), i) * f.beta;
+        // the candidate's coefficient is the total; the nuisance fit already took beta_null
+        const double d = f.beta - C.beta_null[i];
+        for (std::size_t b = 0; b < mb; ++b) zr[b] -= C.raw_cols(static_cast<Eigen::Index>(b), i) * d;
       }
       if (!touched) continue;
       const double before = C.noise.white_dps_rthz;
@@ -829,7 +871,8 @@ CompareResult compare(const Replay& r, const CompareModel& model, const CompareO
       if (f.channel != c) continue;
       const int i = C.index(f.column);
       if (i < 0) continue;
-      for (std::size_t b = 0; b < mb; ++b) zr[b] -= C.raw_cols(static_cast<Eigen::Index>(b), i) * f.beta;
+      const double d = f.beta - C.beta_null[i];  // the nuisance fit already took beta_null
+      for (std::size_t b = 0; b < mb; ++b) zr[b] -= C.raw_cols(static_cast<Eigen::Index>(b), i) * d;
     }
     return zr;
   };
@@ -1319,7 +1362,10 @@ CompareResult compare(const Replay& r, const CompareModel& model, const CompareO
       for (std::size_t k = 0; k < n; ++k) {
         double v = e_nuis[c][k];
         for (const auto& f : cd.fit)
-          if (f.channel == c) v -= column_value(in, c / 3, c % 3, f.column, k) * f.beta;
+          if (f.channel == c) {
+            const int i = ch[c].index(f.column);
+            v -= column_value(in, c / 3, c % 3, f.column, k) * (f.beta - (i >= 0 ? ch[c].beta_null[i] : 0.0));
+          }
         es[k] = v;
       }
       std::vector<double> zb(mb);
@@ -1425,19 +1471,19 @@ void apply_candidate(CompareModel& model, const Candidate& c) {
           p.adc_nonlinearity.enabled = true;
           p.adc_nonlinearity.cubic_pct_fs += f.beta / 3.0;
           break;
-        case kMount0: case kMount1: case kMount2:
-          // the rotation is shared by the sensor's three channels: set once (from channel x)
-          if (j == 0 || std::none_of(c.fit.begin(), c.fit.end(), [&](const ColumnFit& g) { return g.channel == f.channel - j; })) {
-            bool first = true;
-            for (const auto& g : c.fit)
-              if (g.channel / 3 == f.channel / 3 && g.column == f.column && g.channel < f.channel) first = false;
-            if (first) {
-              p.mounting_misalignment.enabled = true;
-              p.mounting_misalignment.angles_deg[f.column - kMount0] += f.beta;
-              p.mounting_misalignment.sigma_deg[f.column - kMount0] = 0.0;
-            }
+        case kMount0: case kMount1: case kMount2: {
+          // the rotation is shared by the sensor's three channels (a channel along the rotation
+          // axis has no column): set it once per sensor and angle
+          bool first = true;
+          for (const auto& g : c.fit)
+            if (g.channel / 3 == f.channel / 3 && g.column == f.column && g.channel < f.channel) first = false;
+          if (first) {
+            p.mounting_misalignment.enabled = true;
+            p.mounting_misalignment.angles_deg[f.column - kMount0] += f.beta;
+            p.mounting_misalignment.sigma_deg[f.column - kMount0] = 0.0;
           }
           break;
+        }
         default: break;
       }
     }

@@ -156,18 +156,22 @@ Eigen::Matrix2d settled_stop_offsets_deg(const BoxParams& box) {
     const Eigen::Vector3d p0 = Eigen::Vector3d::Zero();
     const Eigen::Quaterniond q0 = Eigen::Quaterniond::Identity();
     for (int i = 1; i <= 2; ++i) {
-      world.set_platform(i, box.stop_rad(i, side), 0.0);
+      // start just short of the stop: the servo drives it on and presses, as after a flip
+      world.set_platform(i, box.stop_rad(i, side) - side * 0.2 * kRadPerDeg, 0.0);
       world.set_motor_reference(i, side * (box.end_stop_deg + box.motor.overtravel_deg) * kRadPerDeg);
     }
-    for (int step = 0; step < 1000; ++step) {
+    const int steps = 3000, average_from = 2000;  // 3 s at 1 ms; the last second averaged
+    Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+    for (int step = 0; step < steps; ++step) {
       world.set_base(p0, q0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
       mj_step1(m, d);
       world.drive_base(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
       mj_step2(m, d);
+      if (step >= average_from) {
+        for (int i = 1; i <= 2; ++i) sum[i - 1] += world.platform_angle_rad(i) - box.stop_rad(i, side);
+      }
     }
-    for (int i = 1; i <= 2; ++i) {
-      out(i - 1, side > 0 ? 1 : 0) = (world.platform_angle_rad(i) - box.stop_rad(i, side)) * kDegPerRad;
-    }
+    for (int i = 1; i <= 2; ++i) out(i - 1, side > 0 ? 1 : 0) = sum[i - 1] / (steps - average_from) * kDegPerRad;
   }
   return out;
 }
