@@ -20,6 +20,7 @@ namespace {
 
 struct HilOptions {
   std::string source, switch_to, out_dir, estimator_config, scenario, emu_sensor;
+  std::string twin_flips = "scenario";
   double at_s = kNaN;
   double duration_s = kNaN;
   double rate_hz = 100.0;
@@ -48,6 +49,13 @@ int run_hil(const HilOptions& o) {
   ro.seed = o.seed;
   ro.scenario = o.scenario;
   ro.emu_sensor = o.emu_sensor;
+  if (o.twin_flips != "scenario" && o.twin_flips != "bridge") {
+    throw std::invalid_argument("hil: --twin-flips: expected scenario or bridge, got '" + o.twin_flips + "'");
+  }
+  ro.twin_bridge_flips = o.twin_flips == "bridge";
+  if (ro.twin_bridge_flips && o.source != "twin" && o.switch_to != "twin") {
+    throw std::invalid_argument("hil: --twin-flips bridge needs the twin source (--source twin or --switch-to twin)");
+  }
   auto first = hil::make_source_rig(o.source, ro);
   std::unique_ptr<hil::SourceRig> second;
   if (!o.switch_to.empty()) second = hil::make_source_rig(o.switch_to, ro);
@@ -118,7 +126,18 @@ int run_hil(const HilOptions& o) {
   });
   loop.on_event([&](double t, const std::string& text) { fmt::print("{:>10.2f}  event: {}\n", t, text); });
 
-  const hil::LiveStats st = loop.run(*first->source, second ? second->source : nullptr, stop_requested());
+  hil::LiveStats st;
+  try {
+    st = loop.run(*first->source, second ? second->source : nullptr, stop_requested());
+  } catch (const std::exception& e) {
+    // whatever broke mid-run (a disk that filled, a source that threw), the rows so far stay a
+    // valid log that says it is incomplete and why
+    try {
+      writer.finish(false, std::string("hil stopped by an error: ") + e.what());
+    } catch (...) {
+    }
+    throw;
+  }
   writer.finish(st.complete, st.end_reason);
 
   const Eigen::Matrix<double, 6, 1> sig = filter.sigma_dps();
@@ -153,8 +172,12 @@ const bool registered = register_command(60, [](CLI::App& app) {
   cmd->add_option("--baud", o->baud, "Serial link speed, bit/s")->default_val(921600);
   cmd->add_option("--scenario", o->scenario, "twin: scenario YAML file or built-in name (default: the built-in default)");
   cmd->add_option("--emu-sensor", o->emu_sensor,
-                  "emu-i2c: drive the emulated chips with the twin's sensor model preset (mpu6050, ideal) "
-                  "instead of the built-in biases + white noise");
+                  "emu-i2c, emu-serial: drive the emulated chips with the twin's sensor model preset "
+                  "(mpu6050, ideal) instead of the built-in biases + white noise");
+  cmd->add_option("--twin-flips", o->twin_flips,
+                  "twin: who flips the platforms: scenario (its flip_schedule, inside the simulator) or "
+                  "bridge (the bridge's flip schedule commands the twin's servos, --standstill s hold)")
+      ->default_val("scenario");
   cmd->add_option("--seed", o->seed, "Seed of the emulators and the twin")->default_val(1);
   cmd->add_option("--estimator-config", o->estimator_config, "Estimator configuration (key: value, docs/estimator.md)");
   cmd->add_option("--print-every", o->print_every_s, "Terminal line every this much session time, s")->default_val(10.0);

@@ -100,6 +100,19 @@ struct SerialRig final : SourceRig {
   std::string start() override { return firmware ? firmware->start() : std::string(); }
 };
 
+// what the emulated chips measure: the built-in box at rest, or the twin's sensor model preset
+// named by --emu-sensor (the same box, latitude and motors)
+std::unique_ptr<ImuGenerator> make_generator(const RigOptions& opt, const BoxAtRestGenerator::Params& gp,
+                                             const EmulatedMotors* motors) {
+  if (opt.emu_sensor.empty()) return std::make_unique<BoxAtRestGenerator>(gp, motors);
+#if DRIFTLESS_HIL_WITH_TWIN
+  const twin::SensorParams sp = twin::sensor_preset(opt.emu_sensor);
+  return std::make_unique<SensorModelGenerator>(sp, sp, opt.sample_rate_hz, opt.seed, gp, motors);
+#else
+  throw std::invalid_argument("hil: --emu-sensor needs the twin library, which this build lacks");
+#endif
+}
+
 }  // namespace
 
 std::unique_ptr<SourceRig> make_source_rig(const std::string& spec, const RigOptions& opt) {
@@ -141,16 +154,7 @@ std::unique_ptr<SourceRig> make_source_rig(const std::string& spec, const RigOpt
     BoxAtRestGenerator::Params gp = opt.emulated_box;
     gp.sample_rate_hz = opt.sample_rate_hz;
     gp.seed = opt.seed;
-    if (opt.emu_sensor.empty()) {
-      rig->gen = std::make_unique<BoxAtRestGenerator>(gp, rig->emotors.get());
-    } else {
-#if DRIFTLESS_HIL_WITH_TWIN
-      const twin::SensorParams sp = twin::sensor_preset(opt.emu_sensor);
-      rig->gen = std::make_unique<SensorModelGenerator>(sp, sp, opt.sample_rate_hz, opt.seed, gp, rig->emotors.get());
-#else
-      throw std::invalid_argument("hil: --emu-sensor needs the twin library, which this build lacks");
-#endif
-    }
+    rig->gen = make_generator(opt, gp, rig->emotors.get());
     rig->chip1 = std::make_unique<Mpu6050Emulator>(0, *rig->gen, *rig->clk);
     rig->chip2 = std::make_unique<Mpu6050Emulator>(1, *rig->gen, *rig->clk);
     rig->bus = std::make_unique<EmulatedI2cBus>(*rig->clk, rig->vclk);
@@ -179,6 +183,16 @@ std::unique_ptr<SourceRig> make_source_rig(const std::string& spec, const RigOpt
       fp.rate_hz = opt.sample_rate_hz;
       fp.generator = opt.emulated_box;
       fp.generator.seed = opt.seed;
+      if (!opt.emu_sensor.empty()) {
+        make_generator(opt, fp.generator, nullptr);  // an unknown preset fails here, before the run
+        fp.make_generator = [opt, gp = fp.generator](const EmulatedMotors* motors, double rate_hz) {
+          BoxAtRestGenerator::Params g = gp;
+          g.sample_rate_hz = rate_hz;
+          RigOptions o = opt;
+          o.sample_rate_hz = rate_hz;
+          return make_generator(o, g, motors);
+        };
+      }
       // the emulated microcontroller streams in real time: a pty has no "as fast as possible"
       rig->firmware = std::make_unique<FirmwareEmulator>(fp);
       sp.path = fp.link_path;

@@ -24,9 +24,11 @@ struct RigOptions {
   int baud = 921600;             // serial, bit/s
   std::string work_dir = ".";    // emu-serial puts its tty link here
   std::string scenario;          // twin: scenario YAML (empty: the built-in default)
+  bool twin_bridge_flips = false;  // twin: the bridge's flip schedule (standstill_s) commands the
+                                   // twin's servos instead of the scenario's flip_schedule
   std::uint64_t seed = 1;        // emulators and the twin
   BoxAtRestGenerator::Params emulated_box;  // what emu-i2c / emu-serial measure
-  std::string emu_sensor;        // emu-i2c: a twin sensor-model preset ("mpu6050", "ideal")
+  std::string emu_sensor;        // emu-i2c, emu-serial: a twin sensor-model preset ("mpu6050", "ideal")
                                  // instead of the built-in bias + white-noise generator
 };
 

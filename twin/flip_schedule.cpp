@@ -78,10 +78,10 @@ void FlipController::update(double t, const Eigen::Vector2d& rate) {
     if (moving_[k] && t >= profile_[k].end_s() && std::abs(rate[k]) < settle) {
       moving_[k] = false;
       ++flips_;
-      next_flip_s_ = t + p_.standstill_s;
+      next_flip_s_ = external_ ? std::numeric_limits<double>::infinity() : t + p_.standstill_s;
     }
   }
-  if (!any_moving() && t >= next_flip_s_) {
+  if (!external_ && !any_moving() && t >= next_flip_s_) {
     // Fig. 3: platform 2 flips after (+,+) and (-,-), platform 1 after (+,-) and (-,+)
     const int k = flips_ % 2 == 0 ? 1 : 0;
     sign_[k] = -sign_[k];
@@ -89,6 +89,20 @@ void FlipController::update(double t, const Eigen::Vector2d& rate) {
     moving_[k] = true;
     next_flip_s_ = std::numeric_limits<double>::infinity();
   }
+}
+
+void FlipController::take_external_control() {
+  external_ = true;
+  next_flip_s_ = std::numeric_limits<double>::infinity();
+}
+
+void FlipController::command(int i, int sign, double t) {
+  const int k = i - 1;
+  if (sign_[k] == sign) return;  // at that stop already, or on its way there
+  sign_[k] = sign;
+  profile_[k] = TrapezoidProfile(t, ref_[k], target_for(i, sign), box_.motor.max_speed_dps * kRadPerDeg,
+                                 box_.motor.max_accel_dps2 * kRadPerDeg);
+  moving_[k] = true;
 }
 
 }  // namespace driftless::twin

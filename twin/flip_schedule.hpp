@@ -61,6 +61,15 @@ class FlipController {
   /// Initial platform angle (rad) for platform i: on its + stop, or at +flip angle.
   double initial_angle_rad(int i) const;
 
+  /// Hands the flips to an outside commander (the HIL bridge's motor interface): from now on
+  /// the schedule no longer starts flips by itself; command() does.
+  void take_external_control();
+  bool external_control() const { return external_; }
+  /// Starts platform i (1 or 2) at t_s toward its rest angle of sign `sign` (+1 or -1) along the
+  /// same speed/acceleration-limited profile; a move already heading there is left alone.
+  /// A reversal mid-move restarts the profile from the current reference.
+  void command(int i, int sign, double t_s);
+
  private:
   double target_for(int i, int sign) const;
 
@@ -74,6 +83,7 @@ class FlipController {
   double ref_[2] = {0, 0};
   double next_flip_s_;
   long flips_ = 0;            // completed flips; the next flip moves platform 2 when even
+  bool external_ = false;     // flips come from command(), not from the schedule
 };
 
 }  // namespace driftless::twin

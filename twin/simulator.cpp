@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <stdexcept>
+#include <string>
 
 #include <fmt/core.h>
 
@@ -87,10 +88,23 @@ log::Metadata Simulator::metadata() const {
   m.set("platform_readback", readback_name(scenario_.platform_readback));
   m.set("flip_angle_deg", fmt::format("{}", scenario_.flip_schedule.flip_angle_deg));
   m.set("standstill_s", fmt::format("{}", scenario_.flip_schedule.standstill_s));
+  if (flips_.external_control()) m.set("flip_control", "external");
   m.set("end_stop_deg", fmt::format("{}", scenario_.model.box.end_stop_deg));
   m.set("sensor1_preset", scenario_.model.sensor1.preset);
   m.set("sensor2_preset", scenario_.model.sensor2.preset);
   return m;
+}
+
+void Simulator::take_flip_control() { flips_.take_external_control(); }
+
+void Simulator::command_platform(int i, int sign) {
+  if (i != 1 && i != 2) throw std::invalid_argument("command_platform: platform must be 1 or 2, got " + std::to_string(i));
+  if (sign != 1 && sign != -1) throw std::invalid_argument("command_platform: sign must be +1 or -1, got " + std::to_string(sign));
+  if (!flips_.external_control()) {
+    throw std::invalid_argument("command_platform: the scenario's flip schedule drives the servos (call take_flip_control() first)");
+  }
+  // the move starts at the next physics step; a frozen (static fast path) state thaws there
+  flips_.command(i, sign, static_cast<double>(step_) * scenario_.physics_dt_s);
 }
 
 // one physics step at t = step_ * dt: drive the base, command the motors, step MuJoCo;

@@ -61,6 +61,13 @@ class Simulator {
   const Scenario& scenario() const { return scenario_; }
   const Motion& motion() const { return *motion_; }
   const FlipController& flips() const { return flips_; }
+  /// Hands the platform servos to an outside commander (the HIL bridge's motors): the scenario's
+  /// flip schedule stops; command_platform() starts the flips. Logged as flip_control: external.
+  void take_flip_control();
+  /// Drives platform i (1 or 2) toward its rest angle of sign `sign` (+1 / -1), starting at the
+  /// next physics step. Throws std::invalid_argument on a bad platform or sign, or without
+  /// take_flip_control() first.
+  void command_platform(int i, int sign);
   /// The MuJoCo world (model and data at the last sample's physics state) for rendering.
   World& world() { return world_; }
   const World& world() const { return world_; }

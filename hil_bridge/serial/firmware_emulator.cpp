@@ -71,7 +71,8 @@ void FirmwareEmulator::run() {
   EmulatedMotors motors(mcu, p_.motors);
   BoxAtRestGenerator::Params gp = p_.generator;
   gp.sample_rate_hz = p_.rate_hz;
-  BoxAtRestGenerator gen(gp, &motors);
+  const std::unique_ptr<ImuGenerator> gen =
+      p_.make_generator ? p_.make_generator(&motors, p_.rate_hz) : std::make_unique<BoxAtRestGenerator>(gp, &motors);
   SteadyClock wall;
   const double wall0 = wall.now_s() + p_.start_delay_s;
   serial::Decoder commands;
@@ -114,7 +115,7 @@ void FirmwareEmulator::run() {
     fr.t_us = p_.t0_us + static_cast<std::uint32_t>(std::llround(t * 1e6));
     fr.config = static_cast<std::uint8_t>((p_.gyro_fs_sel & 3) | (p_.accel_fs_sel & 3) << 2);
     for (int s = 0; s < 2; ++s) {
-      const ImuReading r = gen.sample(s, t);
+      const ImuReading r = gen->sample(s, t);
       RawRecord rec;
       for (int a = 0; a < 3; ++a) {
         const auto u = static_cast<std::size_t>(a);

@@ -1,5 +1,5 @@
-// The box's microcontroller, emulated: samples two sensors (a BoxAtRestGenerator quantised as an
-// MPU-6050 would), drives the platform motors on command (EmulatedMotors) and streams sample
+// The box's microcontroller, emulated: samples two sensors (a BoxAtRestGenerator, or any
+// ImuGenerator such as the twin's sensor model, quantised as an MPU-6050 would), drives the platform motors on command (EmulatedMotors) and streams sample
 // frames into a pseudo-terminal at the sample rate, from its own thread. The host opens the tty
 // at `link_path` (a symlink to the pty), exactly as it would open /dev/ttyACM0.
 // Faults for tests: corrupt and dropped frames, stray bytes, a pause, a hang-up and replug.
@@ -7,6 +7,8 @@
 
 #include <atomic>
 #include <cstdint>
+#include <functional>
+#include <memory>
 #include <mutex>
 #include <set>
 #include <string>
@@ -36,6 +38,9 @@ struct FirmwareParams {
   double start_delay_s = 0.05;    // wall time before the first frame (the host opens the tty), s
   bool realtime = true;           // pace frames by the wall clock; false: as fast as the pty takes them
   BoxAtRestGenerator::Params generator;
+  /// What the sensors measure, built in the emulator's thread from its motors; empty: a
+  /// BoxAtRestGenerator from `generator` (e.g. the twin's sensor model: hil::SensorModelGenerator)
+  std::function<std::unique_ptr<ImuGenerator>(const EmulatedMotors* motors, double rate_hz)> make_generator;
   EmulatedMotors::Params motors;
   FirmwareFaults faults;
 };

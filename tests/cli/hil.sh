@@ -44,6 +44,39 @@ grep -q "complete: true" "$out/m/log.csv" || fail "emu-i2c with the mpu6050 sens
 "$bin" check --log "$out/c/log.csv" > "$out/c.check"
 grep -q "150 rows" "$out/c.check" || fail "emu-serial: expected 150 rows: $(head -1 "$out/c.check")"
 
+# emu-serial with the twin's sensor model: the ideal preset reads only the Earth rate
+"$bin" hil --source emu-serial --emu-sensor ideal --out "$out/s" --duration 1 > /dev/null
+awk -F, '!/^#/ && $1 != "t" && NF > 6 { for (i = 2; i <= 7; ++i) if (($i)^2 > 0.01^2) bad = 1; n++ }
+         END { exit (bad || n < 90) }' "$out/s/log.csv" \
+  || fail "emu-serial --emu-sensor ideal: gyros not at the Earth rate (the built-in generator's 0.5 deg/s biases?)"
+if "$bin" hil --source emu-serial --emu-sensor nosuchchip --out "$out/s2" --duration 1 2> "$out/s2.err"; then
+  fail "emu-serial: unknown --emu-sensor accepted"
+fi
+
+# the twin with its servos commanded by the bridge's flip schedule: platform 1 flips first
+"$bin" hil --source twin --twin-flips bridge --standstill 5 --duration 30 --out "$out/tb" > /dev/null
+grep -q "^# flip_control: bridge" "$out/tb/log.csv" || fail "twin bridge flips: metadata"
+# the positions the platforms rested at, in order (columns 8, 9: plat1_deg, plat2_deg)
+order=$(awk -F, '!/^#/ && $1 != "t" && $8 != "" && $9 != "" { p = ($8 + 0) "," ($9 + 0); if (p != last) { printf "%s ", p; last = p } }' "$out/tb/log.csv")
+[[ $order == "90,90 -90,90 -90,-90 90,-90 "* ]] || fail "twin bridge flips: positions '$order', expected the bridge's cycle 90,90 -90,90 -90,-90 90,-90"
+"$bin" check --log "$out/tb/log.csv" > "$out/tb.check" || fail "twin bridge flips: check"
+
+# a run killed mid-way (SIGKILL: no chance to finish) leaves a valid log that says so
+"$bin" hil --source emu-i2c --realtime --out "$out/k" --duration 60 > /dev/null 2>&1 &
+pid=$!
+for _ in $(seq 100); do  # until at least 1 s of rows reached the disk (at most 20 s)
+  [[ -f "$out/k/log.csv" && $(grep -vc '^#' "$out/k/log.csv") -gt 101 ]] && break
+  sleep 0.2
+done
+kill -KILL "$pid"
+wait "$pid" 2> /dev/null || true
+grep -q "^# complete: false" "$out/k/log.csv" || fail "killed run: the log does not say complete: false"
+"$bin" check --log "$out/k/log.csv" > "$out/k.check" 2> "$out/k.err" || { cat "$out/k.err"; fail "killed run: check refuses the log"; }
+rows=$(grep -o "[0-9]* rows" "$out/k.check" | head -1 | cut -d' ' -f1)
+[[ ${rows:-0} -ge 100 ]] || fail "killed run: only '${rows:-0}' rows in the log"
+"$bin" estimate --log "$out/k/log.csv" --out "$out/k_est" > /dev/null 2> "$out/k_est.err" \
+  || { cat "$out/k_est.err"; fail "killed run: estimate refuses the log"; }
+
 # a missing device: one clear error, non-zero exit, no log
 for src in i2c:/dev/i2c-77 serial:/dev/ttyNoSuchPort; do
   if "$bin" hil --source "$src" --out "$out/d" > "$out/d.txt" 2> "$out/d.err"; then fail "$src: exit 0"; fi
@@ -51,6 +84,9 @@ for src in i2c:/dev/i2c-77 serial:/dev/ttyNoSuchPort; do
   grep -q "${src#*:}" "$out/d.err" || fail "$src: error does not name the device: $(cat "$out/d.err")"
   [ ! -e "$out/d/log.csv" ] || fail "$src: a log was written"
 done
+# --twin-flips bridge without the twin is refused
+if "$bin" hil --source emu-i2c --twin-flips bridge --out "$out/g" --duration 1 2> "$out/g.err"; then fail "--twin-flips without twin accepted"; fi
+grep -q "needs the twin source" "$out/g.err" || fail "--twin-flips without twin: $(cat "$out/g.err")"
 # a bad switch request is refused before anything runs
 if "$bin" hil --source emu-i2c --switch-to emu-serial --out "$out/e" --duration 1 2> "$out/e.err"; then fail "--switch-to without --at accepted"; fi
 echo "hil: ok"

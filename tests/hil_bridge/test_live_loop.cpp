@@ -19,6 +19,8 @@
 #include "hil_bridge/i2c/i2c_source.hpp"
 #include "hil_bridge/live_loop.hpp"
 #include "hil_bridge/replay_source.hpp"
+#include "hil_bridge/serial/firmware_emulator.hpp"
+#include "hil_bridge/serial/serial_source.hpp"
 
 namespace driftless::hil {
 namespace {
@@ -275,6 +277,49 @@ TEST(LiveLoop, DeviceGoneForGoodLeavesAnIncompleteButValidLog) {
   const Result r = read_back(path, st);
   EXPECT_FALSE(r.meta.complete());
   EXPECT_NEAR(static_cast<double>(r.rows.size()), 500.0, 2.0);
+  EXPECT_EQ(events_with(r, "gave up"), 1);
+  fs::remove(path);
+}
+
+TEST(LiveLoop, SerialLinkGoneForGoodLeavesAnIncompleteButValidLog) {
+  // GIVEN the emulated microcontroller on a pty whose tty vanishes for good 1 s into the run
+  FirmwareParams fp;
+  fp.link_path = temp_file("gone.tty").string();
+  fp.rate_hz = 100.0;
+  fp.faults.hangup_from_s = 1.0;
+  fp.faults.hangup_to_s = 1e9;
+  FirmwareEmulator emu(fp);
+  ASSERT_EQ(emu.start(), "");
+  SteadyClock clock;
+  SerialSourceParams sp;
+  sp.path = fp.link_path;
+  SerialSource src(clock, sp);
+  ASSERT_TRUE(src.configure().ok());
+  const fs::path path = temp_file("serial-gone.csv");
+  LiveStats st;
+  // WHEN the live loop records it and gives up after 1 s of failed reconnects
+  {
+    log::LogWriter writer(path, box_meta(), src.fields());
+    LiveParams lp;
+    lp.duration_s = 30.0;
+    lp.give_up_after_s = 1.0;
+    LiveLoop loop(lp, clock, &writer, nullptr);
+    std::atomic<bool> stop{false};
+    st = loop.run(src, nullptr, stop);
+    writer.finish(st.complete, st.end_reason);
+  }
+  emu.stop();
+  // THEN the run is not complete, says why, and the log holds every row before the hang-up
+  EXPECT_FALSE(st.complete);
+  EXPECT_NE(st.end_reason.find("lost"), std::string::npos) << st.end_reason;
+  const Result r = read_back(path, st);
+  EXPECT_FALSE(r.meta.complete());
+  // t = 0.00 .. 0.99 s were sent; a frame still in the pty when it closed is gone with it (the
+  // kernel drops it), so allow a few at the end, but no gap and nothing invented before that
+  EXPECT_LE(r.rows.size(), 100u);
+  EXPECT_GE(r.rows.size(), 90u);
+  for (std::size_t i = 0; i < r.rows.size(); ++i) EXPECT_NEAR(r.rows[i].t_s, 0.01 * static_cast<double>(i), 1e-9);
+  EXPECT_GE(events_with(r, "disconnected"), 1);
   EXPECT_EQ(events_with(r, "gave up"), 1);
   fs::remove(path);
 }
