@@ -34,7 +34,7 @@ grep -q "data:image/png;base64," "$t/c0/report.html" || fail "report.html embeds
 # 2. diagnose --apply: scale_factor on sensor 1 ranks first and is written to the model
 "$bin" diagnose --log "$log" --model "$t/model.yaml" --out "$t/d0" --apply "$t/new.yaml" > "$t/d0.out" ||
   { cat "$t/d0.out"; fail "diagnose --apply"; }
-head -1 "$t/d0.out" | grep -q "missing effect: scale_factor on sensor 1" || { cat "$t/d0.out"; fail "diagnose: wrong winner"; }
+grep -q "^missing_effect: missing effect: scale_factor on sensor 1" "$t/d0.out" || { cat "$t/d0.out"; fail "diagnose: wrong winner"; }
 grep -q "value_pct" "$t/new.yaml" || fail "new.yaml lacks the fitted scale factor"
 "$bin" simulate --scenario "$t/new.yaml" --duration 1 --out "$t/sim_new" > /dev/null || fail "simulate cannot read new.yaml"
 

@@ -470,6 +470,46 @@ CompareResult compare(const Replay& r, const CompareModel& model, const CompareO
         zr[b] -= C.raw_cols(static_cast<Eigen::Index>(b), i) * C.beta_null[i];
     return zr;
   };
+  // all coefficients of channel C given a candidate's fitted columns: the candidate's values,
+  // and the nuisance re-fitted (MAP) with those columns held, from the whitened Gram:
+  // beta_N = (G_NN + sigma^2/prior^2)^-1 (G_Ny - G_NX beta_X)
+  auto coefficients_given = [&](const Chan& C, int c, const Candidate& cd) {
+    const int P = static_cast<int>(C.cols.size());
+    Eigen::VectorXd coef = Eigen::VectorXd::Zero(P);
+    std::vector<int> held;
+    for (const auto& f : cd.fit) {
+      if (f.channel != c) continue;
+      const int i = C.index(f.column);
+      if (i < 0) continue;
+      coef[i] = f.beta;
+      held.push_back(i);
+    }
+    std::vector<int> N;
+    for (int i = 0; i < P; ++i)
+      if (C.prior[i] > 0 && std::find(held.begin(), held.end(), i) == held.end()) N.push_back(i);
+    if (!N.empty()) {
+      const int k = static_cast<int>(N.size());
+      Eigen::MatrixXd Am(k, k);
+      Eigen::VectorXd bv(k);
+      for (int a = 0; a < k; ++a) {
+        for (int b = 0; b < k; ++b) Am(a, b) = C.G(N[a], N[b]);
+        Am(a, a) += C.sigma2 / (C.prior[N[a]] * C.prior[N[a]]);
+        bv[a] = C.G(N[a], P);
+        for (int h : held) bv[a] -= C.G(N[a], h) * coef[h];
+      }
+      const Eigen::VectorXd x = Am.ldlt().solve(bv);
+      for (int a = 0; a < k; ++a) coef[N[a]] = x[a];
+    }
+    return coef;
+  };
+  auto block_residual_given = [&](const Chan& C, const Eigen::VectorXd& coef) {
+    std::vector<double> zr = C.z;
+    for (int i = 0; i < static_cast<int>(C.cols.size()); ++i) {
+      if (coef[i] == 0.0) continue;
+      for (std::size_t b = 0; b < mb; ++b) zr[b] -= C.raw_cols(static_cast<Eigen::Index>(b), i) * coef[i];
+    }
+    return zr;
+  };
   for (auto& C : ch) {
     fit_white(C, C.z);
     build_gram(C);
@@ -739,17 +779,9 @@ CompareResult compare(const Replay& r, const CompareModel& model, const CompareO
     bool changed = false;
     for (int c = 0; c < 6; ++c) {
       Chan& C = ch[c];
-      std::vector<double> zr = nuisance_residual(C);
       bool touched = false;
-      for (const auto& f : top->fit) {
-        if (f.channel != c) continue;
-        const int i = C.index(f.column);
-        if (i < 0) continue;
-        touched = true;
-        // the candidate's coefficient is the total; the nuisance fit already took beta_null
-        const double d = f.beta - C.beta_null[i];
-        for (std::size_t b = 0; b < mb; ++b) zr[b] -= C.raw_cols(static_cast<Eigen::Index>(b), i) * d;
-      }
+      for (const auto& f : top->fit) touched = touched || (f.channel == c && C.index(f.column) >= 0);
+      const std::vector<double> zr = touched ? block_residual_given(C, coefficients_given(C, c, *top)) : std::vector<double>{};
       if (!touched) continue;
       const double before = C.noise.white_dps_rthz;
       fit_white(C, zr);
@@ -865,16 +897,8 @@ CompareResult compare(const Replay& r, const CompareModel& model, const CompareO
       if (!sys_on[f.channel] || cd.evidence > sys_on[f.channel]->evidence) sys_on[f.channel] = &cd;
   }
   auto noise_residual = [&](const Chan& C, int c) {
-    std::vector<double> zr = nuisance_residual(C);
-    if (!sys_on[c]) return zr;
-    for (const auto& f : sys_on[c]->fit) {
-      if (f.channel != c) continue;
-      const int i = C.index(f.column);
-      if (i < 0) continue;
-      const double d = f.beta - C.beta_null[i];  // the nuisance fit already took beta_null
-      for (std::size_t b = 0; b < mb; ++b) zr[b] -= C.raw_cols(static_cast<Eigen::Index>(b), i) * d;
-    }
-    return zr;
+    if (!sys_on[c]) return nuisance_residual(C);
+    return block_residual_given(C, coefficients_given(C, c, *sys_on[c]));
   };
   {
     struct NoiseRes { double ev; std::vector<FittedParam> params; double gain; };
@@ -1358,14 +1382,15 @@ CompareResult compare(const Replay& r, const CompareModel& model, const CompareO
       bool touched = false;
       for (const auto& f : cd.fit) touched = touched || f.channel == c;
       if (!touched) continue;
+      // the candidate's columns at their fitted values, the nuisance re-fitted given them
+      const Eigen::VectorXd coef = coefficients_given(ch[c], c, cd);
       std::vector<double> es(n);
       for (std::size_t k = 0; k < n; ++k) {
         double v = e_nuis[c][k];
-        for (const auto& f : cd.fit)
-          if (f.channel == c) {
-            const int i = ch[c].index(f.column);
-            v -= column_value(in, c / 3, c % 3, f.column, k) * (f.beta - (i >= 0 ? ch[c].beta_null[i] : 0.0));
-          }
+        for (int i = 0; i < static_cast<int>(ch[c].cols.size()); ++i) {
+          const double d = coef[i] - ch[c].beta_null[i];
+          if (d != 0.0) v -= column_value(in, c / 3, c % 3, ch[c].cols[i], k) * d;
+        }
         es[k] = v;
       }
       std::vector<double> zb(mb);
