@@ -4,8 +4,10 @@ add_library(driftless_flags INTERFACE)
 add_library(driftless::flags ALIAS driftless_flags)
 target_compile_options(driftless_flags INTERFACE -Wall -Wextra -Werror)
 if(DRIFTLESS_SANITIZE)
+  # -O1 (after the build type's flags, so it wins): the sanitizer pass runs the suite 2-3x faster
+  # than at -O0 and ASan still sees every access; debug info stays for the reports
   target_compile_options(driftless_flags INTERFACE
-    -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer)
+    -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer -O1 -g)
   target_link_options(driftless_flags INTERFACE -fsanitize=address,undefined)
 endif()
 

@@ -47,6 +47,24 @@ Eigen::Vector3d roll_pitch_yaw_deg(const Eigen::Quaterniond& q) {
   return Eigen::Vector3d(roll, pitch, yaw) * kDegPerRad;
 }
 
+void ErrorAccumulator::add(const Eigen::Quaterniond& q_est, const Eigen::Quaterniond& q_ref) {
+  const Eigen::Quaterniond err = q_est.normalized() * q_ref.normalized().conjugate();
+  if (started_) {
+    Eigen::Quaterniond d = err * last_err_.conjugate();  // the error's increment, ENU
+    if (d.w() < 0.0) d.coeffs() = -d.coeffs();
+    const double vn = d.vec().norm();
+    if (vn > 0.0) acc_rad_ += d.vec() / vn * (2.0 * std::atan2(vn, d.w()));
+  } else {
+    // the starting error (normally none: both start at ref) counts in full
+    Eigen::Quaterniond d = err;
+    if (d.w() < 0.0) d.coeffs() = -d.coeffs();
+    const double vn = d.vec().norm();
+    if (vn > 0.0) acc_rad_ = d.vec() / vn * (2.0 * std::atan2(vn, d.w()));
+    started_ = true;
+  }
+  last_err_ = err;
+}
+
 AttitudeError attitude_error(const Eigen::Quaterniond& q_est, const Eigen::Quaterniond& q_ref) {
   // the error rotation in ENU, E = q_est q_ref^-1, as a rotation vector: its Up part is the
   // heading error, its North/East parts the tilt (roll/pitch for a box facing north); unlike

@@ -47,6 +47,26 @@ struct AttitudeError {
 };
 AttitudeError attitude_error(const Eigen::Quaterniond& q_est, const Eigen::Quaterniond& q_ref);
 
+/// Accumulated (unwrapped) attitude error: the sum of the error rotation's increments between
+/// successive comparisons, q_err,k q_err,k-1^-1 in ENU, as one rotation vector. Unlike the error
+/// angle, which never exceeds 180 deg and folds back once an uncorrected gyro has turned the
+/// estimate half a turn, its norm keeps growing with the drift, so a drift rate fitted to it
+/// stays true for hours of a biased raw gyro. While the error is small both agree to first order.
+/// Each increment must stay below 180 deg (rate error times comparison spacing).
+class ErrorAccumulator {
+ public:
+  /// Adds the comparison q_est against q_ref; the first call only sets the starting error.
+  void add(const Eigen::Quaterniond& q_est, const Eigen::Quaterniond& q_ref);
+  /// |accumulated error rotation vector| in deg (0 before two comparisons).
+  double angle_deg() const { return acc_rad_.norm() * kDegPerRad; }
+  bool started() const { return started_; }
+
+ private:
+  Eigen::Quaterniond last_err_ = Eigen::Quaterniond::Identity();
+  Eigen::Vector3d acc_rad_ = Eigen::Vector3d::Zero();
+  bool started_ = false;
+};
+
 /// Roll, pitch, yaw (deg) of q_enu_from_body, ZYX convention.
 Eigen::Vector3d roll_pitch_yaw_deg(const Eigen::Quaterniond& q_enu_from_body);
 

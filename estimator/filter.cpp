@@ -504,25 +504,29 @@ void DriftlessFilter::commit(const Eigen::Vector3d& y1, const Eigen::Vector3d& y
 void DriftlessFilter::fuse_rate(const Sample& s, double p1, double p2, bool p1_rest, bool p2_rest) {
   out_.y1c_dps = s.gyro1_dps - x_.segment<3>(kBias1.start);
   out_.y2c_dps = s.gyro2_dps - x_.segment<3>(kBias2.start);
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero(), raw = Eigen::Vector3d::Zero();
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero(), raw = Eigen::Vector3d::Zero(),
+                  fixed = Eigen::Vector3d::Zero();
   int n = 0;
   // a sensor on a moving platform also reads its hinge rate; only resting ones enter the fusion
   if (p1_rest && finite(p1)) {
     const Eigen::Matrix3d M1 = body_from_sensor(1, p1);
     sum += M1 * out_.y1c_dps;
     raw += M1 * s.gyro1_dps;
+    fixed += M1 * (s.gyro1_dps - fixed_bias_.segment<3>(kBias1.start));
     ++n;
   }
   if (p2_rest && finite(p2)) {
     const Eigen::Matrix3d M2 = body_from_sensor(2, p2);
     sum += M2 * out_.y2c_dps;
     raw += M2 * s.gyro2_dps;
+    fixed += M2 * (s.gyro2_dps - fixed_bias_.segment<3>(kBias2.start));
     ++n;
   }
   out_.sensors_fused = n;
   if (n > 0) {
     out_.rate_body_dps = sum / double(n);
     out_.rate_body_raw_dps = raw / double(n);
+    out_.rate_body_fixed_dps = fixed / double(n);
   }
 }
 

@@ -95,7 +95,7 @@ struct EstimatorConfig {
   double q_override_dps2_per_s = 0.0;      // (deg/s)^2/s, > 0 replaces the spec-derived Q rate
   double r_override_dps2 = 0.0;            // (deg/s)^2 per sample and axis, > 0 replaces R
   double initial_bias_dps = 0.0;           // deg/s, every component of x0
-  double initial_sigma_dps = 5.0;          // deg/s, sqrt of P0's diagonal
+  double initial_sigma_dps = 20.0;         // deg/s, sqrt of P0's diagonal (MPU6050 turn-on +-20)
   double variance_floor_dps2 = 1e-14;      // (deg/s)^2, P's diagonal never drops below this
   double nis_gate_probability = 0.9999;    // chi-square probability of the NIS gate (1 = off)
   /// after this many consecutive gate rejections the filter re-locks: P is widened by the
@@ -164,6 +164,8 @@ struct SampleOutput {
   // sensors whose platform is at rest with a known angle; NaN when none is
   Eigen::Vector3d rate_body_dps = Eigen::Vector3d::Constant(kNaN);
   Eigen::Vector3d rate_body_raw_dps = Eigen::Vector3d::Constant(kNaN);  // the same, uncorrected
+  // the same, corrected by the fixed bias of set_fixed_bias_dps() (the uncorrected rate until set)
+  Eigen::Vector3d rate_body_fixed_dps = Eigen::Vector3d::Constant(kNaN);
   int sensors_fused = 0;  // 0, 1 or 2
   PushStatus status = PushStatus::kInvalid;
 };
@@ -194,6 +196,11 @@ class DriftlessFilter {
   /// paper-mode stacking restarts; the estimate and P are kept. `meta` (optional) may change the
   /// hinge axes and sample rate; time may restart.
   void on_source_switch(const log::Metadata* meta = nullptr);
+
+  /// A bias [b1; b2] (deg/s) held fixed for the comparison output rate_body_fixed_dps: what a box
+  /// whose gyros were calibrated once and never again would use. Zero until set; the filter's
+  /// own state is not touched.
+  void set_fixed_bias_dps(const Vector6d& b) { fixed_bias_ = b; }
 
   /// Bias estimate [b1; b2], deg/s (b_i in sensor-i axes).
   const Vector6d& bias_dps() const { return x_; }
@@ -241,6 +248,7 @@ class DriftlessFilter {
   double q_rate_dps2_per_s_ = 0.0;
 
   Vector6d x_ = Vector6d::Zero();
+  Vector6d fixed_bias_ = Vector6d::Zero();  // deg/s, for rate_body_fixed_dps only
   Matrix6d P_ = Matrix6d::Identity();
   int consecutive_rejections_ = 0;
   double t_filter_s_ = kNaN;  // time P and x refer to

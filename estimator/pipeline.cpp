@@ -25,8 +25,10 @@ EstimateSummary run_estimate(log::LogReader& reader, const EstimatorConfig& cfg,
   const bool have_truth = (reader.fields() & kFieldTrueBias) != 0;
   const bool have_ref = (reader.fields() & kFieldRefQ) != 0;
   sum.attitude_available = have_ref;
-  AttitudeIntegrator att_corr(meta.latitude_deg()), att_raw(meta.latitude_deg());
-  std::vector<double> att_t, att_err_corr, att_err_raw;
+  const double lat = meta.latitude_deg();
+  AttitudeIntegrator att_corr(lat), att_raw(lat), att_fixed(lat);
+  ErrorAccumulator acc_corr, acc_raw, acc_fixed;  // unwrapped errors, every sample with a ref_q
+  std::vector<double> att_t, att_err_corr, att_err_raw, att_err_fixed;
   double next_att_t = kNaN;
 
   // truth statistics accumulators
@@ -72,32 +74,51 @@ EstimateSummary run_estimate(log::LogReader& reader, const EstimatorConfig& cfg,
       }
     }
 
-    // attitude: both integrators start at the first finite ref_q
-    if (have_ref && s.ref_q_wxyz.allFinite()) {
-      if (!att_corr.initialized()) {
+    // attitude: the three integrations start together at the first finite ref_q once the filter
+    // has locked on (every bias sigma below attitude_start_sigma_dps); the bias estimate then is
+    // what a box calibrated once would keep: the `fixed` integration holds it
+    const bool ref_ok = have_ref && s.ref_q_wxyz.allFinite();
+    if (ref_ok && !att_corr.initialized()) {
+      const bool locked = opt.attitude_start_sigma_dps <= 0.0 ||
+                          (filter.has_update() && filter.sigma_dps().maxCoeff() < opt.attitude_start_sigma_dps);
+      if (locked) {
+        filter.set_fixed_bias_dps(filter.bias_dps());  // the next sample's fixed rate uses it
+        sum.fixed_bias_dps = filter.bias_dps();
+        sum.attitude_start_s = s.t_s;
         att_corr.reset(s.q_enu_from_body(), s.t_s);
         att_raw.reset(s.q_enu_from_body(), s.t_s);
+        att_fixed.reset(s.q_enu_from_body(), s.t_s);
         next_att_t = s.t_s;
-      } else {
-        att_corr.step(s.t_s, out.rate_body_dps);
-        att_raw.step(s.t_s, out.rate_body_raw_dps);
       }
+    } else if (att_corr.initialized() && std::isfinite(s.t_s)) {
+      att_corr.step(s.t_s, out.rate_body_dps);
+      att_raw.step(s.t_s, out.rate_body_raw_dps);
+      att_fixed.step(s.t_s, out.rate_body_fixed_dps);
+    }
+    if (ref_ok && att_corr.initialized()) {
+      acc_corr.add(att_corr.q_enu_from_body(), s.q_enu_from_body());
+      acc_raw.add(att_raw.q_enu_from_body(), s.q_enu_from_body());
+      acc_fixed.add(att_fixed.q_enu_from_body(), s.q_enu_from_body());
       if (s.t_s >= next_att_t) {
         AttitudePoint ap;
         ap.t_s = s.t_s;
         ap.corrected = attitude_error(att_corr.q_enu_from_body(), s.q_enu_from_body());
         ap.raw = attitude_error(att_raw.q_enu_from_body(), s.q_enu_from_body());
+        ap.fixed = attitude_error(att_fixed.q_enu_from_body(), s.q_enu_from_body());
+        ap.corrected_accumulated_deg = acc_corr.angle_deg();
+        ap.raw_accumulated_deg = acc_raw.angle_deg();
+        ap.fixed_accumulated_deg = acc_fixed.angle_deg();
         att_t.push_back(ap.t_s);
-        att_err_corr.push_back(ap.corrected.angle_deg);
-        att_err_raw.push_back(ap.raw.angle_deg);
+        // the drift is fitted to the unwrapped error: a raw gyro's error angle folds at 180 deg
+        att_err_corr.push_back(ap.corrected_accumulated_deg);
+        att_err_raw.push_back(ap.raw_accumulated_deg);
+        att_err_fixed.push_back(ap.fixed_accumulated_deg);
         sum.final_corrected = ap.corrected;
         sum.final_raw = ap.raw;
+        sum.final_fixed = ap.fixed;
         if (sink != nullptr) sink->on_attitude(ap);
         next_att_t += opt.attitude_interval_s;
       }
-    } else if (att_corr.initialized() && std::isfinite(s.t_s)) {
-      att_corr.step(s.t_s, out.rate_body_dps);
-      att_raw.step(s.t_s, out.rate_body_raw_dps);
     }
   }
   sum.rows_missing_gyro = reader.rows_with_missing_gyro();
@@ -120,6 +141,13 @@ EstimateSummary run_estimate(log::LogReader& reader, const EstimatorConfig& cfg,
   if (att_t.size() >= 2) {
     sum.drift_corrected_deg_per_h = drift_deg_per_h(att_t, att_err_corr);
     sum.drift_raw_deg_per_h = drift_deg_per_h(att_t, att_err_raw);
+    sum.drift_fixed_deg_per_h = drift_deg_per_h(att_t, att_err_fixed);
+  } else if (have_ref && !att_corr.initialized() && sum.rows > 0) {
+    sum.warnings.push_back(
+        "no attitude comparison: the filter never locked on (every bias sigma below " +
+        std::to_string(opt.attitude_start_sigma_dps) + " deg/s; the largest is " +
+        std::to_string(filter.sigma_dps().maxCoeff()) +
+        " deg/s); an attitude start sigma of 0 compares from the log's start");
   }
   if (!err2_per_update.empty()) {
     const std::size_t n = err2_per_update.size();

@@ -16,8 +16,12 @@ namespace driftless::est {
 /// One attitude comparison point (deg), with and without the DriftLess correction.
 struct AttitudePoint {
   double t_s = kNaN;
-  AttitudeError corrected;
-  AttitudeError raw;
+  AttitudeError corrected;  // with DriftLess: the filter's running bias estimate
+  AttitudeError raw;        // no bias correction at all
+  AttitudeError fixed;      // the bias estimate at the comparison's start, never updated again
+  double corrected_accumulated_deg = kNaN;  // deg, unwrapped errors (ErrorAccumulator)
+  double raw_accumulated_deg = kNaN;
+  double fixed_accumulated_deg = kNaN;
 };
 
 /// Receives the pass's outputs as they happen (all optional).
@@ -34,6 +38,9 @@ class EstimateSink {
 
 struct EstimateRunOptions {
   double attitude_interval_s = 1.0;  // s, spacing of attitude comparison points
+  // deg/s: the attitude comparison starts at the first ref_q once every bias sigma is below this
+  // (the filter has locked on); <= 0 starts it at the log's first ref_q
+  double attitude_start_sigma_dps = 0.05;
   double nees_band_probability = 0.95;  // two-sided chi-square band for the NEES statistics
 };
 
@@ -63,7 +70,10 @@ struct EstimateSummary {
   bool attitude_available = false;   // the log has ref_q
   double drift_corrected_deg_per_h = kNaN;
   double drift_raw_deg_per_h = kNaN;
-  AttitudeError final_corrected, final_raw;
+  double drift_fixed_deg_per_h = kNaN;
+  double attitude_start_s = kNaN;                  // s, where the comparison started
+  Vector6d fixed_bias_dps = Vector6d::Constant(kNaN);  // deg/s, the bias held by `fixed`
+  AttitudeError final_corrected, final_raw, final_fixed;
   TruthStats truth;
   bool log_complete = true;
   std::vector<std::string> warnings;

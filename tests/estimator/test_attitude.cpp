@@ -1,4 +1,5 @@
 // Strapdown attitude against closed forms: Earth-rate removal, a constant turn, the error split.
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -60,6 +61,53 @@ TEST(AttitudeTest, DriftIsTheSlopeOfTheErrorIgnoringItsOffset) {
   }
   EXPECT_NEAR(drift_deg_per_h(t, e), 36.0, 1e-9);
   EXPECT_TRUE(std::isnan(drift_deg_per_h({1.0}, {2.0})));
+}
+
+TEST(AttitudeTest, AccumulatedErrorKeepsGrowingPastHalfATurn) {
+  // GIVEN a static box at the pole (Earth rate along Up, so every rotation here is about Up and
+  // the closed form is exact) whose raw gyro reads a 0.5 deg/s bias about box z (= Up): over one
+  // hour the estimate turns 1800 deg, folding the error angle five times
+  const Eigen::Quaterniond q_ref = Eigen::Quaterniond::Identity();
+  AttitudeIntegrator att(90.0);
+  att.reset(q_ref, 0.0);
+  const Eigen::Vector3d w_earth_dps = att.earth_rate_enu_radps() * kDegPerRad;
+  ErrorAccumulator acc;
+  acc.add(att.q_enu_from_body(), q_ref);
+  std::vector<double> t, wrapped, unwrapped;
+  for (int k = 1; k <= 360000; ++k) {
+    att.step(k * 0.01, w_earth_dps + Eigen::Vector3d(0, 0, 0.5));
+    acc.add(att.q_enu_from_body(), q_ref);
+    if (k % 100 == 0) {
+      t.push_back(k * 0.01);
+      wrapped.push_back(attitude_error(att.q_enu_from_body(), q_ref).angle_deg);
+      unwrapped.push_back(acc.angle_deg());
+    }
+  }
+  // THEN the accumulated error is the closed form 0.5 t and its drift 1800 deg/h,
+  EXPECT_NEAR(acc.angle_deg(), 1800.0, 1e-6);
+  EXPECT_NEAR(drift_deg_per_h(t, unwrapped), 1800.0, 1e-6);
+  // while the folded angle never passes 180 deg and its fitted slope says almost nothing
+  EXPECT_LE(*std::max_element(wrapped.begin(), wrapped.end()), 180.0 + 1e-9);
+  EXPECT_LT(std::fabs(drift_deg_per_h(t, wrapped)), 100.0);
+}
+
+TEST(AttitudeTest, AccumulatedErrorEqualsTheErrorAngleWhileSmall) {
+  // GIVEN a box turning about a tilted axis with a small rate error about another axis
+  AttitudeIntegrator est(30.0), ref(30.0);
+  est.reset(Eigen::Quaterniond::Identity(), 0.0);
+  ref.reset(Eigen::Quaterniond::Identity(), 0.0);
+  ErrorAccumulator acc;
+  acc.add(est.q_enu_from_body(), ref.q_enu_from_body());
+  for (int k = 1; k <= 6000; ++k) {
+    const Eigen::Vector3d w(3.0 * std::sin(0.01 * k), 2.0, -1.0);
+    ref.step(k * 0.01, w);
+    est.step(k * 0.01, w + Eigen::Vector3d(0.0, 0.0, 0.01));
+    acc.add(est.q_enu_from_body(), ref.q_enu_from_body());
+  }
+  // THEN after 60 s (0.6 deg of error) both measures agree to a fraction of a percent
+  const double angle = attitude_error(est.q_enu_from_body(), ref.q_enu_from_body()).angle_deg;
+  EXPECT_GT(angle, 0.3);
+  EXPECT_NEAR(acc.angle_deg(), angle, 0.01 * angle);
 }
 
 TEST(AttitudeTest, NanRateHoldsTheLastRate) {
