@@ -30,6 +30,7 @@ int run_compare(const CompareArgs& a) {
   opt.replay.resample = a.resample;
   if (std::isfinite(model.latitude_deg)) opt.replay.default_latitude_deg = model.latitude_deg;
   const twin::Replay replay = twin::replay_log(a.log, opt.replay);
+  for (const auto& n : replay.notes) fmt::print("note: {}\n", n);
   progress.update(0.3, "replayed");
   if (!a.before.empty()) {
     // before/after: the same log against the earlier model, then the given one

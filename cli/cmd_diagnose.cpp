@@ -28,6 +28,7 @@ int run_diagnose(const DiagnoseArgs& a) {
   opt.replay.resample = a.resample;
   if (std::isfinite(model.latitude_deg)) opt.replay.default_latitude_deg = model.latitude_deg;
   const twin::Replay replay = twin::replay_log(a.log, opt.replay);
+  for (const auto& n : replay.notes) fmt::print("note: {}\n", n);
   const twin::CompareResult r = twin::compare(replay, model, opt);
   progress.update(0.5, "compared");
   fmt::print("{}: {}\n", r.verdict, r.statement);

@@ -186,8 +186,9 @@ void parse_box(const Parser& P, const YAML::Node& n, BoxParams& b) {
 }
 
 void parse_model(const Parser& P, const YAML::Node& n, ModelConfig& m) {
-  P.check_keys(n, "model", {"box", "sensor1", "sensor2"});
+  P.check_keys(n, "model", {"box", "sensor1", "sensor2", "time_offset_s"});
   if (auto b = n["box"]) parse_box(P, b, m.box);
+  P.get(n, "model", "time_offset_s", m.time_offset_s);
   // the sensor blocks belong to the effect catalogue (docs/effects.md); it names file and line
   if (auto v = n["sensor1"]) m.sensor1 = parse_sensor_params(v, m.sensor1, P.file());
   if (auto v = n["sensor2"]) m.sensor2 = parse_sensor_params(v, m.sensor2, P.file());
@@ -310,6 +311,9 @@ const char* readback_name(PlatformReadback r) {
 
 void ModelConfig::validate() const {
   box.validate();
+  if (!(std::abs(time_offset_s) <= 1.0)) {
+    throw std::invalid_argument(fmt::format("model.time_offset_s must be within [-1, 1] s, got {}", time_offset_s));
+  }
   for (const auto* sp : {&sensor1, &sensor2}) {
     try {
       sp->validate();
@@ -459,6 +463,7 @@ std::string emit_scenario(const Scenario& s) {
   emit_sensor_params(out, s.model.sensor1);
   out << YAML::Key << "sensor2" << YAML::Value;
   emit_sensor_params(out, s.model.sensor2);
+  emit_num(out, "time_offset_s", s.model.time_offset_s);
   out << YAML::EndMap;
 
   out << YAML::Key << "motion" << YAML::Value << YAML::BeginMap;

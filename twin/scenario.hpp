@@ -29,6 +29,8 @@ struct ModelConfig {
   BoxParams box;
   SensorParams sensor1 = mpu6050_defaults();  // `model.sensor1`: effect catalogue, docs/effects.md
   SensorParams sensor2 = mpu6050_defaults();  // `model.sensor2`
+  double time_offset_s = 0.0;  // `model.time_offset_s`, s: the sensors sample this long before
+                               // the log's time stamp (0 <= offset <= 1 s in simulate)
   void validate() const;
 };
 

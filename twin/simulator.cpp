@@ -34,6 +34,12 @@ Simulator::Simulator(const Scenario& scenario, SimOptions options)
       earth_enu_radps_(earth_rate_enu_radps(scenario.latitude_deg)),
       steps_per_sample_(scenario.steps_per_sample()),
       total_(scenario.total_samples()) {
+  if (scenario.model.time_offset_s < 0) {
+    throw std::invalid_argument(fmt::format(
+        "model.time_offset_s = {} s: simulate models sensors sampling before the log's time stamp "
+        "(offset >= 0) only; compare and diagnose honour negative offsets",
+        scenario.model.time_offset_s));
+  }
   // each sensor draws its run-to-run values and noise from its own stream of the seed
   sensors_.emplace_back(scenario.model.sensor1, scenario.sample_rate_hz, derive_seed(scenario.seed, 1001));
   sensors_.emplace_back(scenario.model.sensor2, scenario.sample_rate_hz, derive_seed(scenario.seed, 1002));
@@ -177,12 +183,31 @@ void Simulator::fill_sample(Sample& out) {
   out = Sample{};
   out.t_s = truth_.t_s;
   // the sensor-effect catalogue turns the truth into readings (docs/effects.md)
+  // model.time_offset_s: the sensors sampled the truth of `offset` earlier (linear
+  // interpolation between the output samples kept in a short history)
+  const double shift = scenario_.model.time_offset_s * scenario_.sample_rate_hz;
+  Eigen::Vector3d w_in[2] = {truth_.w_sensor_radps[0], truth_.w_sensor_radps[1]};
+  Eigen::Vector3d f_in[2] = {truth_.f_sensor_mps2[0], truth_.f_sensor_mps2[1]};
+  if (shift > 0) {
+    history_.push_back(truth_);
+    const auto keep = static_cast<std::size_t>(std::ceil(shift)) + 2;
+    while (history_.size() > keep) history_.pop_front();
+    const auto whole = static_cast<std::size_t>(std::floor(shift));
+    const double u = shift - static_cast<double>(whole);
+    const std::size_t last = history_.size() - 1;
+    const SampleTruth& a = history_[last >= whole ? last - whole : 0];
+    const SampleTruth& b = history_[last >= whole + 1 ? last - whole - 1 : 0];
+    for (int i = 0; i < 2; ++i) {
+      w_in[i] = (1.0 - u) * a.w_sensor_radps[i] + u * b.w_sensor_radps[i];
+      f_in[i] = (1.0 - u) * a.f_sensor_mps2[i] + u * b.f_sensor_mps2[i];
+    }
+  }
   SensorReading r[2];
   for (int i = 0; i < 2; ++i) {
     SensorTruth st;
     st.t_s = truth_.t_s;
-    st.w_radps = truth_.w_sensor_radps[i];
-    st.f_mps2 = truth_.f_sensor_mps2[i];
+    st.w_radps = w_in[i];
+    st.f_mps2 = f_in[i];
     r[i] = sensors_[static_cast<std::size_t>(i)].step(st);
   }
   out.gyro1_dps = r[0].gyro_radps * kDegPerRad;

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <deque>
 #include <filesystem>
 #include <functional>
 #include <memory>
@@ -102,6 +103,7 @@ class Simulator {
   SampleTruth truth_;
   SampleTruth frozen_truth_;
   MotionState base_;             // motion state at the last output sample
+  std::deque<SampleTruth> history_;  // recent output truths (model.time_offset_s > 0)
 };
 
 /// Result of simulate_to_log().

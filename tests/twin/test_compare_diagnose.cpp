@@ -9,6 +9,7 @@
 #include <string>
 
 #include "tests/twin/compare_test_log.hpp"
+#include "tests/twin/compare_twin_log.hpp"
 #include "twin/compare/compare.hpp"
 
 namespace driftless::twin {
@@ -17,15 +18,7 @@ namespace {
 constexpr double kDuration = 150.0;
 
 // the log's sensor: MPU6050 defaults with the run-to-run draws fixed at zero, noise kept
-SensorParams base_sensor() {
-  SensorParams p = deterministic_part(mpu6050_defaults());
-  p.white_noise.enabled = true;
-  p.bias_instability.enabled = true;
-  p.rate_random_walk.enabled = true;
-  p.quantization.enabled = true;
-  p.constant_bias.value_dps = Eigen::Vector3d(1.5, -2.0, 0.7);
-  return p;
-}
+SensorParams base_sensor() { return twinlog::base_sensor(); }
 
 CompareResult run(const SensorParams& log1, const SensorParams& log2, const SensorParams& model1,
                   const SensorParams& model2, std::uint64_t seed) {

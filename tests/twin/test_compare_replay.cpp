@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
+#include <sstream>
 #include <string>
 
 #include "tests/twin/compare_test_log.hpp"
@@ -89,6 +91,69 @@ TEST(CompareReport, JsonIsDeterministicAndHoldsTheContract) {
   for (const char* key : {"\"verdict\"", "\"ranking\"", "\"effect\"", "\"sensor\"", "\"axis\"", "\"params\"",
                           "\"explained_fraction\"", "\"evidence\"", "\"residual_rms_dps\"", "\"before\"", "\"after_best\""})
     EXPECT_NE(a.find(key), std::string::npos) << key;
+}
+
+TEST(CompareReplay, RateKinksAreMarkedRoughAndLinearRateIsExact) {
+  // GIVEN a static log with one rate kink: from t = 5 s the box turns about z with a constant
+  // acceleration of 200 deg/s^2 (a trapezoid profile's corner)
+  const auto lg = testlog::make_log(ideal(), ideal(), 10.0, 6, 0.0);
+  std::vector<Sample> s = lg.samples;
+  for (auto& x : s) {
+    const double u = std::max(0.0, x.t_s - 5.0);
+    const double yaw = 0.5 * 200.0 * u * u * kRadPerDeg;
+    x.set_q_enu_from_body(Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ())));
+  }
+  // WHEN replayed
+  const Replay r = replay_samples(s, lg.meta, lg.fields, ReplayOptions{}, "kink.csv");
+  // THEN the samples at the kink are rough (left out), the others are not
+  EXPECT_TRUE(r.rough[500]);
+  EXPECT_FALSE(r.rough[400]);
+  EXPECT_FALSE(r.rough[600]);
+  // AND away from it the body rate equals the closed form (exact for a linear rate)
+  const Eigen::Vector3d earth = r.w_body_radps[300];
+  for (std::size_t k : {520u, 700u, 950u}) {
+    const double want = 200.0 * (r.t_s[k] - 5.0) * kRadPerDeg;
+    EXPECT_NEAR((r.w_body_radps[k] - earth)[2], want, 1e-6) << k;
+  }
+}
+
+TEST(CompareReport, EmbeddedPlotsAreNonEmpty) {
+  // GIVEN a comparison with a missing effect
+  SensorParams p = deterministic_part(mpu6050_defaults());
+  p.white_noise.enabled = true;
+  SensorParams q = p;
+  q.scale_factor.value_pct = Eigen::Vector3d(3.0, 0.0, 0.0);
+  const auto lg = testlog::make_log(q, p, 60.0, 7);
+  const Replay r = replay_samples(lg.samples, lg.meta, lg.fields, ReplayOptions{}, "t.csv");
+  CompareModel m = default_compare_model();
+  m.sensor = {p, p};
+  const auto dir = std::filesystem::temp_directory_path() / "driftless_report_plots_test";
+  std::filesystem::remove_all(dir);
+  // WHEN the report is written
+  write_report(compare(r, m, CompareOptions{}), dir);
+  std::ifstream f(dir / "report.html");
+  std::stringstream ss;
+  ss << f.rdbuf();
+  const std::string html = ss.str();
+  // THEN it embeds all four plots, each a PNG of real size, and gnuplot drew data in each
+  int images = 0;
+  for (std::size_t at = html.find("data:image/png;base64,"); at != std::string::npos;
+       at = html.find("data:image/png;base64,", at + 1)) {
+    const std::size_t start = at + 22, end = html.find('\'', start);
+    ASSERT_NE(end, std::string::npos);
+    EXPECT_EQ(html.substr(start, 8), "iVBORw0K");  // base64 of the PNG signature
+    EXPECT_GT(end - start, 8000u) << "image " << images << " is tiny";
+    ++images;
+  }
+  EXPECT_EQ(images, 4) << "plots missing (is gnuplot on PATH?)";
+  for (const char* stem : {"residual", "windows", "adev", "regimes"}) {
+    std::ifstream lf(dir / "plots" / (std::string(stem) + ".log"));
+    std::stringstream ls;
+    ls << lf.rdbuf();
+    EXPECT_EQ(ls.str().find("no valid points"), std::string::npos) << stem << ": " << ls.str();
+    EXPECT_GT(std::filesystem::file_size(dir / "plots" / (std::string(stem) + ".dat")), 100u) << stem;
+  }
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

@@ -20,7 +20,10 @@ struct CompareOptions {
   int worst_windows = 5;            // windows listed by time
   double evidence_threshold = 10.0; // evidence (2 ln-likelihood gain - BIC penalty) for "missing"
   double whiteness_alpha = 1e-3;    // per-channel false-alarm level of the whiteness tests
-  int ljung_box_lags = 20;          // lags of the Ljung-Box portmanteau
+  int ljung_box_lags = 20;          // lags of the Ljung-Box portmanteau (chi-square on lags - 1 dof)
+  double min_effect_fraction = 0.005;  // structure must also explain this fraction of the residual
+                                       // variance (sum of squared autocorrelations, or rho^2 of a
+                                       // correlation) to count: significance alone grows with length
   double correlation_z = 5.0;       // |rho| sqrt(m) above this names a correlated input
   ReplayOptions replay;
   /// Throws std::invalid_argument naming the field.
@@ -70,6 +73,8 @@ struct ChannelSummary {
   double systematic_rms_dps = 0.0;               // sqrt(max(0, rms^2 - floor^2))
   double white_fit_dps_rthz = 0.0;               // N fitted to the residual
   double ljung_box_q = 0.0, ljung_box_p = 1.0;   // whiteness of the block residual
+  double autocorrelation_excess = 0.0;           // sum of squared autocorrelations - lags/m
+  bool white = true;                             // p >= alpha/6 or excess <= min_effect_fraction
   double turn_on_bias_dps = 0.0, turn_on_sigma_dps = 0.0;
   est::AllanCurve adev;                          // of the residual (bias drift kept)
   std::vector<double> adev_model;                // the model's ADEV at the same taus

@@ -1,12 +1,25 @@
 #include "twin/compare/compare_model.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <stdexcept>
 
 #include <fmt/core.h>
+#include <mujoco/mujoco.h>
+
+#include "twin/world.hpp"
 
 namespace driftless::twin {
+
+ModelConfig CompareModel::config() const {
+  ModelConfig c;
+  c.box = box;
+  c.sensor1 = sensor[0];
+  c.sensor2 = sensor[1];
+  c.time_offset_s = time_offset_s;
+  return c;
+}
 
 CompareModel default_compare_model() {
   CompareModel m;
@@ -17,60 +30,58 @@ CompareModel default_compare_model() {
 }
 
 CompareModel load_compare_model(const std::filesystem::path& path) {
-  CompareModel m;
-  m.source = path.string();
-  m.sensor = {mpu6050_defaults(), mpu6050_defaults()};
+  // a file holding only `model:` is a model config; anything else is a scenario. Both go
+  // through twin-core's parser, so every key a user can write is honoured (or refused there).
+  YAML::Node root;
   try {
-    m.root = YAML::LoadFile(path.string());
+    root = YAML::LoadFile(path.string());
+  } catch (const YAML::BadFile&) {
+    throw std::runtime_error(fmt::format("{}: cannot read the model file", path.string()));
   } catch (const YAML::Exception& e) {
     throw std::runtime_error(fmt::format("{}:{}: {}", path.string(), e.mark.line + 1, e.msg));
   }
-  if (!m.root.IsMap()) {
-    throw std::runtime_error(fmt::format("{}: expected a YAML map with a 'model:' key", path.string()));
-  }
-  YAML::Node model = m.root["model"];
-  if (!model) {
+  if (!root.IsMap() || !root["model"]) {
     throw std::runtime_error(fmt::format(
-        "{}: no 'model:' key (a model file holds 'model: {{sensor1: ..., sensor2: ...}}', see "
-        "docs/compare.md)",
+        "{}: no 'model:' key (a model file is a scenario, or a file holding only 'model: {{box: ..., "
+        "sensor1: ..., sensor2: ...}}'; see docs/compare.md)",
         path.string()));
   }
-  for (int s = 0; s < 2; ++s) {
-    const std::string key = s == 0 ? "sensor1" : "sensor2";
-    YAML::Node node = model[key];
-    if (node) m.sensor[s] = parse_sensor_params(node, mpu6050_defaults(), path.string());
+  CompareModel m;
+  m.source = path.string();
+  ModelConfig cfg;
+  if (root.size() == 1) {
+    cfg = load_model_config(path, ModelConfig{});
+  } else {
+    m.scenario = load_scenario(path.string());
+    m.is_scenario = true;
+    cfg = m.scenario.model;
+    m.sample_rate_hz = m.scenario.sample_rate_hz;
+    m.latitude_deg = m.scenario.latitude_deg;
   }
-  auto number = [&](const char* key) {
-    YAML::Node n = m.root[key];
-    if (!n) return kNaN;
-    try {
-      return n.as<double>();
-    } catch (const YAML::Exception&) {
-      throw std::runtime_error(fmt::format("{}:{}: key '{}': expected a number", path.string(),
-                                           n.Mark().line + 1, key));
-    }
-  };
-  m.sample_rate_hz = number("sample_rate_hz");
-  m.latitude_deg = number("latitude_deg");
+  m.sensor = {cfg.sensor1, cfg.sensor2};
+  m.box = cfg.box;
+  m.time_offset_s = cfg.time_offset_s;
   return m;
 }
 
 void save_compare_model(const CompareModel& m, const std::filesystem::path& path) {
-  YAML::Node root = m.root ? YAML::Clone(m.root) : YAML::Node(YAML::NodeType::Map);
-  if (!root["model"]) root["model"] = YAML::Node(YAML::NodeType::Map);
-  for (int s = 0; s < 2; ++s) {
-    YAML::Emitter e;
-    emit_sensor_params(e, m.sensor[s]);
-    root["model"][s == 0 ? "sensor1" : "sensor2"] = YAML::Load(e.c_str());
+  Scenario sc = m.is_scenario ? m.scenario : Scenario{};
+  sc.model = m.config();
+  if (m.is_scenario && std::isfinite(m.latitude_deg)) sc.latitude_deg = m.latitude_deg;
+  sc.validate();
+  std::string text = emit_scenario(sc);
+  if (!m.is_scenario) {
+    // a model-only file stays one: only the `model:` block
+    YAML::Node full = YAML::Load(text);
+    YAML::Emitter out;
+    out.SetDoublePrecision(10);
+    out << YAML::BeginMap << YAML::Key << "model" << YAML::Value << full["model"] << YAML::EndMap;
+    text = out.c_str();
   }
-  if (std::isfinite(m.latitude_deg)) root["latitude_deg"] = m.latitude_deg;
-  if (std::isfinite(m.sample_rate_hz) && !root["sample_rate_hz"]) root["sample_rate_hz"] = m.sample_rate_hz;
-  YAML::Emitter out;
-  out.SetDoublePrecision(10);
-  out << root;
   std::ofstream f(path);
   if (!f) throw std::runtime_error(fmt::format("cannot write {}", path.string()));
-  f << "# written by driftless diagnose --apply (docs/compare.md)\n" << out.c_str() << "\n";
+  f << "# written by driftless diagnose --apply (docs/compare.md)\n" << text << "\n";
+  if (!f) throw std::runtime_error(fmt::format("error writing {}", path.string()));
 }
 
 SensorParams deterministic_part(const SensorParams& p) {
@@ -132,7 +143,49 @@ std::vector<double> dlpf_impulse(const SensorParams& p, double fs) {
 
 }  // namespace
 
-SensorPrediction predict_sensor(const Replay& r, int s, const SensorParams& p) {
+Eigen::Matrix2d settled_stop_offsets_deg(const BoxParams& box) {
+  // the servo's reference runs past the stop by the overtravel (twin/flip_schedule.cpp), so the
+  // platform presses into MuJoCo's soft stop: settle each platform on each stop, level box held
+  // still, and read how far past (nominal + error) it rests
+  Eigen::Matrix2d out = Eigen::Matrix2d::Zero();
+  World world(box, 0.001);
+  mjModel* m = world.model();
+  mjData* d = world.data();
+  for (int side : {-1, 1}) {
+    mj_resetData(m, d);
+    const Eigen::Vector3d p0 = Eigen::Vector3d::Zero();
+    const Eigen::Quaterniond q0 = Eigen::Quaterniond::Identity();
+    for (int i = 1; i <= 2; ++i) {
+      // start just short of the stop: the servo drives it on and presses, as after a flip
+      world.set_platform(i, box.stop_rad(i, side) - side * 0.2 * kRadPerDeg, 0.0);
+      world.set_motor_reference(i, side * (box.end_stop_deg + box.motor.overtravel_deg) * kRadPerDeg);
+    }
+    const int steps = 3000, average_from = 2000;  // 3 s at 1 ms; the last second averaged
+    Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+    for (int step = 0; step < steps; ++step) {
+      world.set_base(p0, q0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
+      mj_step1(m, d);
+      world.drive_base(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
+      mj_step2(m, d);
+      if (step >= average_from) {
+        for (int i = 1; i <= 2; ++i) sum[i - 1] += world.platform_angle_rad(i) - box.stop_rad(i, side);
+      }
+    }
+    for (int i = 1; i <= 2; ++i) out(i - 1, side > 0 ? 1 : 0) = sum[i - 1] / (steps - average_from) * kDegPerRad;
+  }
+  return out;
+}
+
+int on_stop_side(const Replay& r, int s, std::size_t k, const BoxParams& box) {
+  if (r.encoder_readback) return 0;  // an encoder reports the true angle, errors included
+  const double ang = r.plat_deg[s][k];
+  if (!std::isfinite(ang) || r.flipping[k]) return 0;
+  if (std::abs(std::abs(ang) - box.end_stop_deg) > 0.01) return 0;
+  return ang > 0 ? 1 : -1;
+}
+
+SensorPrediction predict_sensor(const Replay& r, int s, const SensorParams& p, const BoxParams& box,
+                                double time_offset_s, const Eigen::Matrix2d& settled_offset_deg) {
   const SensorParams d = deterministic_part(p);
   const SensorInstance inst = draw_sensor_instance(d, 0);
   const TemperatureModel temp(d.temperature);
@@ -146,15 +199,43 @@ SensorPrediction predict_sensor(const Replay& r, int s, const SensorParams& p) {
     const DlpfSetting set = mpu6050_dlpf(d.lowpass_latency.dlpf_cfg);
     lp.d = design_lowpass(set.gyro_bandwidth_hz, set.gyro_delay_s, r.sample_rate_hz);
   }
+  // end-stop errors: the platform rests at nominal + error, so the sensor frame is turned by
+  // the error about the hinge axis relative to the logged angle (twin/world.hpp stop_rad)
+  const Eigen::Vector2d err = (s == 0 ? box.stop1_error_deg : box.stop2_error_deg) +
+                              Eigen::Vector2d(settled_offset_deg.row(s).transpose());  // [-stop, +stop]
+  const Eigen::Matrix3d Rt_minus = platform_rotation(r.hinge_axis[s], err[0]).transpose();
+  const Eigen::Matrix3d Rt_plus = platform_rotation(r.hinge_axis[s], err[1]).transpose();
+  const bool stop_errors = err.cwiseAbs().maxCoeff() > 0.0;
+  // time offset: the sensors sample at t - offset (linear interpolation of the replayed truth)
+  const double shift = time_offset_s * r.sample_rate_hz;
+  auto truth_at = [&](const std::vector<Eigen::Vector3d>& v, std::size_t k) -> Eigen::Vector3d {
+    if (shift == 0.0) return v[k];
+    const double x = std::clamp(static_cast<double>(k) - shift, 0.0, static_cast<double>(n - 1));
+    const auto i = static_cast<std::size_t>(std::floor(x));
+    const double u = x - static_cast<double>(i);
+    if (i + 1 >= n || u == 0.0) return v[i];
+    return (1.0 - u) * v[i] + u * v[i + 1];
+  };
   Eigen::Vector3d last_w = Eigen::Vector3d::Zero(), last_f(0, 0, kStandardGravityMps2);
   for (std::size_t k = 0; k < n; ++k) {
     double tc = r.has_temp ? r.temp_c[s][k] : kNaN;
     if (!std::isfinite(tc)) tc = temp.at(r.t_s[k]);
     out.temp_c[k] = tc;
     // while a hardware platform's angle is unknown the last truth is held (samples unused)
-    if (r.w_radps[s][k].allFinite()) last_w = r.w_radps[s][k];
-    if (r.f_mps2[s][k].allFinite()) last_f = r.f_mps2[s][k];
-    Eigen::Vector3d y = gyro_deterministic_radps(d, inst, last_w, last_f, tc);
+    Eigen::Vector3d w = truth_at(r.w_radps[s], k), f = truth_at(r.f_mps2[s], k);
+    if (w.allFinite()) last_w = w;
+    if (f.allFinite()) last_f = f;
+    w = last_w;
+    f = last_f;
+    if (stop_errors) {
+      const int side = on_stop_side(r, s, k, box);
+      if (side != 0) {
+        const Eigen::Matrix3d& Rt = side > 0 ? Rt_plus : Rt_minus;
+        w = Rt * w;
+        if (!r.has_accel) f = Rt * f;  // logged accelerometers already sense the true frame
+      }
+    }
+    Eigen::Vector3d y = gyro_deterministic_radps(d, inst, w, f, tc);
     if (d.lowpass_latency.enabled) y = lp.apply(y);
     out.gyro_dps[k] = gyro_adc_radps(d, inst, y) * kDegPerRad;
   }

@@ -12,25 +12,34 @@
 #include <yaml-cpp/yaml.h>
 
 #include "twin/compare/replay.hpp"
+#include "twin/scenario.hpp"
 #include "twin/sensor/sensor_model.hpp"
 
 namespace driftless::twin {
 
-/// The parts of a model config a comparison uses.
+/// The model side of a comparison: twin-core's model config (box + sensors, every key of a
+/// scenario's `model:` block) plus the scenario keys a comparison uses.
 struct CompareModel {
-  std::array<SensorParams, 2> sensor;  // sensor1, sensor2
-  double sample_rate_hz = kNaN;        // Hz, the scenario's rate when the file states one
-  double latitude_deg = kNaN;          // deg, the scenario's latitude when stated
+  std::array<SensorParams, 2> sensor;  // sensor1, sensor2 (the working copy of config.sensor1/2)
+  BoxParams box;                       // hinge axes, end stops and their errors, motors
+  double time_offset_s = 0.0;          // s; the sensors sample this long before the log's stamp
+  double sample_rate_hz = kNaN;        // Hz, the scenario's rate when the file is a scenario
+  double latitude_deg = kNaN;          // deg, the scenario's latitude when the file is a scenario
   std::string source;                  // file name, or "embedded MPU6050 defaults"
-  YAML::Node root;                     // the whole file, kept for --apply
+  bool is_scenario = false;            // the file is a whole scenario (else a `model:`-only file)
+  Scenario scenario;                   // the parsed scenario (its other keys are kept by --apply)
+  /// The model config as twin-core holds it.
+  ModelConfig config() const;
 };
 
-/// The embedded default: both sensors mpu6050_defaults().
+/// The embedded default: both sensors mpu6050_defaults(), the default box, no time offset.
 CompareModel default_compare_model();
-/// Reads `model: {sensor1: {...}, sensor2: {...}}` (a scenario file or a file with only `model:`).
-/// Throws std::runtime_error naming the file and key on bad input.
+/// Reads a scenario file or a file with only `model:` through twin-core's parser
+/// (parse_scenario / load_model_config): every key of the model block is honoured.
+/// Throws std::runtime_error naming the file, line and key on bad input.
 CompareModel load_compare_model(const std::filesystem::path& path);
-/// Writes the model (with `root`'s other keys kept) to `path`.
+/// Writes the model to `path` in the form it was read: a whole scenario (emit_scenario) or a
+/// `model:`-only file; both `simulate --scenario` (scenarios) and `compare --model` read it back.
 void save_compare_model(const CompareModel& m, const std::filesystem::path& path);
 
 /// The model's noise-free prediction of one sensor along a replay, deg/s, plus the temperature
@@ -45,8 +54,22 @@ struct SensorPrediction {
 /// quantisation and missing codes off (they cannot be predicted sample by sample).
 SensorParams deterministic_part(const SensorParams& p);
 
-/// Predicts sensor `s` (0 or 1): deterministic chain, DLPF, nonlinearity and saturation.
-SensorPrediction predict_sensor(const Replay& r, int s, const SensorParams& p);
+/// Predicts sensor `s` (0 or 1): deterministic chain, DLPF, nonlinearity and saturation, with
+/// the model's end-stop errors (a platform logged at rest on a stop sits at the stop's true
+/// angle, unless the log's platform_readback is an encoder) and its sensor time offset.
+/// `settled_offset_deg` (platform x [-stop, +stop]) adds how far the servo presses each platform
+/// into its stop (settled_stop_offsets_deg).
+SensorPrediction predict_sensor(const Replay& r, int s, const SensorParams& p, const BoxParams& box = {},
+                                double time_offset_s = 0.0,
+                                const Eigen::Matrix2d& settled_offset_deg = Eigen::Matrix2d::Zero());
+
+/// How far past (nominal + error) each platform rests when its servo presses it onto a stop,
+/// deg, [platform][0: - stop, 1: + stop]: the MuJoCo box settled on its stops (level, still).
+Eigen::Matrix2d settled_stop_offsets_deg(const BoxParams& box);
+
+/// True when platform s (0 or 1) rests on one of its end stops at sample k and the log reports
+/// the nominal stop angle there (end-stop switches), so the box's stop errors apply.
+int on_stop_side(const Replay& r, int s, std::size_t k, const BoxParams& box);
 
 /// Per-sample standard deviation of the model's white noise after its DLPF, deg/s.
 double white_noise_floor_dps(const SensorParams& p, int axis, double sample_rate_hz);

@@ -6,6 +6,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include <Eigen/Dense>
 #include <fmt/core.h>
 
 namespace driftless::twin {
@@ -134,6 +135,25 @@ double largest_rest_swing_dps(const std::vector<Raw>& raw, double fs) {
   return worst;
 }
 
+// taps c_0..c_{M-1} of the symmetric FIR w_k = sum_j c_j (m_{k+j} + m_{k-1-j}) over interval
+// mean rates m: least squares on the response 2 sum_j c_j cos(2 pi f h (j + 1/2)) sinc(f h) = 1
+// for f h in [0, 0.42], with the DC gain held at exactly 1 (a linear rate is rebuilt exactly)
+std::vector<double> interval_mean_fir() {
+  constexpr int M = 4;
+  constexpr int F = 120;
+  Eigen::MatrixXd A(F + 1, M);
+  Eigen::VectorXd b = Eigen::VectorXd::Ones(F + 1);
+  for (int i = 0; i <= F; ++i) {
+    const double x = 0.42 * i / F;  // f h
+    const double sinc = x == 0.0 ? 1.0 : std::sin(kPi * x) / (kPi * x);
+    const double wgt = i == 0 ? 1e4 : 1.0;
+    for (int j = 0; j < M; ++j) A(i, j) = wgt * 2.0 * std::cos(2.0 * kPi * x * (j + 0.5)) * sinc;
+    b[i] = wgt;
+  }
+  const Eigen::VectorXd c = A.colPivHouseholderQr().solve(b);
+  return std::vector<double>(c.data(), c.data() + M);
+}
+
 Replay build(std::vector<Raw> raw, const log::Metadata& meta, std::uint32_t fields,
              const ReplayOptions& opt, const std::string& where) {
   opt.validate();
@@ -148,6 +168,7 @@ Replay build(std::vector<Raw> raw, const log::Metadata& meta, std::uint32_t fiel
   out.has_ref_p = (fields & kFieldRefP) != 0;
   out.has_accel = (fields & kFieldAccel) != 0;
   out.has_temp = (fields & kFieldTemp) != 0;
+  out.encoder_readback = meta.get("platform_readback").value_or("") == "encoder";
   out.hinge_axis[0] = meta.hinge1_axis().normalized();
   out.hinge_axis[1] = meta.hinge2_axis().normalized();
 
@@ -236,14 +257,60 @@ Replay build(std::vector<Raw> raw, const log::Metadata& meta, std::uint32_t fiel
     out.t_s[k] = raw[k].t;
     R_enu_from_body[k] = quat(k).toRotationMatrix();
   }
-  // body rate relative to ENU by central differences of the attitude (right increments give
-  // body axes); the Earth rate is added in body axes. Transport rate (v/R) is neglected.
-  for (std::size_t k = 0; k < n; ++k) {
-    const std::size_t a = k == 0 ? 0 : k - 1;
-    const std::size_t b = k + 1 < n ? k + 1 : n - 1;
-    const Eigen::Quaterniond dq = quat(a).conjugate() * quat(b);
-    const Eigen::Vector3d w_eb = rotation_vector(dq) / (out.t_s[b] - out.t_s[a]);
-    out.w_body_radps[k] = w_eb + R_enu_from_body[k].transpose() * earth_enu;
+  // body rate relative to ENU from the attitude: each interval's rotation (right increments give
+  // body axes) over its length is the mean rate over that interval, i.e. the rate seen through a
+  // one-sample box filter half a sample late. A symmetric FIR over those interval means undoes
+  // the box filter up to 0.42 fs (band-limited reconstruction: a vehicle's 30 Hz vibration is
+  // rebuilt, where central differences lose half of it); it is exact for a rate linear in time.
+  // The Earth rate is added in body axes; the transport rate (v/R) is neglected.
+  out.rough.assign(n, 0);
+  {
+    std::vector<Eigen::Vector3d> mean_rate(n - 1);
+    for (std::size_t k = 0; k + 1 < n; ++k) {
+      const Eigen::Quaterniond dq = quat(k).conjugate() * quat(k + 1);
+      mean_rate[k] = rotation_vector(dq) / (out.t_s[k + 1] - out.t_s[k]);
+    }
+    const std::vector<double> c = interval_mean_fir();
+    const auto M = c.size();
+    for (std::size_t k = 0; k < n; ++k) {
+      Eigen::Vector3d w_eb;
+      if (k >= M && k + M < n) {
+        w_eb.setZero();
+        for (std::size_t j = 0; j < M; ++j) w_eb += c[j] * (mean_rate[k + j] + mean_rate[k - 1 - j]);
+      } else if (k > 0 && k + 1 < n) {
+        w_eb = 0.5 * (mean_rate[k - 1] + mean_rate[k]);
+      } else {
+        w_eb = mean_rate[k == 0 ? 0 : n - 2];
+      }
+      out.w_body_radps[k] = w_eb + R_enu_from_body[k].transpose() * earth_enu;
+    }
+    // a kink of the rate (a motion profile starting or ending an acceleration) is not band
+    // limited: no stencil rebuilds the rate near it. It shows as an isolated spike of the second
+    // difference of the interval means; continuous vibration raises them everywhere and is not a
+    // kink (the FIR rebuilds it).
+    const double limit = opt.replay_error_limit_dps * kRadPerDeg;
+    std::vector<double> d2(n, 0.0), csum(n + 1, 0.0);
+    for (std::size_t k = 1; k + 1 < mean_rate.size(); ++k) {
+      d2[k] = (mean_rate[k + 1] - 2.0 * mean_rate[k] + mean_rate[k - 1]).cwiseAbs().maxCoeff();
+    }
+    for (std::size_t k = 0; k < n; ++k) csum[k + 1] = csum[k] + d2[k];
+    const auto half = static_cast<std::size_t>(std::max(5.0, std::round(0.5 * fs)));
+    const auto spread = static_cast<std::size_t>(std::ceil(opt.rough_guard_s * fs)) + M;
+    for (std::size_t k = 1; k + 1 < n; ++k) {
+      if (d2[k] <= limit) continue;
+      const std::size_t lo = k >= half ? k - half : 0, hi = std::min(n, k + half + 1);
+      const double local = (csum[hi] - csum[lo] - d2[k]) / static_cast<double>(hi - lo - 1);
+      if (d2[k] <= opt.kink_ratio * local) continue;
+      const std::size_t a = k >= spread ? k - spread : 0, b = std::min(n - 1, k + spread + 1);
+      for (std::size_t i = a; i <= b; ++i) out.rough[i] = 1;
+    }
+    const auto rough_count = static_cast<std::size_t>(std::count(out.rough.begin(), out.rough.end(), 1));
+    if (rough_count > 0) {
+      out.notes.push_back(fmt::format(
+          "{} samples ({:.1f} %) near kinks of the reference rate (a motion profile's acceleration steps), where "
+          "the rate cannot be rebuilt from ref_q to within {:.3g} deg/s, are left out of the fits",
+          rough_count, 100.0 * static_cast<double>(rough_count) / static_cast<double>(n), opt.replay_error_limit_dps));
+    }
   }
   // specific force in body axes: second differences of ref_p, else gravity only
   bool p_ok = out.has_ref_p;
@@ -390,6 +457,9 @@ void ReplayOptions::validate() const {
   if (!std::isnan(model_sample_rate_hz)) positive(model_sample_rate_hz, "model_sample_rate_hz");
   positive(flip_rate_threshold_dps, "flip_rate_threshold_dps");
   positive(static_rate_limit_dps, "static_rate_limit_dps");
+  positive(replay_error_limit_dps, "replay_error_limit_dps");
+  positive(kink_ratio, "kink_ratio");
+  if (!(rough_guard_s >= 0)) throw std::invalid_argument("ReplayOptions.rough_guard_s must be >= 0");
   if (!(flip_guard_s >= 0)) throw std::invalid_argument("ReplayOptions.flip_guard_s must be >= 0");
   if (!(std::abs(default_latitude_deg) <= 90)) {
     throw std::invalid_argument("ReplayOptions.default_latitude_deg must be within [-90, 90] deg");

@@ -24,6 +24,12 @@ struct ReplayOptions {
   double flip_rate_threshold_dps = 0.5; // deg/s; a platform turning faster than this is flipping
   double flip_guard_s = 0.05;           // s; samples this close to a flip count as flipping
   double static_rate_limit_dps = 0.5;   // deg/s; without ref_q, larger gyro swings mean "moving"
+  double replay_error_limit_dps = 0.01; // deg/s; a kink of the rate whose spike in the second
+                                        // difference of the interval mean rates exceeds this ...
+  double kink_ratio = 8.0;              // ... and this many times its +-0.5 s neighbourhood's mean
+                                        // is left out (the rate cannot be rebuilt there)
+  double rough_guard_s = 0.03;          // s; samples this close to such a kink (plus the FIR's
+                                        // half length) are left out too
   /// Throws std::invalid_argument naming the field on a bad value.
   void validate() const;
 };
@@ -46,6 +52,7 @@ struct Replay {
   std::array<std::vector<double>, 2> temp_c;             // logged die temperature, NaN if absent
   std::vector<std::uint8_t> usable;    // gyro finite and the truth is known
   std::vector<std::uint8_t> flipping;  // a platform moves, or its angle is unknown
+  std::vector<std::uint8_t> rough;     // the rate cannot be rebuilt from ref_q here (a kink)
   std::array<std::vector<float>, 2> since_flip_s;       // s since platform i last stopped (inf)
   std::array<std::vector<std::int8_t>, 2> last_flip_dir; // +1/-1: direction of that flip, 0 none
   std::array<std::vector<std::int8_t>, 2> rest_side;     // +1/-1 platform at rest on that side, 0
@@ -55,6 +62,7 @@ struct Replay {
   double sample_rate_hz = kNaN;   // Hz, of the replayed series (after any resampling)
   double log_rate_hz = kNaN;      // Hz, as found in the log
   bool resampled = false;
+  bool encoder_readback = false;  // metadata platform_readback: encoder (angles are true angles)
   bool has_ref_q = false, has_ref_p = false, has_accel = false, has_temp = false;
   log::Metadata meta;
   std::string log_path;

@@ -65,23 +65,25 @@ std::string read_file(const std::filesystem::path& p) {
   return ss.str();
 }
 
-// runs gnuplot on a script; returns the PNG bytes or "" when gnuplot is missing/failed
+// runs gnuplot on a script; returns the PNG bytes or "" when gnuplot is missing or failed, or
+// when it found no data to draw (its messages are kept in plots/<stem>.log)
 std::string gnuplot_png(const std::filesystem::path& dir, const std::string& stem, const std::string& script) {
   const auto gp = dir / (stem + ".gp");
   const auto png = dir / (stem + ".png");
-  {
-    std::ofstream f(gp);
-    f << "set terminal pngcairo size 900,420 font 'sans,9'\nset output '" << png.string() << "'\n" << script;
-  }
-  const std::string cmd = fmt::format("gnuplot '{}' > /dev/null 2>&1", gp.string());
-  if (std::system(cmd.c_str()) != 0) {
-    // pngcairo may be absent in gnuplot-nox: fall back to the plain png terminal
-    std::string s2 = script;
-    std::ofstream f(gp);
-    f << "set terminal png size 900,420\nset output '" << png.string() << "'\n" << s2;
-    f.close();
-    if (std::system(cmd.c_str()) != 0) return {};
-  }
+  const auto log = dir / (stem + ".log");
+  auto run = [&](const char* terminal) {
+    std::filesystem::remove(png);
+    {
+      std::ofstream f(gp);
+      f << "set terminal " << terminal << " size 900,420\nset output '" << png.string() << "'\n" << script;
+    }
+    const std::string cmd = fmt::format("gnuplot '{}' > '{}' 2>&1", gp.string(), log.string());
+    return std::system(cmd.c_str()) == 0;
+  };
+  // pngcairo may be absent in gnuplot-nox: fall back to the plain png terminal
+  if (!run("pngcairo font 'sans,9'") && !run("png")) return {};
+  const std::string msgs = read_file(log);
+  if (msgs.find("no valid points") != std::string::npos || msgs.find("all points") != std::string::npos) return {};
   return read_file(png);
 }
 
@@ -135,7 +137,8 @@ std::string diagnosis_json(const CompareResult& r, const ReportExtras& x) {
     const auto& ch = r.channels[c];
     o << "    \"" << channel_name(c) << "\": {\"mean_dps\": " << num(ch.mean_dps) << ", \"raw_mean_dps\": " << num(ch.raw_mean_dps)
       << ", \"white_noise_fit_dps_rthz\": " << num(ch.white_fit_dps_rthz) << ", \"ljung_box_q\": " << num(ch.ljung_box_q)
-      << ", \"ljung_box_p\": " << num(ch.ljung_box_p) << ", \"turn_on_bias_dps\": " << num(ch.turn_on_bias_dps)
+      << ", \"ljung_box_p\": " << num(ch.ljung_box_p)
+      << ", \"autocorrelation_excess\": " << num(ch.autocorrelation_excess) << ", \"white\": " << (ch.white ? "true" : "false") << ", \"turn_on_bias_dps\": " << num(ch.turn_on_bias_dps)
       << ", \"adev_outside_fraction\": " << num(ch.adev_outside_fraction) << "}" << (c < 5 ? ",\n" : "\n");
   }
   o << "  },\n  \"regimes\": [\n";
@@ -196,6 +199,7 @@ void write_report(const CompareResult& r, const std::filesystem::path& dir, cons
       for (int c = 0; c < 6; ++c) d << ' ' << num(r.block_residual_dps[c][b]) << ' ' << num(r.block_bias_dps[c][b]);
       d << '\n';
     }
+    d.close();  // flushed before gnuplot reads it (an open stream left the file empty)
     std::string s = "set multiplot layout 2,1\nset xlabel 't (s)'\nset ylabel 'residual (deg/s)'\nset key outside right\nset datafile missing 'null'\n";
     for (int sn = 0; sn < 2; ++sn) {
       s += fmt::format("set title 'sensor {}: block-mean residual after the nuisance fit (points) and smoothed bias (lines)'\nplot ", sn + 1);
@@ -216,6 +220,7 @@ void write_report(const CompareResult& r, const std::filesystem::path& dir, cons
       for (int c = 0; c < 6; ++c) d << ' ' << num(w.rms_dps[c]);
       d << '\n';
     }
+    d.close();
     std::string s = "set xlabel 't (s)'\nset ylabel 'rms (deg/s)'\nset key outside right\nset title 'windowed residual rms'\nplot ";
     for (int c = 0; c < 6; ++c)
       s += fmt::format("'{}' u 1:{} w lp t '{}'{}", (plot_dir / "windows.dat").string(), 2 + c, channel_name(c), c < 5 ? ", " : "\n");
@@ -234,6 +239,7 @@ void write_report(const CompareResult& r, const std::filesystem::path& dir, cons
       }
       d << '\n';
     }
+    d.close();
     std::string s = "set logscale xy\nset xlabel 'tau (s)'\nset ylabel 'ADEV (deg/s)'\nset key outside right\nset datafile missing 'null'\nset title 'Allan deviation of the residual (points) and of the model noise (lines)'\nplot ";
     for (int c = 0; c < 6; ++c)
       s += fmt::format("'{0}' u {1}:{2} w p t '{3}', '' u {1}:{4} w l dt 2 t '{3} model'{5}", (plot_dir / "adev.dat").string(), 1 + 3 * c,
@@ -248,6 +254,7 @@ void write_report(const CompareResult& r, const std::filesystem::path& dir, cons
       for (int c = 0; c < 6; ++c) d << ' ' << num(r.regimes[i].rms_dps[c]);
       d << '\n';
     }
+    d.close();
     std::string s = "set style data histograms\nset style fill solid 0.8\nset xtics rotate by -30\nset ylabel 'rms (deg/s)'\nset key outside right\nset title 'residual rms by regime'\nplot ";
     for (int c = 0; c < 6; ++c)
       s += fmt::format("'{}' u {}:xtic(1) t '{}'{}", (plot_dir / "regimes.dat").string(), 2 + c, channel_name(c), c < 5 ? ", " : "\n");
@@ -329,7 +336,7 @@ void write_report(const CompareResult& r, const std::filesystem::path& dir, cons
   }
   h << "<h2>Plots</h2>\n";
   for (const auto& [title, png] : plots) {
-    if (png.empty()) h << "<p>" << esc_html(title) << ": gnuplot not available, plot skipped (data in plots/)</p>\n";
+    if (png.empty()) h << "<p>" << esc_html(title) << ": no plot (gnuplot missing or no data to draw; data and gnuplot's messages in plots/)</p>\n";
     else h << "<h3>" << esc_html(title) << "</h3><img alt='" << esc_html(title) << "' src='data:image/png;base64," << base64(png) << "'>\n";
   }
   h << "</body></html>\n";
