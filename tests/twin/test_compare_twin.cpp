@@ -15,7 +15,7 @@ namespace {
 
 using twinlog::find_param;
 
-constexpr double kDuration = 120.0;
+constexpr double kDuration = 90.0;
 
 void expect_error_falls(const CompareResult& before, const CompareResult& after, int c) {
   const auto& b = before.channels[c];
