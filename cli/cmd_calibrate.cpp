@@ -30,7 +30,7 @@ est::CalibMethod parse_method(const std::string& m) {
 }
 
 void print_summary(const est::CalibFit& fit, const twin::calib::RigConditions& rig,
-                   const twin::calib::ExtractReport& rep) {
+                   const twin::calib::ExtractReport& rep, const est::GSensitivityFit& g) {
   fmt::print("calibration ({}), {} segments, Earth rate {}\n", est::method_name(fit.method),
              rig.plan.segments.size(), rep.earth_rate_removed ? "removed" : "NOT removed");
   for (const auto& n : rep.notes) fmt::print("  note: {}\n", n);
@@ -49,7 +49,13 @@ void print_summary(const est::CalibFit& fit, const twin::calib::RigConditions& r
                i + 1, 100 * e.scale_error.x(), 100 * e.scale_error.y(), 100 * e.scale_error.z(),
                e.nonorthogonality_deg.x(), e.nonorthogonality_deg.y(), e.nonorthogonality_deg.z(),
                e.travel_error_deg);
+    if (g.valid) {
+      const auto iu = static_cast<std::size_t>(i);
+      fmt::print("  sensor {}: g-sensitivity |G| {:.4f} deg/s/g (max sigma {:.4f}) from {} segment biases\n", i + 1,
+                 g.G_dps_per_g[iu].norm(), g.G_sigma[iu].maxCoeff(), g.segments);
+    }
   }
+  if (!g.valid) fmt::print("  g-sensitivity not fitted: {}\n", g.reason);
 }
 
 // --prior-out: the calibrated errors as a twin model-config file
@@ -71,6 +77,7 @@ int run_from_log(const Options& o) {
   est::CalibFitOptions fo;
   fo.method = parse_method(o.method.empty() ? "least_squares" : o.method);
   const est::CalibFit fit = est::fit_calibration(segs, fo);
+  const est::GSensitivityFit g = est::fit_g_sensitivity(segs, fit);
   twin::calib::RigConditions rig;
   rig.source = "log " + o.log + ", plan " + o.plan;
   rig.latitude_deg = rep.latitude_deg;
@@ -81,8 +88,8 @@ int run_from_log(const Options& o) {
   rig.hinge2_axis = meta.hinge2_axis();
   rig.plan = plan;
   rig.samples_used = rep.samples_used;
-  twin::calib::save_calib(o.out, fit, rig);
-  print_summary(fit, rig, rep);
+  twin::calib::save_calib(o.out, fit, rig, &g);
+  print_summary(fit, rig, rep, g);
   fmt::print("wrote {}\n", o.out);
   write_prior(o);
   return 0;
@@ -116,6 +123,7 @@ int run_from_scenario(const Options& o) {
   est::CalibFitOptions fo;
   fo.method = parse_method(o.method.empty() ? cs.rig.method : o.method);
   const est::CalibFit fit = est::fit_calibration(segs, fo);
+  const est::GSensitivityFit g = est::fit_g_sensitivity(segs, fit);
   twin::calib::RigConditions rig;
   rig.source = "scenario " + o.scenario + " (the twin's pan/tilt rig)";
   rig.latitude_deg = rep.latitude_deg;
@@ -126,8 +134,8 @@ int run_from_scenario(const Options& o) {
   rig.hinge2_axis = run.meta.hinge2_axis();
   rig.plan = run.plan;
   rig.samples_used = rep.samples_used;
-  twin::calib::save_calib(o.out, fit, rig);
-  print_summary(fit, rig, rep);
+  twin::calib::save_calib(o.out, fit, rig, &g);
+  print_summary(fit, rig, rep, g);
   // the fit against the twin's own true M, absolute and in units of the fit's 1-sigma
   double worst = 0.0, worst_sigma = 0.0;
   for (int i = 0; i < 2; ++i) {

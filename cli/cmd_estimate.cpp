@@ -305,6 +305,8 @@ int run_estimate_cmd(const EstimateArgs& a) {
           meta.hinge2_axis().z()));
     }
     cfg.calibration = est::to_filter_calibration(c.M);
+    // y <- y - G f / g with the log's accelerometer columns (samples without them stay as they are)
+    if (c.has_g_sensitivity) cfg.calibration.G_dps_per_g = c.G_dps_per_g;
   }
   cfg.validate();
 

@@ -389,4 +389,76 @@ CalibErrors describe_errors(const CalibMatrices& m, int sensor, const Eigen::Vec
   return e;
 }
 
+GSensitivityFit fit_g_sensitivity(const std::vector<CalibSegment>& segments, const CalibFit& fit) {
+  GSensitivityFit g;
+  g.valid = true;
+  for (int i = 0; i < 2; ++i) {
+    const auto iu = static_cast<std::size_t>(i);
+    // per segment: [1, f_seg], its temperature and its bias, over both end stops
+    std::vector<Eigen::Vector4d> x;
+    std::vector<double> temp;
+    std::vector<Eigen::Vector3d> y;
+    for (const auto& seg : segments) {
+      if (!seg.f_mean_g[iu].allFinite()) continue;
+      for (const auto& b : fit.fit[iu][static_cast<std::size_t>(seg.pos[iu])].biases) {
+        if (b.segment != seg.name) continue;
+        x.emplace_back(1.0, seg.f_mean_g[iu].x(), seg.f_mean_g[iu].y(), seg.f_mean_g[iu].z());
+        temp.push_back(seg.temp_mean_c[iu]);
+        y.push_back(b.bias_dps);
+      }
+    }
+    const std::string who = "sensor " + std::to_string(i + 1);
+    if (x.size() < 5) {
+      g = GSensitivityFit{};
+      g.reason = who + ": " + std::to_string(x.size()) +
+                 " segments with accelerometer data; the g-sensitivity fit needs 5 or more";
+      return g;
+    }
+    const auto n = static_cast<Eigen::Index>(x.size());
+    Eigen::MatrixXd F(n, 4);
+    for (Eigen::Index k = 0; k < n; ++k) F.row(k) = x[static_cast<std::size_t>(k)].transpose();
+    // the gravity directions must span 3-D (an offset b0 plus 3 slopes)
+    if (Eigen::JacobiSVD<Eigen::MatrixXd>(F).singularValues().minCoeff() < 0.2) {
+      g = GSensitivityFit{};
+      g.reason = who + ": the segments' gravity directions do not span three axes (use the XY, YZ and XZ "
+                       "orientations)";
+      return g;
+    }
+    double t_mean = 0.0, t_min = 1e300, t_max = -1e300;
+    bool t_ok = n >= 6;
+    for (double t : temp) {
+      t_ok = t_ok && std::isfinite(t);
+      t_mean += t / static_cast<double>(n);
+      t_min = std::min(t_min, t);
+      t_max = std::max(t_max, t);
+    }
+    t_ok = t_ok && t_max - t_min > 0.05;
+    if (i == 0) g.temperature_term = t_ok;
+    const bool use_t = g.temperature_term && t_ok;
+    const Eigen::Index p = use_t ? 5 : 4;
+    Eigen::MatrixXd X(n, p), Y(n, 3);
+    X.leftCols(4) = F;
+    for (Eigen::Index k = 0; k < n; ++k) {
+      if (use_t) X(k, 4) = temp[static_cast<std::size_t>(k)] - t_mean;
+      Y.row(k) = y[static_cast<std::size_t>(k)].transpose();
+    }
+    const Eigen::MatrixXd XtX_inv = (X.transpose() * X).inverse();
+    const Eigen::MatrixXd beta = XtX_inv * X.transpose() * Y;  // p x 3: rows b0, G^T, (k_T)
+    const Eigen::MatrixXd res = Y - X * beta;
+    const double dof = static_cast<double>(n - p);
+    for (int j = 0; j < 3; ++j) {
+      const double var = dof > 0 ? res.col(j).squaredNorm() / dof : kNaN;
+      g.residual_rms_dps[iu][j] = std::sqrt(res.col(j).squaredNorm() / static_cast<double>(n));
+      g.b0_dps[iu][j] = beta(0, j);
+      if (use_t) g.bias_tc_dps_per_degc[iu][j] = beta(4, j);
+      for (int c = 0; c < 3; ++c) {
+        g.G_dps_per_g[iu](j, c) = beta(1 + c, j);
+        g.G_sigma[iu](j, c) = std::sqrt(var * XtX_inv(1 + c, 1 + c));
+      }
+    }
+    g.segments = x.size();
+  }
+  return g;
+}
+
 }  // namespace driftless::est

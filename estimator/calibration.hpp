@@ -83,6 +83,11 @@ struct CalibSegment {
   Eigen::Vector3d axis_box = Eigen::Vector3d::UnitZ();  // table rotation axis in box axes (unit)
   double rate_dps = 50.0;               // table rate magnitude
   std::vector<CalibSample> samples;     // plateau samples only
+  /// mean specific force of sensor 1 and 2 over the plateaus, g, sensor axes (from the
+  /// accelerometers); NaN when the log has none. Feeds the g-sensitivity fit.
+  std::array<Eigen::Vector3d, 2> f_mean_g{Eigen::Vector3d::Constant(kNaN), Eigen::Vector3d::Constant(kNaN)};
+  /// mean temperature of sensor 1 and 2 over the plateaus, degC; NaN when the log has none
+  std::array<double, 2> temp_mean_c{kNaN, kNaN};
 };
 
 enum class CalibMethod {
@@ -131,6 +136,31 @@ struct CalibFit {
 /// every coefficient (an orientation missing), or naming the segment when it lacks samples.
 CalibFit fit_calibration(const std::vector<CalibSegment>& segments,
                          const CalibFitOptions& opts = {});
+
+// ---- g-sensitivity from the per-segment biases ------------------------------------------------
+
+/// The g-sensitivity G of each sensor (y += G f, deg/s per g) read from the rig: every segment
+/// holds the box in another orientation, so gravity lies along other sensor axes and the
+/// segment's bias is b_seg = b0 + G f_seg + k_T (T_seg - T_mean). Per output axis j a
+/// least-squares fit of [b0_j, G_j,:, k_T,j] over the segments (both end stops; at least 5
+/// segments with 3 independent gravity directions). The temperature term (the bias drifts while
+/// the chip warms up during the rig, and would otherwise alias into G) is fitted when every
+/// segment has a temperature, there are 6 or more segments and the temperatures spread by more
+/// than 0.05 degC.
+struct GSensitivityFit {
+  bool valid = false;
+  std::string reason;  // why not valid (too few segments, no accelerometer data, degenerate)
+  bool temperature_term = false;
+  std::array<Eigen::Matrix3d, 2> G_dps_per_g{Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero()};
+  std::array<Eigen::Matrix3d, 2> G_sigma{Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero()};
+  std::array<Eigen::Vector3d, 2> bias_tc_dps_per_degc{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  std::array<Eigen::Vector3d, 2> b0_dps{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  std::array<Eigen::Vector3d, 2> residual_rms_dps{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  std::size_t segments = 0;
+};
+/// Fits G from `fit`'s per-segment biases and the segments' mean specific force. Never throws
+/// for missing data: returns valid = false with the reason.
+GSensitivityFit fit_g_sensitivity(const std::vector<CalibSegment>& segments, const CalibFit& fit);
 
 // ---- reading a fitted M as physical errors ------------------------------------------------
 

@@ -27,6 +27,10 @@ bool finite(double v) { return std::isfinite(v); }
 // configuration
 
 void Calibration::validate() const {
+  for (int i = 0; i < 2; ++i) {
+    if (!G_dps_per_g[static_cast<std::size_t>(i)].allFinite())
+      throw std::invalid_argument("calibration: sensor " + std::to_string(i + 1) + " has a non-finite g-sensitivity entry");
+  }
   auto check = [&](const std::vector<CalibratedPosition>& list, int sensor) {
     for (const auto& p : list) {
       if (!finite(p.plat_deg) || !p.M_body_from_sensor.allFinite()) {
@@ -527,6 +531,17 @@ void DriftlessFilter::fuse_rate(const Sample& s, double p1, double p2, bool p1_r
 }
 
 PushStatus DriftlessFilter::push(const Sample& s) {
+  // calibrated g-sensitivity: y <- y - G f / g with the sample's own specific force
+  if (cfg_.calibration.has_g_sensitivity()) {
+    Sample c = s;
+    if (s.accel1_mps2.allFinite()) c.gyro1_dps -= cfg_.calibration.G_dps_per_g[0] * (s.accel1_mps2 / kStandardGravityMps2);
+    if (s.accel2_mps2.allFinite()) c.gyro2_dps -= cfg_.calibration.G_dps_per_g[1] * (s.accel2_mps2 / kStandardGravityMps2);
+    return push_corrected(c);
+  }
+  return push_corrected(s);
+}
+
+PushStatus DriftlessFilter::push_corrected(const Sample& s) {
   ++counters_.samples;
   out_ = SampleOutput{};
   out_.t_s = s.t_s;

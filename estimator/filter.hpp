@@ -57,7 +57,11 @@ struct Calibration {
   std::vector<CalibratedPosition> sensor1;
   std::vector<CalibratedPosition> sensor2;
   double match_tolerance_deg = 10.0;  // deg, a platform angle this close uses that position's M
+  /// g-sensitivity per sensor, deg/s per g of specific force (sensor axes): push() subtracts
+  /// G f / g from the gyros of samples whose accel columns are finite. Zero = none.
+  std::array<Eigen::Matrix3d, 2> G_dps_per_g{Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero()};
   bool empty() const { return sensor1.empty() && sensor2.empty(); }
+  bool has_g_sensitivity() const { return !G_dps_per_g[0].isZero(0.0) || !G_dps_per_g[1].isZero(0.0); }
   /// Throws std::invalid_argument when a matrix is singular or not finite.
   void validate() const;
 };
@@ -218,6 +222,7 @@ class DriftlessFilter {
   Eigen::Matrix3d body_from_sensor(int sensor, double plat_deg) const;
 
  private:
+  PushStatus push_corrected(const Sample& s);
   struct Standstill;  // running sums of one standstill
   void set_metadata(const log::Metadata& meta);
   bool classify(const Sample& s, double& p1, double& p2, bool& p1_rest, bool& p2_rest);

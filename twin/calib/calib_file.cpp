@@ -23,7 +23,7 @@ void emit_num_or_null(YAML::Emitter& out, double v) {
 }  // namespace
 
 void save_calib(const std::filesystem::path& path, const est::CalibFit& fit,
-                const RigConditions& rig) {
+                const RigConditions& rig, const est::GSensitivityFit* g) {
   using yio::num;
   const est::CalibMatrices mats = fit.matrices();
   YAML::Emitter out;
@@ -111,6 +111,25 @@ void save_calib(const std::filesystem::path& path, const est::CalibFit& fit,
     out << YAML::Key << "travel_error_deg" << YAML::Value << num(e.travel_error_deg);
     out << YAML::Key << "travel_offaxis_deg" << YAML::Value << num(e.travel_offaxis_deg);
     out << YAML::EndMap;
+    // y += G f: the gyro's response to specific force, from the per-segment biases
+    if (g && g->valid) {
+      const auto iu = static_cast<std::size_t>(i);
+      out << YAML::Key << "g_sensitivity" << YAML::Value << YAML::BeginMap;
+      out << YAML::Key << "G_dps_per_g" << YAML::Value;
+      yio::emit_mat3(out, g->G_dps_per_g[iu]);
+      out << YAML::Key << "G_sigma" << YAML::Value;
+      yio::emit_mat3(out, g->G_sigma[iu]);
+      out << YAML::Key << "b0_dps" << YAML::Value;
+      yio::emit_vec3(out, g->b0_dps[iu]);
+      if (g->temperature_term) {
+        out << YAML::Key << "bias_tc_dps_per_degc" << YAML::Value;
+        yio::emit_vec3(out, g->bias_tc_dps_per_degc[iu]);
+      }
+      out << YAML::Key << "residual_rms_dps" << YAML::Value;
+      yio::emit_vec3(out, g->residual_rms_dps[iu]);
+      out << YAML::Key << "segments" << YAML::Value << g->segments;
+      out << YAML::EndMap;
+    }
     out << YAML::EndMap;
   }
   out << YAML::EndMap;
@@ -156,6 +175,11 @@ CalibFile load_calib(const std::filesystem::path& path) {
       c.residual_rms_dps[i][p] = n["residual_rms_dps"]
                                      ? as_vec3(n["residual_rms_dps"], file, key + ".residual_rms_dps")
                                      : Eigen::Vector3d::Zero();
+    }
+    if (const YAML::Node gs = s["g_sensitivity"]) {
+      const std::string key = std::string(kSensorKey[i]) + ".g_sensitivity.G_dps_per_g";
+      c.G_dps_per_g[static_cast<std::size_t>(i)] = as_mat3(gs["G_dps_per_g"], file, key);
+      c.has_g_sensitivity = true;
     }
   }
   try {

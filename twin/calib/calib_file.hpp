@@ -41,11 +41,15 @@ struct CalibFile {
   double latitude_deg = driftless::kNaN;
   bool earth_rate_removed = false;
   std::string source;
+  /// g-sensitivity per sensor (sensorN.g_sensitivity.G_dps_per_g, deg/s per g), when fitted
+  bool has_g_sensitivity = false;
+  std::array<Eigen::Matrix3d, 2> G_dps_per_g{Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero()};
 };
 
 /// Writes calib.yaml (throws std::runtime_error naming the path when it cannot be written).
+/// With a valid `g`, each sensor block also holds its g_sensitivity.
 void save_calib(const std::filesystem::path& path, const est::CalibFit& fit,
-                const RigConditions& rig);
+                const RigConditions& rig, const est::GSensitivityFit* g = nullptr);
 /// Reads calib.yaml; throws std::invalid_argument naming file, line and key (missing matrix,
 /// wrong shape, singular M, another format).
 CalibFile load_calib(const std::filesystem::path& path);

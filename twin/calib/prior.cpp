@@ -61,6 +61,12 @@ std::string model_prior_yaml(const CalibFile& c) {
         << "enabled" << YAML::Value << true << YAML::Key << "angles_deg" << YAML::Value;
     yio::emit_vec3(out, s[i].mounting_deg);
     out << YAML::Key << "sigma_deg" << YAML::Value << 0 << YAML::EndMap;
+    if (c.has_g_sensitivity) {
+      out << YAML::Key << "g_sensitivity" << YAML::Value << YAML::BeginMap << YAML::Key << "enabled"
+          << YAML::Value << true << YAML::Key << "matrix_dps_per_g" << YAML::Value;
+      yio::emit_mat3(out, c.G_dps_per_g[static_cast<std::size_t>(i)]);
+      out << YAML::Key << "sigma_dps_per_g" << YAML::Value << 0 << YAML::EndMap;
+    }
     out << YAML::EndMap << YAML::EndMap;
   }
   out << YAML::EndMap << YAML::EndMap;

@@ -277,6 +277,8 @@ std::vector<est::CalibSegment> extract_segments(const std::vector<Sample>& log,
                                   [](const Sample& s, double t) { return s.t_s < t; });
     Eigen::Vector3d turn_sum = Eigen::Vector3d::Zero();
     double turn_n = 0;
+    Eigen::Vector3d f_sum[2] = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+    double f_n[2] = {0, 0}, tc_sum[2] = {0, 0}, tc_n[2] = {0, 0};
     const Sample* prev_plateau = nullptr;
     for (auto it = first; it != log.end() && it->t_s < ps.t_end_s; ++it) {
       const Sample& s = *it;
@@ -332,6 +334,21 @@ std::vector<est::CalibSegment> extract_segments(const std::vector<Sample>& log,
       }
       prev_plateau = &s;
       seg.samples.push_back(x);
+      // gravity in sensor axes for the g-sensitivity fit
+      const Eigen::Vector3d* f[2] = {&s.accel1_mps2, &s.accel2_mps2};
+      const double tc[2] = {s.temp1_c, s.temp2_c};
+      for (int i = 0; i < 2; ++i) {
+        if (std::isfinite(tc[i])) tc_sum[i] += tc[i], tc_n[i] += 1;
+        if (!f[i]->allFinite()) continue;
+        f_sum[i] += *f[i] / kStandardGravityMps2;
+        f_n[i] += 1;
+      }
+    }
+    for (int i = 0; i < 2; ++i) {
+      const auto iu = static_cast<std::size_t>(i);
+      const double half = 0.5 * static_cast<double>(seg.samples.size());
+      if (f_n[i] > half) seg.f_mean_g[iu] = f_sum[i] / f_n[i];
+      if (tc_n[i] > half) seg.temp_mean_c[iu] = tc_sum[i] / tc_n[i];
     }
     if (seg.samples.empty()) {
       throw std::invalid_argument(mismatch + seg_where + " holds no usable plateau samples");

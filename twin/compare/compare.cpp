@@ -321,7 +321,8 @@ CompareResult compare(const Replay& r, const CompareModel& model, const CompareO
       if (k % 3 == 0) sample.push_back(dh[k]);
     }
     if (sample.size() < 20) continue;
-    const double sd = 1.4826 * median_abs(sample);  // robust spread of the hinge differences
+    // robust spread of the hinge differences (floored: a noise-free log has none)
+    const double sd = std::max(1.4826 * median_abs(sample), 1e-3);
     const auto guard = static_cast<std::size_t>(std::ceil(0.1 * fs));
     std::vector<std::uint8_t> bad(n, 0);
     for (std::size_t k = 1; k < n; ++k) {
