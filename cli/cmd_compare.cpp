@@ -56,7 +56,9 @@ const bool registered = register_command(50, [](CLI::App& app) {
                                             "of candidate missing effects (docs/compare.md)");
   auto a = std::make_shared<CompareArgs>();
   cmd->add_option("--log", a->log, "Measurement log (CSV, driftless-log 1; gyro in deg/s)")->required()->check(CLI::ExistingFile);
-  cmd->add_option("--model", a->model, "Model or scenario YAML (its 'model:' block); default: embedded MPU6050 model at 100 Hz")
+  cmd->add_option("--model", a->model, "Model or scenario YAML (its 'model:' block); default: embedded nominal MPU6050 at "
+                  "100 Hz (datasheet noise, bias instability, turn-on bias; scale, cross-axis, "
+                  "g-sensitivity, temperature coefficients at zero; docs/compare.md)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--before", a->before, "An earlier model YAML: report the residual before (this) and after (--model)")
       ->check(CLI::ExistingFile);

@@ -65,7 +65,9 @@ const bool registered = register_command(51, [](CLI::App& app) {
                                              "--apply, write the model with the winner added (docs/compare.md)");
   auto a = std::make_shared<DiagnoseArgs>();
   cmd->add_option("--log", a->log, "Measurement log (CSV, driftless-log 1; gyro in deg/s)")->required()->check(CLI::ExistingFile);
-  cmd->add_option("--model", a->model, "Model or scenario YAML; default: embedded MPU6050 model at 100 Hz")->check(CLI::ExistingFile);
+  cmd->add_option("--model", a->model, "Model or scenario YAML; default: embedded nominal MPU6050 at 100 Hz (datasheet "
+                  "noise, bias instability, turn-on bias; scale, cross-axis, g-sensitivity, "
+                  "temperature coefficients at zero; docs/compare.md)")->check(CLI::ExistingFile);
   cmd->add_option("--out", a->out, "Output directory (report.html, diagnosis.json, plots/)")->required();
   cmd->add_option("--apply", a->apply, "Write the model with the best candidate's fitted parameters added to this YAML file");
   cmd->add_flag("--resample", a->resample, "Resample a log whose rate differs from the model's (else it is refused)");

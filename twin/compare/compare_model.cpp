@@ -21,11 +21,22 @@ ModelConfig CompareModel::config() const {
   return c;
 }
 
+SensorParams nominal_mpu6050() {
+  SensorParams p = mpu6050_defaults();
+  p.scale_factor.sigma_pct.setZero();
+  p.misalignment.sigma_pct = 0.0;
+  p.g_sensitivity.sigma_dps_per_g = 0.0;
+  p.temperature.bias_tc_sigma_dps_per_degc.setZero();
+  p.temperature.scale_tc_sigma_pct_per_degc.setZero();
+  p.mounting_misalignment.sigma_deg.setZero();
+  return p;
+}
+
 CompareModel default_compare_model() {
   CompareModel m;
-  m.sensor = {mpu6050_defaults(), mpu6050_defaults()};
+  m.sensor = {nominal_mpu6050(), nominal_mpu6050()};
   m.sample_rate_hz = 100.0;
-  m.source = "embedded MPU6050 defaults";
+  m.source = "embedded nominal MPU6050";
   return m;
 }
 

@@ -32,7 +32,12 @@ struct CompareModel {
   ModelConfig config() const;
 };
 
-/// The embedded default: both sensors mpu6050_defaults(), the default box, no time offset.
+/// The nominal MPU6050: mpu6050_defaults()'s random parts (white noise, bias instability, rate
+/// random walk, turn-on bias spread), DLPF and ADC, with no run-to-run spread of the
+/// calibration-type effects (scale, cross-axis, g-sensitivity, temperature coefficients,
+/// mounting): they sit at their nominal zero, so a unit's own values are findings, not nuisance.
+SensorParams nominal_mpu6050();
+/// The embedded default: both sensors nominal_mpu6050(), the default box, no time offset.
 CompareModel default_compare_model();
 /// Reads a scenario file or a file with only `model:` through twin-core's parser
 /// (parse_scenario / load_model_config): every key of the model block is honoured.
