@@ -47,21 +47,23 @@ Eigen::Vector3d roll_pitch_yaw_deg(const Eigen::Quaterniond& q) {
   return Eigen::Vector3d(roll, pitch, yaw) * kDegPerRad;
 }
 
+namespace {
+
+// the rotation vector (rad) of q, taking the shorter way round (angle in [0, pi])
+Eigen::Vector3d rotation_vector(Eigen::Quaterniond q) {
+  if (q.w() < 0.0) q.coeffs() = -q.coeffs();
+  const double vn = q.vec().norm();
+  return vn > 0.0 ? Eigen::Vector3d(q.vec() / vn * (2.0 * std::atan2(vn, q.w()))) : Eigen::Vector3d::Zero();
+}
+
+}  // namespace
+
 void ErrorAccumulator::add(const Eigen::Quaterniond& q_est, const Eigen::Quaterniond& q_ref) {
   const Eigen::Quaterniond err = q_est.normalized() * q_ref.normalized().conjugate();
-  if (started_) {
-    Eigen::Quaterniond d = err * last_err_.conjugate();  // the error's increment, ENU
-    if (d.w() < 0.0) d.coeffs() = -d.coeffs();
-    const double vn = d.vec().norm();
-    if (vn > 0.0) acc_rad_ += d.vec() / vn * (2.0 * std::atan2(vn, d.w()));
-  } else {
-    // the starting error (normally none: both start at ref) counts in full
-    Eigen::Quaterniond d = err;
-    if (d.w() < 0.0) d.coeffs() = -d.coeffs();
-    const double vn = d.vec().norm();
-    if (vn > 0.0) acc_rad_ = d.vec() / vn * (2.0 * std::atan2(vn, d.w()));
-    started_ = true;
-  }
+  // after the first call: the error's increment in ENU; the starting error (normally none: both
+  // start at ref) counts in full
+  acc_rad_ += rotation_vector(started_ ? Eigen::Quaterniond(err * last_err_.conjugate()) : err);
+  started_ = true;
   last_err_ = err;
 }
 
@@ -69,16 +71,12 @@ AttitudeError attitude_error(const Eigen::Quaterniond& q_est, const Eigen::Quate
   // the error rotation in ENU, E = q_est q_ref^-1, as a rotation vector: its Up part is the
   // heading error, its North/East parts the tilt (roll/pitch for a box facing north); unlike
   // Euler-angle differences this has no singularity at +-90 deg pitch
-  Eigen::Quaterniond d = q_est.normalized() * q_ref.normalized().conjugate();
-  if (d.w() < 0.0) d.coeffs() = -d.coeffs();
-  const double vn = d.vec().norm();
-  const double angle = 2.0 * std::atan2(vn, d.w());
-  const Eigen::Vector3d phi = vn > 0.0 ? Eigen::Vector3d(d.vec() / vn * angle) : Eigen::Vector3d::Zero();
+  const Eigen::Vector3d phi = rotation_vector(q_est.normalized() * q_ref.normalized().conjugate());
   AttitudeError e;
   e.roll_deg = phi.y() * kDegPerRad;     // about North
   e.pitch_deg = phi.x() * kDegPerRad;    // about East
   e.heading_deg = phi.z() * kDegPerRad;  // about Up
-  e.angle_deg = angle * kDegPerRad;
+  e.angle_deg = phi.norm() * kDegPerRad;
   return e;
 }
 

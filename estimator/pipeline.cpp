@@ -1,5 +1,6 @@
 #include "estimator/pipeline.hpp"
 
+#include <array>
 #include <cmath>
 
 #include <Eigen/Cholesky>
@@ -26,9 +27,17 @@ EstimateSummary run_estimate(log::LogReader& reader, const EstimatorConfig& cfg,
   const bool have_ref = (reader.fields() & kFieldRefQ) != 0;
   sum.attitude_available = have_ref;
   const double lat = meta.latitude_deg();
-  AttitudeIntegrator att_corr(lat), att_raw(lat), att_fixed(lat);
-  ErrorAccumulator acc_corr, acc_raw, acc_fixed;  // unwrapped errors, every sample with a ref_q
-  std::vector<double> att_t, att_err_corr, att_err_raw, att_err_fixed;
+  // the three attitude integrations of docs/estimator.md section 4, each with its unwrapped
+  // error (updated every sample with a ref_q) and that error at the comparison points
+  struct Track {
+    AttitudeIntegrator att;
+    ErrorAccumulator acc;
+    std::vector<double> err_deg;
+  };
+  enum { kCorrected, kRaw, kFixed };
+  std::array<Track, 3> tracks{Track{AttitudeIntegrator(lat), {}, {}}, Track{AttitudeIntegrator(lat), {}, {}},
+                              Track{AttitudeIntegrator(lat), {}, {}}};
+  std::vector<double> att_t;
   double next_att_t = kNaN;
 
   // truth statistics accumulators
@@ -78,41 +87,36 @@ EstimateSummary run_estimate(log::LogReader& reader, const EstimatorConfig& cfg,
     // has locked on (every bias sigma below attitude_start_sigma_dps); the bias estimate then is
     // what a box calibrated once would keep: the `fixed` integration holds it
     const bool ref_ok = have_ref && s.ref_q_wxyz.allFinite();
-    if (ref_ok && !att_corr.initialized()) {
+    const bool started = tracks[kCorrected].att.initialized();
+    if (ref_ok && !started) {
       const bool locked = opt.attitude_start_sigma_dps <= 0.0 ||
                           (filter.has_update() && filter.sigma_dps().maxCoeff() < opt.attitude_start_sigma_dps);
       if (locked) {
         filter.set_fixed_bias_dps(filter.bias_dps());  // the next sample's fixed rate uses it
         sum.fixed_bias_dps = filter.bias_dps();
         sum.attitude_start_s = s.t_s;
-        att_corr.reset(s.q_enu_from_body(), s.t_s);
-        att_raw.reset(s.q_enu_from_body(), s.t_s);
-        att_fixed.reset(s.q_enu_from_body(), s.t_s);
+        for (Track& tr : tracks) tr.att.reset(s.q_enu_from_body(), s.t_s);
         next_att_t = s.t_s;
       }
-    } else if (att_corr.initialized() && std::isfinite(s.t_s)) {
-      att_corr.step(s.t_s, out.rate_body_dps);
-      att_raw.step(s.t_s, out.rate_body_raw_dps);
-      att_fixed.step(s.t_s, out.rate_body_fixed_dps);
+    } else if (started && std::isfinite(s.t_s)) {
+      tracks[kCorrected].att.step(s.t_s, out.rate_body_dps);
+      tracks[kRaw].att.step(s.t_s, out.rate_body_raw_dps);
+      tracks[kFixed].att.step(s.t_s, out.rate_body_fixed_dps);
     }
-    if (ref_ok && att_corr.initialized()) {
-      acc_corr.add(att_corr.q_enu_from_body(), s.q_enu_from_body());
-      acc_raw.add(att_raw.q_enu_from_body(), s.q_enu_from_body());
-      acc_fixed.add(att_fixed.q_enu_from_body(), s.q_enu_from_body());
+    if (ref_ok && tracks[kCorrected].att.initialized()) {
+      for (Track& tr : tracks) tr.acc.add(tr.att.q_enu_from_body(), s.q_enu_from_body());
       if (s.t_s >= next_att_t) {
         AttitudePoint ap;
         ap.t_s = s.t_s;
-        ap.corrected = attitude_error(att_corr.q_enu_from_body(), s.q_enu_from_body());
-        ap.raw = attitude_error(att_raw.q_enu_from_body(), s.q_enu_from_body());
-        ap.fixed = attitude_error(att_fixed.q_enu_from_body(), s.q_enu_from_body());
-        ap.corrected_accumulated_deg = acc_corr.angle_deg();
-        ap.raw_accumulated_deg = acc_raw.angle_deg();
-        ap.fixed_accumulated_deg = acc_fixed.angle_deg();
+        ap.corrected = attitude_error(tracks[kCorrected].att.q_enu_from_body(), s.q_enu_from_body());
+        ap.raw = attitude_error(tracks[kRaw].att.q_enu_from_body(), s.q_enu_from_body());
+        ap.fixed = attitude_error(tracks[kFixed].att.q_enu_from_body(), s.q_enu_from_body());
+        ap.corrected_accumulated_deg = tracks[kCorrected].acc.angle_deg();
+        ap.raw_accumulated_deg = tracks[kRaw].acc.angle_deg();
+        ap.fixed_accumulated_deg = tracks[kFixed].acc.angle_deg();
         att_t.push_back(ap.t_s);
         // the drift is fitted to the unwrapped error: a raw gyro's error angle folds at 180 deg
-        att_err_corr.push_back(ap.corrected_accumulated_deg);
-        att_err_raw.push_back(ap.raw_accumulated_deg);
-        att_err_fixed.push_back(ap.fixed_accumulated_deg);
+        for (Track& tr : tracks) tr.err_deg.push_back(tr.acc.angle_deg());
         sum.final_corrected = ap.corrected;
         sum.final_raw = ap.raw;
         sum.final_fixed = ap.fixed;
@@ -139,10 +143,10 @@ EstimateSummary run_estimate(log::LogReader& reader, const EstimatorConfig& cfg,
   sum.bias_dps = filter.bias_dps();
   sum.sigma_dps = filter.sigma_dps();
   if (att_t.size() >= 2) {
-    sum.drift_corrected_deg_per_h = drift_deg_per_h(att_t, att_err_corr);
-    sum.drift_raw_deg_per_h = drift_deg_per_h(att_t, att_err_raw);
-    sum.drift_fixed_deg_per_h = drift_deg_per_h(att_t, att_err_fixed);
-  } else if (have_ref && !att_corr.initialized() && sum.rows > 0) {
+    sum.drift_corrected_deg_per_h = drift_deg_per_h(att_t, tracks[kCorrected].err_deg);
+    sum.drift_raw_deg_per_h = drift_deg_per_h(att_t, tracks[kRaw].err_deg);
+    sum.drift_fixed_deg_per_h = drift_deg_per_h(att_t, tracks[kFixed].err_deg);
+  } else if (have_ref && !tracks[kCorrected].att.initialized() && sum.rows > 0) {
     sum.warnings.push_back(
         "no attitude comparison: the filter never locked on (every bias sigma below " +
         std::to_string(opt.attitude_start_sigma_dps) + " deg/s; the largest is " +

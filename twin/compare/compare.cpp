@@ -16,6 +16,17 @@
 namespace driftless::twin {
 namespace {
 
+// the per-channel (or per-set) fits with positive evidence `ev`; if none has, the best one alone
+template <class Fit>
+std::vector<Fit> supported_or_best(const std::vector<Fit>& fits) {
+  std::vector<Fit> chosen;
+  for (const auto& f : fits)
+    if (f.ev > 0) chosen.push_back(f);
+  if (chosen.empty() && !fits.empty())
+    chosen.push_back(*std::max_element(fits.begin(), fits.end(), [](const Fit& a, const Fit& b) { return a.ev < b.ev; }));
+  return chosen;
+}
+
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr const char* kAxis[3] = {"x", "y", "z"};
 
@@ -605,9 +616,7 @@ CompareResult compare(const Replay& r, const CompareModel& model, const CompareO
       cands.push_back(cd);
       continue;
     }
-    std::vector<Best> chosen;
-    for (const auto& b : bests) if (b.ev > 0) chosen.push_back(b);
-    if (chosen.empty()) chosen.push_back(*std::max_element(bests.begin(), bests.end(), [](const Best& a, const Best& b) { return a.ev < b.ev; }));
+    const std::vector<Best> chosen = supported_or_best(bests);
     double ev_sum = 0.0;
     std::vector<int> s_set, axes1, axes2;
     for (const auto& b : chosen) {
@@ -720,9 +729,7 @@ CompareResult compare(const Replay& r, const CompareModel& model, const CompareO
       cands.push_back(cd);
       continue;
     }
-    std::vector<One> chosen;
-    for (const auto& o : ones) if (o.ev > 0) chosen.push_back(o);
-    if (chosen.empty()) chosen.push_back(*std::max_element(ones.begin(), ones.end(), [](const One& a, const One& b) { return a.ev < b.ev; }));
+    const std::vector<One> chosen = supported_or_best(ones);
     for (const auto& o : chosen) {
       ev_sum += o.ev;
       gain_sum += o.gain;

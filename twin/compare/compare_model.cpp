@@ -21,14 +21,23 @@ ModelConfig CompareModel::config() const {
   return c;
 }
 
-SensorParams nominal_mpu6050() {
-  SensorParams p = mpu6050_defaults();
+namespace {
+
+// no run-to-run spread of the calibration-type effects: their values are fixed as written
+void clear_calibration_spread(SensorParams& p) {
   p.scale_factor.sigma_pct.setZero();
   p.misalignment.sigma_pct = 0.0;
   p.g_sensitivity.sigma_dps_per_g = 0.0;
   p.temperature.bias_tc_sigma_dps_per_degc.setZero();
   p.temperature.scale_tc_sigma_pct_per_degc.setZero();
   p.mounting_misalignment.sigma_deg.setZero();
+}
+
+}  // namespace
+
+SensorParams nominal_mpu6050() {
+  SensorParams p = mpu6050_defaults();
+  clear_calibration_spread(p);
   return p;
 }
 
@@ -98,12 +107,7 @@ void save_compare_model(const CompareModel& m, const std::filesystem::path& path
 SensorParams deterministic_part(const SensorParams& p) {
   SensorParams d = p;
   d.constant_bias.sigma_dps.setZero();
-  d.scale_factor.sigma_pct.setZero();
-  d.misalignment.sigma_pct = 0.0;
-  d.g_sensitivity.sigma_dps_per_g = 0.0;
-  d.temperature.bias_tc_sigma_dps_per_degc.setZero();
-  d.temperature.scale_tc_sigma_pct_per_degc.setZero();
-  d.mounting_misalignment.sigma_deg.setZero();
+  clear_calibration_spread(d);
   d.bias_instability.enabled = false;
   d.rate_random_walk.enabled = false;
   d.white_noise.enabled = false;
