@@ -350,7 +350,7 @@ const bool registered = register_command(40, [](CLI::App& app) {
   cmd->add_option("--columns", a->columns,
                   "Comma-separated channels (log default: gyro1_x..gyro2_z; required with --csv)");
   cmd->add_option("--units", a->units, "--csv gyro units: deg/s, rad/s or lsb:<LSB per deg/s> (MPU6050 +-250: lsb:131)");
-  cmd->add_option("--rate", a->rate_hz, "Sample rate in Hz (overrides the file's)")->check(CLI::PositiveNumber);
+  cmd->add_option("--rate", a->rate_hz, "Sample rate in Hz (overrides the file's)")->check(positive_number("Hz"));
   cmd->add_option("--time-column", a->time_column, "--csv timestamp column in s (default: sec, t, time, timestamp)");
   cmd->add_option("--out", a->out, "Output folder: allan.csv, allan_fit.json [, imu.yaml, allan.png/svg]")->required();
   cmd->add_flag("--corrected", a->corrected, "Log only: also the DriftLess-corrected gyro channels, side by side");

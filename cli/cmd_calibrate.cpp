@@ -186,7 +186,7 @@ const bool registered = register_command(40, [](CLI::App& app) {
       throw std::invalid_argument("calibrate: give --scenario FILE, or --log FILE --plan FILE");
     return o->scenario.empty() ? run_from_log(*o) : run_from_scenario(*o);
   };
-});
+}, Interrupt::kPolls);
 
 }  // namespace
 }  // namespace driftless::cli

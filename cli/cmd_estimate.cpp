@@ -410,9 +410,9 @@ const bool registered = register_command(30, [](CLI::App& app) {
                   "'bias fixed at start' integration takes the estimate and keeps it; 0 starts at "
                   "the log's first ref_q")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative_number("deg/s"));
   return [a] { return run_estimate_cmd(*a); };
-});
+}, Interrupt::kPolls);
 
 }  // namespace
 }  // namespace driftless::cli

@@ -164,7 +164,7 @@ const bool registered = register_command(60, [](CLI::App& app) {
     (void)cmd;
     return run_render(*a);
   };
-});
+}, Interrupt::kPolls);
 
 }  // namespace
 }  // namespace driftless::cli

@@ -62,12 +62,13 @@ const bool registered = register_command(10, [](CLI::App& app) {
   cmd->add_option_function<double>(
          "--duration", [args](double v) { args->duration_s = v; },
          "Simulated duration in s (overrides the scenario's duration_s)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number("s"));
   cmd->add_option_function<std::uint64_t>(
       "--seed", [args](std::uint64_t v) { args->seed = v; },
-      "Random seed (overrides the scenario's seed); the same seed gives a byte-identical log");
+      "Random seed 0 .. 2^64-1 (overrides the scenario's seed); the same seed gives a byte-identical log")
+      ->check(seed_number());
   return [args] { return run_simulate(*args); };
-});
+}, Interrupt::kPolls);
 
 }  // namespace
 }  // namespace driftless::cli
