@@ -106,6 +106,11 @@ int run_from_scenario(const Options& o) {
     });
     progress.done();
   }
+  if (stop_requested().load()) {
+    // interrupted: the rig run is partial, so no fit and no calibration file that would look whole
+    fmt::print(stderr, "driftless calibrate: stopped before the rig run finished; nothing written\n");
+    return interrupted_exit_code();
+  }
   if (!o.save_log.empty()) {
     log::LogWriter w(o.save_log, run.meta,
                      kFieldAccel | kFieldTemp | kFieldRefQ | kFieldRefP | kFieldTrueBias |

@@ -96,6 +96,10 @@ struct Gap {
 /// (kLayoutSingleSensor: the single-sensor form, without gyro2_*, plat2_deg and sensor-2 columns).
 std::vector<std::string> column_names(std::uint32_t fields);
 
+/// Bytes a row of a log with these fields takes, about (the written decimals plus sign, integer
+/// digits, point and comma per column); for the free-space check before a run.
+double estimated_row_bytes(std::uint32_t fields);
+
 /// Streams samples into a log file. The header says 'complete: false' until finish(true) succeeds,
 /// so a crash, Ctrl-C, a full disk or a vanished device never leaves a file that looks whole and is
 /// not. The log is written in place (not under a temporary name): a run killed at hour 13 of 14, or
@@ -136,8 +140,15 @@ class LogWriter {
   bool finished_ = false;
 };
 
+/// Every optional column group.
+inline constexpr std::uint32_t kAllFieldGroups = kFieldAccel | kFieldTemp | kFieldRefQ | kFieldRefP |
+                                                 kFieldTrueBias | kFieldTrueRate | kFieldTruePlat;
+
 /// Reader options.
 struct ReaderOptions {
+  /// The optional column groups to parse. Columns of other groups are skipped unparsed (read as no
+  /// value, their bits absent from fields()): a command parses what it uses, `check` everything.
+  std::uint32_t fields = kAllFieldGroups;
   /// Accept a last row cut off mid-line when the log says 'complete: false' (else it is an error).
   bool tolerate_truncated_tail = true;
   /// Accept the single-sensor form ('sensors: 1'); commands that need both gyro triads refuse it
@@ -205,6 +216,7 @@ class LogReader {
   ReaderOptions opts_;
   std::unique_ptr<std::FILE, Closer> file_;
   std::string buf_;
+  std::size_t chunk_bytes_ = 0;  // bytes read at a time
   std::size_t buf_pos_ = 0;
   bool eof_ = false;
   bool last_line_unterminated_ = false;
@@ -213,7 +225,7 @@ class LogReader {
   std::vector<std::string> columns_;
   std::uint32_t fields_ = 0;
   std::vector<double*> target_;  // column -> value in row_sample_ (nullptr for unknown columns)
-  std::vector<bool> known_;      // column -> a column of the format (parsed strictly)
+  std::vector<char> parse_;      // column -> 0 skip, 1 parse strictly (known), 2 parse leniently (unknown)
   Sample row_sample_;            // the row being read; columns the file lacks stay NaN
   std::vector<double> row_;
   std::vector<Event> events_;

@@ -43,6 +43,7 @@ inline constexpr std::array<ColumnSpec, 35> kColumns = {{
 
 inline constexpr std::uint32_t kAllFields = kFieldAccel | kFieldTemp | kFieldRefQ | kFieldRefP |
                                             kFieldTrueBias | kFieldTrueRate | kFieldTruePlat;
+static_assert(kAllFields == 0x7f, "a new column group needs its bit in kAllFields");
 inline constexpr std::size_t kPlat1Column = 7;
 
 /// Column i is part of a log with these fields (layout bit included).

@@ -194,4 +194,12 @@ std::vector<std::string> column_names(std::uint32_t fields) {
   return names;
 }
 
+double estimated_row_bytes(std::uint32_t fields) {
+  double bytes = 0.0;
+  for (std::size_t i = 0; i < detail::kColumns.size(); ++i) {
+    if (detail::column_in_layout(i, fields)) bytes += detail::kColumns[i].decimals + 5.0;
+  }
+  return bytes;
+}
+
 }  // namespace driftless::log

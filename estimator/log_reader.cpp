@@ -59,7 +59,10 @@ LogReader::LogReader(const std::filesystem::path& path, ReaderOptions opts) : pa
   errno = 0;
   file_.reset(std::fopen(path.c_str(), "rb"));
   if (!file_) throw LogError(path.string() + ": cannot open: " + std::strerror(errno));
-  buf_.reserve(kChunkBytes);
+  // chunks of 1 MiB, or the whole file when it is smaller
+  const auto size = std::filesystem::file_size(path, ec);
+  chunk_bytes_ = ec ? kChunkBytes : static_cast<std::size_t>(std::min<std::uintmax_t>(kChunkBytes, size + 1));
+  buf_.reserve(chunk_bytes_);
   read_header();
   map_columns();
   validate_metadata(meta_, path_.string());
@@ -121,7 +124,7 @@ void LogReader::read_header() {
 void LogReader::map_columns() {
   const bool single = meta_.sensors() == 1;
   target_.assign(columns_.size(), nullptr);
-  known_.assign(columns_.size(), false);
+  parse_.assign(columns_.size(), 2);
   std::vector<bool> seen(detail::kColumns.size(), false);
   for (std::size_t c = 0; c < columns_.size(); ++c) {
     for (std::size_t k = 0; k < detail::kColumns.size(); ++k) {
@@ -131,8 +134,10 @@ void LogReader::map_columns() {
         fail("column '" + columns_[c] + "' in a single-sensor log ('sensors: 1' has no sensor-2 columns)");
       }
       seen[k] = true;
-      known_[c] = true;
-      target_[c] = &detail::column_slot(row_sample_, k);
+      const std::uint32_t group = detail::kColumns[k].field;
+      const bool wanted = group == 0 || (opts_.fields & group) != 0;
+      parse_[c] = wanted ? 1 : 0;
+      if (wanted) target_[c] = &detail::column_slot(row_sample_, k);
     }
   }
   std::string missing;
@@ -157,7 +162,7 @@ void LogReader::map_columns() {
     for (std::size_t k = 0; k < detail::kColumns.size(); ++k) {
       if (detail::kColumns[k].field == bit && !seen[k] && !(single && detail::kColumns[k].sensor == 2)) all = false;
     }
-    if (all) fields_ |= bit;
+    if (all && (opts_.fields & bit) != 0) fields_ |= bit;
   }
   row_.assign(columns_.size(), kNaN);
 }
@@ -205,9 +210,9 @@ bool LogReader::read_line(std::string_view& line) {
     buf_.erase(0, buf_pos_);
     buf_pos_ = 0;
     const std::size_t old = buf_.size();
-    buf_.resize(old + kChunkBytes);
+    buf_.resize(old + chunk_bytes_);
     errno = 0;
-    const std::size_t got = std::fread(buf_.data() + old, 1, kChunkBytes, file_.get());
+    const std::size_t got = std::fread(buf_.data() + old, 1, chunk_bytes_, file_.get());
     buf_.resize(old + got);
     if (got == 0) {
       if (std::ferror(file_.get())) fail(std::string("read error: ") + std::strerror(errno));
@@ -222,6 +227,14 @@ bool LogReader::split_row(std::string_view line, std::string& problem) {
   const char* const end = line.data() + line.size();
   std::size_t col = 0;
   for (;;) {
+    if (col < columns_.size() && parse_[col] == 0) {
+      // a column the caller does not use: skipped unparsed
+      const char* comma = static_cast<const char*>(std::memchr(p, ',', static_cast<std::size_t>(end - p)));
+      ++col;
+      if (comma == nullptr) break;
+      p = comma + 1;
+      continue;
+    }
     if (col < columns_.size()) {
       // the common case: a plain number right up to the comma
       const char* q = io::parse_decimal(p, end, row_[col]);
@@ -238,7 +251,7 @@ bool LogReader::split_row(std::string_view line, std::string& problem) {
       return false;
     }
     if (!parse_field(p, field_end, row_[col])) {
-      if (known_[col]) {
+      if (parse_[col] == 1) {
         problem = "column '" + columns_[col] + "': expected a number, got '" + std::string(p, field_end) + "'";
         return false;
       }
