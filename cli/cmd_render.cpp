@@ -21,6 +21,9 @@ struct RenderArgs {
   double from = kNaN, to = kNaN;
   double realtime_flip_every = kNaN;
   std::string camera;
+  double azimuth_deg = render::ViewAngles{}.azimuth_deg;
+  double elevation_deg = render::ViewAngles{}.elevation_deg;
+  bool no_close_ups = false;
   std::string preset = "ultrafast";
   int crf = 23;
   bool no_overlay = false;
@@ -41,6 +44,8 @@ int run_render(const RenderArgs& a) {
   p.scene.width_px = a.width;
   p.scene.height_px = a.height;
   p.scene.camera = a.camera;
+  p.scene.view = {a.azimuth_deg, a.elevation_deg};
+  p.scene.close_ups = !a.no_close_ups;
   p.timeline.fps = a.fps;
   p.timeline.speed = a.speed;
   p.timeline.from_s = a.from;
@@ -135,8 +140,18 @@ const bool registered = register_command(60, [](CLI::App& app) {
   cmd->add_option("--height", a->height, "Frame height, px (even)")->capture_default_str();
   cmd->add_option("--fps", a->fps, "Video frame rate, frames/s")->capture_default_str();
   cmd->add_option("--camera", a->camera,
-                  "MJCF camera name, or 'free' (orbit camera tracking the box); default: the "
-                  "tracking camera if the model has one");
+                  "auto (default): a camera that frames the box large, follows it and closes in "
+                  "on a flipping platform; 'free': an orbit camera tracking the box; or an MJCF "
+                  "camera name");
+  cmd->add_option("--azimuth", a->azimuth_deg,
+                  "Direction the auto camera looks towards, deg from East towards North (ENU)")
+      ->capture_default_str();
+  cmd->add_option("--elevation", a->elevation_deg,
+                  "Elevation of the auto camera's line of sight, deg (negative: looking down)")
+      ->capture_default_str()
+      ->check(CLI::Range(-89.0, 89.0));
+  cmd->add_flag("--no-close-ups", a->no_close_ups,
+                "Auto camera: keep the whole box in view during flips (no close-up of the platform)");
   auto* from = cmd->add_option("--from", a->from, "First data time shown, s (default: start)");
   auto* to = cmd->add_option("--to", a->to, "Data time where the video ends, s (default: end)");
   (void)from;

@@ -17,6 +17,7 @@ Telemetry::Telemetry(const TelemetryParams& p, const log::Metadata& meta)
     filter_ = std::make_unique<est::DriftlessFilter>(est::EstimatorConfig{}, meta);
     bias1_.emplace(1, p_.window_s);
     bias2_.emplace(2, p_.window_s);
+    attitude_chart_.emplace(p_.window_s);
     const double lat = meta.latitude_deg();
     attitude_.emplace(std::isfinite(lat) ? lat : 0.0);
   }
@@ -35,22 +36,25 @@ void Telemetry::push(const Sample& s, double rest_s, OverlayState& st) {
     // strapdown attitude from the bias-corrected fused rate (paper section 4), started at the
     // first reference attitude and compared with ref_q
     const bool has_ref = s.ref_q_wxyz.allFinite();
+    attitude_now_.available = attitude_now_.available || has_ref;
     if (has_ref && !attitude_->initialized()) {
       attitude_->reset(s.q_enu_from_body().normalized(), s.t_s);
+      attitude_now_.started = true;
+      attitude_now_.start_s = s.t_s;
     } else if (attitude_->initialized()) {
       attitude_->step(s.t_s, filter_->output().rate_body_dps);
       if (has_ref) {
-        attitude_error_deg_ = est::attitude_error(attitude_->q_enu_from_body(),
-                                                  s.q_enu_from_body().normalized())
-                                  .angle_deg;
+        attitude_now_.corrected_deg =
+            est::attitude_error(attitude_->q_enu_from_body(), s.q_enu_from_body().normalized()).angle_deg;
       }
     }
+    attitude_chart_->push(s.t_s, attitude_now_);
   }
-  st.attitude_error_deg = attitude_error_deg_;
+  st.attitude = attitude_now_;
 }
 
 std::vector<const StripChart*> Telemetry::charts() const {
-  if (filter_) return {&bias2_->chart(), &bias1_->chart()};
+  if (filter_) return {&bias1_->chart(), &bias2_->chart(), &attitude_chart_->chart()};
   return {&residual_.chart()};
 }
 

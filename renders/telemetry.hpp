@@ -33,7 +33,8 @@ class Telemetry {
   /// Adds one sample; `rest_s`: how long both platforms have been at rest (0 while moving).
   /// Fills the estimator-derived parts of `st` (attitude error).
   void push(const Sample& s, double rest_s, OverlayState& st);
-  /// The charts to draw, bottom first: bias 1 and 2 estimates with the filter, else the residual.
+  /// The charts to draw, top first: bias 1 and 2 estimates and the attitude error with the
+  /// filter, else the residual.
   std::vector<const StripChart*> charts() const;
   /// The filter, when it runs (for tests and summaries).
   const est::DriftlessFilter* filter() const { return filter_.get(); }
@@ -43,8 +44,9 @@ class Telemetry {
   ResidualChart residual_;
   std::unique_ptr<est::DriftlessFilter> filter_;
   std::optional<BiasChart> bias1_, bias2_;
+  std::optional<AttitudeChart> attitude_chart_;
   std::optional<est::AttitudeIntegrator> attitude_;  // from the filter's corrected body rate
-  double attitude_error_deg_ = kNaN;
+  AttitudeNow attitude_now_;
 };
 
 }  // namespace driftless::render
