@@ -1,6 +1,8 @@
 // driftless render: an off-screen video (OSMesa, no display or GPU) of a log replay or a
 // simulated scenario, with an overlay of time, platform state, residual and attitude error.
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <memory>
 #include <string>
 
@@ -37,6 +39,22 @@ ModelPtr load_mjcf(const std::string& path) {
   ModelPtr m(mj_loadXML(path.c_str(), nullptr, err, sizeof err), &mj_deleteModel);
   if (!m) throw std::runtime_error(fmt::format("{}: cannot load the MJCF model: {}", path, err));
   return m;
+}
+
+// video.json beside video.mp4: what the renderer wrote, for checks (driftless demo) and users
+void write_sidecar(const RenderArgs& a, const render::RenderParams& p, const render::RenderStats& st, bool complete) {
+  const std::filesystem::path path = std::filesystem::path(a.out).replace_extension(".json");
+  auto num = [](double v) { return std::isfinite(v) ? fmt::format("{}", v) : std::string("null"); };
+  std::ofstream f(path);
+  f << fmt::format(
+      "{{\n  \"format\": \"driftless-video 1\",\n  \"output\": \"{}\",\n  \"png_fallback\": {},\n"
+      "  \"complete\": {},\n  \"frames\": {},\n  \"width\": {},\n  \"height\": {},\n  \"fps\": {},\n"
+      "  \"speed\": {},\n  \"first_frame_s\": {},\n  \"last_frame_s\": {},\n  \"realtime_flip_frames\": {},\n"
+      "  \"camera\": \"{}\",\n  \"wall_s\": {:.3f}\n}}\n",
+      st.output, st.png_fallback, complete, st.frames, p.scene.width_px, p.scene.height_px, p.timeline.fps,
+      p.timeline.speed, num(st.first_frame_s), num(st.last_frame_s), st.realtime_flip_frames,
+      p.scene.camera.empty() ? "auto" : p.scene.camera, st.wall_s);
+  if (!f.flush()) throw std::runtime_error("cannot write " + path.string());
 }
 
 int run_render(const RenderArgs& a) {
@@ -105,6 +123,7 @@ int run_render(const RenderArgs& a) {
              static_cast<double>(stats.frames) / a.fps, stats.first_frame_s, stats.last_frame_s,
              stats.realtime_flip_frames, stats.wall_s,
              stats.wall_s > 0 ? static_cast<double>(stats.frames) / stats.wall_s : 0.0);
+  write_sidecar(a, p, stats, !stop_requested().load());
   if (stop_requested().load()) {
     fmt::print(stderr, "driftless render: stopped early (Ctrl-C); the video ends at t = {:.2f} s\n",
                stats.last_frame_s);
