@@ -278,7 +278,9 @@ RenderStats render_video(FrameSource& source, const RenderParams& params,
   GlContext gl;
   stats.gl_renderer = gl.renderer();
   WorldPoser& poser = source.poser();
-  SceneRenderer scene(poser.model(), params.scene, poser.bodies());
+  SceneParams sp = params.scene;
+  sp.fps = params.timeline.fps;
+  SceneRenderer scene(poser.model(), sp, poser.bodies());
   const int w = params.scene.width_px, h = params.scene.height_px;
   AsyncSink out(open_sink(params, stats), static_cast<std::size_t>(w) * h * 3);
   stats.output = out.sink().description();

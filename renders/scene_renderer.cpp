@@ -13,6 +13,7 @@ namespace driftless::render {
 
 namespace {
 constexpr double kMinNearM = 0.005;  // m, the closest near plane (depth buffer precision)
+constexpr double kCameraMoveS = 0.3;  // s of video the auto camera takes to close in or back out
 }  // namespace
 
 void SceneParams::validate() const {
@@ -40,6 +41,7 @@ void SceneRenderer::choose_camera(const mjModel* m, const FramedBodies& bodies) 
   if (name.empty() || name == "auto") {
     CameraDirector::Params dp;
     dp.view = params_.view;
+    dp.blend_frames = std::max(1, static_cast<int>(std::lround(kCameraMoveS * params_.fps)));
     director_ = std::make_unique<CameraDirector>(m, bodies, dp);
     camera_name_ = "auto";
     return;

@@ -24,6 +24,7 @@ struct SceneParams {
   std::string camera;
   ViewAngles view;              // direction of the framing camera, deg
   bool close_ups = true;        // framing camera: show a flipping platform large
+  double fps = 30.0;            // video frames per second: the camera's moves take 0.3 s of video
   bool shadows = false;         // shadows double llvmpipe's cost per frame
   bool reflections = false;
   int msaa_samples = 0;         // off-screen multisampling (0 = off)
