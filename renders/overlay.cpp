@@ -64,7 +64,7 @@ std::string next_flip_text(const PlayState& p, const OverlayState& st) {
 
 std::string attitude_text(const AttitudeNow& a) {
   if (!a.available) return "n/a (needs ref_q and the estimator)";
-  if (!a.started) return "-  (from when the filter has locked on)";
+  if (!a.started) return "-  (starts when the filter has locked on)";
   return fmt::format("{:.2f} deg since lock at {:.1f} s", a.corrected_deg, a.start_s);
 }
 
@@ -159,9 +159,9 @@ void BiasChart::push(double t_s, const Eigen::Vector3d& est, const Eigen::Vector
 AttitudeChart::AttitudeChart(double window_s, int points)
     : chart_("attitude error since lock, deg",
              {{"DriftLess", {0.4f, 0.6f, 1.0f}}, {"bias fixed at lock", {0.95f, 0.35f, 0.3f}}},
-             {{"DriftLess", {0.4f, 0.6f, 1.0f}}, {"bias fixed at lock", {0.95f, 0.35f, 0.3f}}}, window_s, 0.1),
+             {{"DriftLess", {0.4f, 0.6f, 1.0f}}, {"bias fixed", {0.95f, 0.35f, 0.3f}}}, window_s, 0.1),
       bucket_s_(window_s / points) {
-  chart_.empty_text = "starts when the filter has locked on";
+  chart_.empty_text = "waiting for the filter to lock";
 }
 
 void AttitudeChart::push(double t_s, const AttitudeNow& a) {

@@ -1,13 +1,14 @@
 // The numbers behind the overlay, computed from the sample stream as it is read: the DriftLess
 // filter's bias estimate (when enabled) against the true biases, the residual of eq. (2), and
-// the attitude error of a strapdown attitude against ref_q.
+// the attitude error from lock on (est::AttitudeComparison: what `driftless estimate` reports).
 #pragma once
 
 #include <memory>
 #include <optional>
 #include <vector>
 
-#include "estimator/attitude.hpp"
+#include "estimator/attitude_comparison.hpp"
+#include "estimator/pipeline.hpp"
 #include "estimator/filter.hpp"
 #include "estimator/log.hpp"
 #include "renders/overlay.hpp"
@@ -45,7 +46,7 @@ class Telemetry {
   std::unique_ptr<est::DriftlessFilter> filter_;
   std::optional<BiasChart> bias1_, bias2_;
   std::optional<AttitudeChart> attitude_chart_;
-  std::optional<est::AttitudeIntegrator> attitude_;  // from the filter's corrected body rate
+  std::optional<est::AttitudeComparison> attitude_;  // the comparison `driftless estimate` makes
   AttitudeNow attitude_now_;
 };
 
