@@ -99,11 +99,16 @@ int run_estimate_cmd(const EstimateArgs& a) {
   const bool interrupted = stop_requested().load();
 
   auto warnings = summary.warnings;
+  std::vector<FigureOutcome> figures;
   if (a.plot && !interrupted) {
     double rate = reader.metadata().sample_rate_hz();
     if (!std::isfinite(rate) && summary.rows > 1) rate = double(summary.rows - 1) / (summary.t_last_s - summary.t_first_s);
-    const EstimateFigureInputs fig{&files.series(), truth, attitude, rate};
-    for (auto& w : write_estimate_figures(dir, fig)) warnings.push_back(w);
+    EstimateFigureInputs fig{&files.series(), truth, attitude, rate, summary.attitude_start_s,
+                             a.attitude_start_sigma_dps};
+    figures = write_estimate_figures(dir, fig);
+    for (const auto& f : figures) {
+      if (!f.written) warnings.push_back(fmt::format("{} not drawn: {}", f.stem, f.reason));
+    }
   } else if (a.plot) {
     warnings.push_back("figures not drawn: the run was interrupted");
   }
@@ -114,6 +119,7 @@ int run_estimate_cmd(const EstimateArgs& a) {
   ctx.mode = cfg.mode;
   ctx.complete = !interrupted;
   ctx.stopped_at_t_s = summary.t_last_s;
+  ctx.figures = &figures;
   write_estimate_summary(dir / "summary.json", ctx, final_summary);
 
   for (const auto& w : warnings) fmt::print(stderr, "driftless estimate: warning: {}\n", w);

@@ -88,6 +88,17 @@ std::string json_string(const std::string& s) {
   return o + "\"";
 }
 
+// "figures": what --plot drew, and why a figure was left out
+std::string json_figures(const std::vector<FigureOutcome>& figures) {
+  std::string o = "[";
+  for (std::size_t i = 0; i < figures.size(); ++i) {
+    const auto& f = figures[i];
+    o += fmt::format("{}{{\"name\": {}, \"written\": {}, \"reason\": {}}}", i ? ", " : "", json_string(f.stem),
+                     f.written ? "true" : "false", f.written ? "null" : json_string(f.reason));
+  }
+  return o + "]";
+}
+
 }  // namespace
 
 EstimateFiles::EstimateFiles(const fs::path& dir, const EstimateFilesOptions& opt)
@@ -139,6 +150,7 @@ void EstimateFiles::on_update(const est::UpdateRecord& r, const est::Matrix6d&, 
     for (int i = 0; i < 3; ++i) l.next(s.true_bias2_dps[i], 9);
   }
   l.end_into(estimate_);
+  if (opt_.keep_series) series_.add_update(r, s);
 }
 
 void EstimateFiles::on_attitude(const est::AttitudePoint& p) {
@@ -213,6 +225,7 @@ void write_estimate_summary(const fs::path& path, const SummaryContext& ctx, con
     o += "  },\n";
   }
   add("  \"bias_error_rms_dps\": {},\n", json_number(s.truth.bias_error_rms_dps));
+  if (ctx.figures != nullptr) add("  \"figures\": {},\n", json_figures(*ctx.figures));
   o += "  \"warnings\": [";
   for (std::size_t i = 0; i < s.warnings.size(); ++i) add("{}{}", i ? ", " : "", json_string(s.warnings[i]));
   o += "]\n}\n";

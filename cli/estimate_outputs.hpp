@@ -61,6 +61,7 @@ struct SummaryContext {
   est::FilterMode mode = est::FilterMode::kGeneral;
   bool complete = true;             // false: the run was interrupted
   double stopped_at_t_s = kNaN;     // s, the last row processed when interrupted
+  const std::vector<FigureOutcome>* figures = nullptr;  // what --plot drew (nullptr: no "figures")
 };
 
 /// Writes summary.json (docs/estimator.md): "complete" and "stopped_at_t_s" first, then the
