@@ -8,16 +8,13 @@
 #include <Eigen/Geometry>
 #include <Eigen/LU>
 
+#include "estimator/geometry.hpp"
 #include "estimator/stats.hpp"
 
 namespace driftless::est {
 namespace {
 
 constexpr double kBiasInstabilityFactor = 0.6642824702679600;  // sqrt(2 ln 2 / pi)
-
-Eigen::Matrix3d rot_deg(const Eigen::Vector3d& axis, double deg) {
-  return Eigen::AngleAxisd(deg * kRadPerDeg, axis).toRotationMatrix();
-}
 
 bool finite(double v) { return std::isfinite(v); }
 
@@ -184,7 +181,7 @@ Eigen::Matrix3d DriftlessFilter::body_from_sensor(int sensor, double plat_deg) c
   const std::size_t i = sensor == 1 ? 0 : 1;
   if (cache_deg_[i] == plat_deg) return cache_M_[i];
   const auto& list = sensor == 1 ? cfg_.calibration.sensor1 : cfg_.calibration.sensor2;
-  Eigen::Matrix3d M = rot_deg(sensor == 1 ? hinge1_ : hinge2_, plat_deg);
+  Eigen::Matrix3d M = geo::rot_about_axis_deg(sensor == 1 ? hinge1_ : hinge2_, plat_deg);
   double best = cfg_.calibration.match_tolerance_deg;
   for (const auto& p : list) {
     const double d = std::fabs(p.plat_deg - plat_deg);
@@ -198,20 +195,12 @@ Eigen::Matrix3d DriftlessFilter::body_from_sensor(int sensor, double plat_deg) c
   return M;
 }
 
-// eq. (5)'s position sequence: (+,+), (+,-), (-,-), (-,+)
-int DriftlessFilter::pattern_of(double p1, double p2) const {
-  const bool s1 = p1 >= 0.0, s2 = p2 >= 0.0;
-  if (s1 && s2) return 0;
-  if (s1 && !s2) return 1;
-  if (!s1 && !s2) return 2;
-  return 3;
-}
+// eq. (5)'s position sequence (geo::kFlipCycle): (+,+), (+,-), (-,-), (-,+)
+int DriftlessFilter::pattern_of(double p1, double p2) const { return geo::flip_cycle_index(p1, p2); }
 
 double DriftlessFilter::pattern_angle(int pattern, int sensor) const {
-  static constexpr int kSign1[4] = {+1, +1, -1, -1};
-  static constexpr int kSign2[4] = {+1, -1, -1, +1};
-  const int p = ((pattern % 4) + 4) % 4;
-  return cfg_.flip_angle_deg * (sensor == 1 ? kSign1[p] : kSign2[p]);
+  const geo::FlipSigns s = geo::flip_cycle_at(pattern);
+  return cfg_.flip_angle_deg * (sensor == 1 ? s.plat1 : s.plat2);
 }
 
 void DriftlessFilter::predict_to(double t_s) {

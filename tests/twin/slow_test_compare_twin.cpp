@@ -199,7 +199,7 @@ TEST(CompareTwinEffects, LowpassLatency) {
   };
   c.effect = "lowpass_latency";
   c.param = "s1.delay_s";
-  c.truth = mpu6050_dlpf(5).gyro_delay_s - mpu6050_dlpf(3).gyro_delay_s;
+  c.truth = mpu6050::dlpf_setting(5).gyro_delay_s - mpu6050::dlpf_setting(3).gyro_delay_s;
   check(c);
 }
 

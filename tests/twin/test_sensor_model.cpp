@@ -206,7 +206,7 @@ TEST(SensorModel, DlpfGroupDelayMatchesTheDatasheet) {
       p.lowpass_latency.enabled = true;
       p.lowpass_latency.dlpf_cfg = cfg;
       SensorModel m(p, fs, 1);
-      const DlpfSetting d = mpu6050_dlpf(cfg);
+      const DlpfSetting d = mpu6050::dlpf_setting(cfg);
       EXPECT_NEAR(m.gyro_lowpass().dc_group_delay_s(fs), d.gyro_delay_s, 1e-15);
       EXPECT_NEAR(m.accel_lowpass().dc_group_delay_s(fs), d.accel_delay_s, 1e-15);
       const double slope = 0.5;  // rad/s per s

@@ -148,7 +148,7 @@ struct LowpassRun {
 std::vector<double> dlpf_impulse(const SensorParams& p, double fs) {
   std::vector<double> h;
   if (!p.lowpass_latency.enabled) return {1.0};
-  const DlpfSetting set = mpu6050_dlpf(p.lowpass_latency.dlpf_cfg);
+  const DlpfSetting set = mpu6050::dlpf_setting(p.lowpass_latency.dlpf_cfg);
   LowpassRun lp;
   lp.d = design_lowpass(set.gyro_bandwidth_hz, set.gyro_delay_s, fs);
   lp.apply(Eigen::Vector3d::Zero());
@@ -211,7 +211,7 @@ SensorPrediction predict_sensor(const Replay& r, int s, const SensorParams& p, c
   out.temp_from_log = r.has_temp;
   LowpassRun lp;
   if (d.lowpass_latency.enabled) {
-    const DlpfSetting set = mpu6050_dlpf(d.lowpass_latency.dlpf_cfg);
+    const DlpfSetting set = mpu6050::dlpf_setting(d.lowpass_latency.dlpf_cfg);
     lp.d = design_lowpass(set.gyro_bandwidth_hz, set.gyro_delay_s, r.sample_rate_hz);
   }
   // end-stop errors: the platform rests at nominal + error, so the sensor frame is turned by

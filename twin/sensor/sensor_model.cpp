@@ -80,49 +80,7 @@ double accel_adc_axis_mps2(const AccelQuantizationParams& q, double a) {
 
 }  // namespace
 
-// ---- random streams ----
-
-std::uint64_t derive_seed(std::uint64_t seed, std::uint64_t stream) {
-  auto mix = [](std::uint64_t z) {  // splitmix64 finaliser
-    z += 0x9E3779B97F4A7C15ull;
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-  };
-  return mix(mix(seed) ^ mix(stream * 0xD1B54A32D192ED03ull + 0x632BE59BD9B4E019ull));
-}
-
-double NormalStream::operator()() {
-  if (has_spare_) {
-    has_spare_ = false;
-    return spare_;
-  }
-  double u, v, s;
-  do {
-    u = 2.0 * uniform() - 1.0;
-    v = 2.0 * uniform() - 1.0;
-    s = u * u + v * v;
-  } while (s >= 1.0 || s == 0.0);
-  const double m = std::sqrt(-2.0 * std::log(s) / s);
-  spare_ = v * m;
-  has_spare_ = true;
-  return u * m;
-}
-
 // ---- DLPF ----
-
-DlpfSetting mpu6050_dlpf(int cfg) {
-  // MPU-6000/6050 register map rev 4.2, register 26 (CONFIG): bandwidth Hz, delay ms
-  static const DlpfSetting table[7] = {
-      {260.0, 0.0e-3, 256.0, 0.98e-3}, {184.0, 2.0e-3, 188.0, 1.9e-3},
-      {94.0, 3.0e-3, 98.0, 2.8e-3},    {44.0, 4.9e-3, 42.0, 4.8e-3},
-      {21.0, 8.5e-3, 20.0, 8.3e-3},    {10.0, 13.8e-3, 10.0, 13.4e-3},
-      {5.0, 19.0e-3, 5.0, 18.6e-3},
-  };
-  if (cfg < 0 || cfg > 6)
-    throw std::invalid_argument("MPU6050 dlpf_cfg must be 0..6, got " + std::to_string(cfg));
-  return table[cfg];
-}
 
 double LowpassDesign::dc_group_delay_s(double fs) const {
   return (pole / (1.0 - pole) + delay_whole_samples + delay_frac) / fs;
@@ -385,7 +343,7 @@ SensorModel::SensorModel(const SensorParams& params, double sample_rate_hz, std:
     throw std::invalid_argument("SensorModel: sample_rate_hz must be > 0");
   const auto& p = params_;
   if (p.lowpass_latency.enabled) {
-    const DlpfSetting d = mpu6050_dlpf(p.lowpass_latency.dlpf_cfg);
+    const DlpfSetting d = mpu6050::dlpf_setting(p.lowpass_latency.dlpf_cfg);
     gyro_filter_ = LowpassFilter(design_lowpass(d.gyro_bandwidth_hz, d.gyro_delay_s, fs_hz_));
     accel_filter_ = LowpassFilter(design_lowpass(d.accel_bandwidth_hz, d.accel_delay_s, fs_hz_));
   }
@@ -413,7 +371,7 @@ SensorModel::SensorModel(const SensorParams& params, double sample_rate_hz, std:
   // otherwise it is added before the filter, which colours it (long-tau density stays N)
   double gyro_noise_bw_hz = 0.5 * fs_hz_, accel_noise_bw_hz = 0.5 * fs_hz_;
   if (p.lowpass_latency.enabled) {
-    const DlpfSetting d = mpu6050_dlpf(p.lowpass_latency.dlpf_cfg);
+    const DlpfSetting d = mpu6050::dlpf_setting(p.lowpass_latency.dlpf_cfg);
     gyro_white_after_filter_ = 2.0 * d.gyro_bandwidth_hz >= fs_hz_;
     accel_white_after_filter_ = 2.0 * d.accel_bandwidth_hz >= fs_hz_;
     if (gyro_white_after_filter_) gyro_noise_bw_hz = d.gyro_bandwidth_hz;
