@@ -233,180 +233,223 @@ void save_rig_plan(const std::filesystem::path& path, const RigPlan& plan) {
   if (!f) throw std::runtime_error("cannot write rig plan " + path.string());
 }
 
+namespace {
+
+// what extract_segments knows about the whole log while it walks the segments
+struct ExtractContext {
+  const std::vector<Sample>& log;
+  std::string log_name;
+  std::string mismatch;  // message prefix: "plan does not match the log <name>: "
+  Eigen::Vector3d hinge[2];
+  Eigen::Vector3d w_earth_enu_dps = Eigen::Vector3d::Zero();
+  double fs_sat_dps = 0.0;
+  double temp_sum[2] = {0, 0};
+  std::size_t temp_n[2] = {0, 0};
+};
+
+// one segment's running sums besides its samples
+struct SegmentSums {
+  Eigen::Vector3d turn_sum = Eigen::Vector3d::Zero();  // the table's turn from ref_q, deg/s
+  double turn_n = 0;
+  Eigen::Vector3d f_sum[2] = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  double f_n[2] = {0, 0}, tc_sum[2] = {0, 0}, tc_n[2] = {0, 0};
+};
+
+// the sensor's nominal response to the table's rate: R_i(p)^T a rate, sensor axes
+Eigen::Vector3d nominal_response_dps(const ExtractContext& c, const PlanSegment& ps, int i, int pos) {
+  return geo::rot_about_axis_deg(c.hinge[i], est::position_deg(pos)).transpose() * ps.axis_box * ps.rate_dps;
+}
+
+// the platform angles as the log knows them must sit at the planned end stops; the gyros must not
+// reach their full scale
+void check_row(const ExtractContext& c, const PlanSegment& ps, const std::string& seg_where, const Sample& s) {
+  const double plat[2] = {s.plat1_deg, s.plat2_deg};
+  const double want[2] = {ps.plat1_deg, ps.plat2_deg};
+  for (int i = 0; i < 2; ++i) {
+    if (!std::isfinite(plat[i]) || std::abs(plat[i] - want[i]) > 2.0) {
+      throw std::invalid_argument(fmt::format(
+          "{}{}: at t = {} s plat{}_deg is {} but the plan puts platform {} at {} deg", c.mismatch,
+          seg_where, s.t_s, i + 1, std::isfinite(plat[i]) ? fmt::format("{}", plat[i]) : std::string("empty (moving)"),
+          i + 1, want[i]));
+    }
+  }
+  if (!s.gyros_finite()) return;
+  for (int i = 0; i < 2; ++i) {
+    const Eigen::Vector3d& y = i == 0 ? s.gyro1_dps : s.gyro2_dps;
+    if (y.cwiseAbs().maxCoeff() >= 0.999 * c.fs_sat_dps) {
+      throw std::invalid_argument(fmt::format(
+          "{}: {}: gyro {} reads {} deg/s at t = {} s, at its full scale +-{} deg/s: the rate "
+          "table saturates the gyro (lower rate_dps, or set gyro_full_scale_dps to the "
+          "sensor's range)", c.log_name, seg_where, i + 1, vtext(y, 2), s.t_s, c.fs_sat_dps));
+    }
+  }
+}
+
+// one plateau sample: the fit's input, the turn ref_q shows, gravity and temperature sums
+void add_plateau_sample(const ExtractContext& c, const PlanSegment& ps, const Sample& s,
+                        const Sample* prev_plateau, est::CalibSegment& seg, SegmentSums& sums) {
+  est::CalibSample x;
+  x.t_s = s.t_s;
+  x.sign = ps.sign_at(s.t_s);
+  x.gyro_dps = {s.gyro1_dps, s.gyro2_dps};
+  const bool q_ok = s.ref_q_wxyz.allFinite();
+  if (q_ok) x.earth_rate_box_dps = s.q_enu_from_body().normalized().conjugate() * c.w_earth_enu_dps;
+  // the table's turn as ref_q shows it, box axes: 2 vec(q_k^-1 q_k+1) / dt
+  if (q_ok && prev_plateau && prev_plateau->ref_q_wxyz.allFinite() && ps.sign_at(prev_plateau->t_s) == x.sign) {
+    const Eigen::Quaterniond dq =
+        prev_plateau->q_enu_from_body().normalized().conjugate() * s.q_enu_from_body().normalized();
+    sums.turn_sum += x.sign * geo::rotvec_rad(dq) * kDegPerRad / (s.t_s - prev_plateau->t_s);
+    sums.turn_n += 1;
+  }
+  seg.samples.push_back(x);
+  // gravity in sensor axes for the g-sensitivity fit
+  const Eigen::Vector3d* f[2] = {&s.accel1_mps2, &s.accel2_mps2};
+  const double tc[2] = {s.temp1_c, s.temp2_c};
+  for (int i = 0; i < 2; ++i) {
+    if (std::isfinite(tc[i])) sums.tc_sum[i] += tc[i], sums.tc_n[i] += 1;
+    if (!f[i]->allFinite()) continue;
+    sums.f_sum[i] += *f[i] / kStandardGravityMps2;
+    sums.f_n[i] += 1;
+  }
+}
+
+// the rows of one planned segment, checked against the plan
+est::CalibSegment collect_segment(ExtractContext& c, const PlanSegment& ps, const std::string& seg_where,
+                                  ExtractReport& rep, SegmentSums& sums) {
+  est::CalibSegment seg;
+  seg.name = ps.name;
+  seg.orientation = ps.orientation;
+  seg.pos = {ps.position(0), ps.position(1)};
+  seg.axis_box = ps.axis_box;
+  seg.rate_dps = ps.rate_dps;
+  auto first = std::lower_bound(c.log.begin(), c.log.end(), ps.t_start_s,
+                                [](const Sample& s, double t) { return s.t_s < t; });
+  const Sample* prev_plateau = nullptr;
+  for (auto it = first; it != c.log.end() && it->t_s < ps.t_end_s; ++it) {
+    const Sample& s = *it;
+    check_row(c, ps, seg_where, s);
+    if (!s.gyros_finite()) {
+      ++rep.rows_skipped_nan;
+      prev_plateau = nullptr;
+      continue;
+    }
+    const double temp[2] = {s.temp1_c, s.temp2_c};
+    for (int i = 0; i < 2; ++i)
+      if (std::isfinite(temp[i])) c.temp_sum[i] += temp[i], ++c.temp_n[i];
+    if (!ps.on_plateau(s.t_s)) {
+      prev_plateau = nullptr;
+      continue;
+    }
+    add_plateau_sample(c, ps, s, prev_plateau, seg, sums);
+    prev_plateau = &s;
+  }
+  for (int i = 0; i < 2; ++i) {
+    const auto iu = static_cast<std::size_t>(i);
+    const double half = 0.5 * static_cast<double>(seg.samples.size());
+    if (sums.f_n[i] > half) seg.f_mean_g[iu] = sums.f_sum[i] / sums.f_n[i];
+    if (sums.tc_n[i] > half) seg.temp_mean_c[iu] = sums.tc_sum[i] / sums.tc_n[i];
+  }
+  if (seg.samples.empty()) throw std::invalid_argument(c.mismatch + seg_where + " holds no usable plateau samples");
+  return seg;
+}
+
+// the reference attitude must show the planned turn
+void check_turn(const ExtractContext& c, const PlanSegment& ps, const std::string& seg_where, const SegmentSums& sums) {
+  if (!(sums.turn_n > 10)) return;
+  const Eigen::Vector3d turn = sums.turn_sum / sums.turn_n;
+  if (angle_deg(turn, ps.axis_box) > 10.0 || std::abs(turn.norm() / ps.rate_dps - 1.0) > 0.1) {
+    throw std::invalid_argument(fmt::format(
+        "{}{}: the reference attitude (ref_q) shows the box turning at {:.1f} deg/s about box "
+        "{}, the plan says {} deg/s about box {} (orientation {}, first_sign {:+g}); check the "
+        "orientation, rate_dps, t_start_s, half_period_s and first_sign",
+        c.mismatch, seg_where, turn.norm(), vtext(turn.normalized()), ps.rate_dps, vtext(ps.axis_box, 0),
+        ps.orientation, ps.first_sign));
+  }
+}
+
+// a clipped sensor shows a flat top below the level the turn should give: one extreme value
+// repeated over much of a plateau, short of the nominal response |R_i(p)^T a| rate
+void check_clipping(const ExtractContext& c, const PlanSegment& ps, const std::string& seg_where,
+                    const est::CalibSegment& seg) {
+  for (int i = 0; i < 2; ++i)
+    for (int j = 0; j < 3; ++j)
+      for (double sgn : {1.0, -1.0}) {
+        const double nominal = std::abs(nominal_response_dps(c, ps, i, seg.pos[i])[j]);
+        double extreme = 0.0;
+        std::size_t n = 0, at = 0;
+        for (const auto& x : seg.samples)
+          if (x.sign == sgn) extreme = std::max(extreme, std::abs(x.gyro_dps[i][j])), ++n;
+        for (const auto& x : seg.samples)
+          if (x.sign == sgn && std::abs(x.gyro_dps[i][j]) >= extreme - 1e-9) ++at;
+        if (n > 20 && at > n / 20 && extreme > 0.5 * ps.rate_dps && extreme < 0.9 * nominal) {
+          throw std::invalid_argument(fmt::format(
+              "{}: {}: gyro {} axis {} sits at {:.4f} deg/s in {:.0f} % of the {} plateau: it is "
+              "clipped, the rate table saturates the gyro (lower rate_dps or raise the sensor's "
+              "full scale, FS_SEL)", c.log_name, seg_where, i + 1, "xyz"[j], extreme,
+              100.0 * static_cast<double>(at) / static_cast<double>(n), sgn > 0 ? "+rate" : "-rate"));
+        }
+      }
+}
+
+// each sensor must follow the planned square wave: mean(sign y) ~ R_i(p)^T a rate
+void check_square_wave(const ExtractContext& c, const PlanSegment& ps, const std::string& seg_where,
+                       const est::CalibSegment& seg) {
+  for (int i = 0; i < 2; ++i) {
+    Eigen::Vector3d d = Eigen::Vector3d::Zero();
+    for (const auto& x : seg.samples) d += x.sign * x.gyro_dps[i];
+    d /= static_cast<double>(seg.samples.size());
+    const Eigen::Vector3d expected = nominal_response_dps(c, ps, i, seg.pos[i]);
+    if (d.norm() < 0.5 * ps.rate_dps || angle_deg(d, expected) > 30.0) {
+      throw std::invalid_argument(fmt::format(
+          "{}{}: sensor {}'s output does not follow the planned +-{} deg/s square wave: its mean "
+          "signed response is {} deg/s, a turn about box {} with platform {} at {} should give "
+          "about {} deg/s (check t_start_s, half_period_s, first_sign, the orientation and "
+          "plat{}_deg)",
+          c.mismatch, seg_where, i + 1, ps.rate_dps, vtext(d, 2), vtext(ps.axis_box, 0), i + 1,
+          est::position_name(seg.pos[i]), vtext(expected, 1), i + 1));
+    }
+  }
+}
+
+}  // namespace
+
 std::vector<est::CalibSegment> extract_segments(const std::vector<Sample>& log,
                                                 const log::Metadata& meta, const RigPlan& plan,
                                                 const std::string& log_name,
                                                 ExtractReport* report) {
   plan.validate();
   ExtractReport rep;
-  const std::string mismatch = "plan does not match the log " + log_name + ": ";
-  if (log.empty()) throw std::invalid_argument(mismatch + "the log holds no samples");
-  const Eigen::Vector3d hinge[2] = {meta.hinge1_axis().normalized(), meta.hinge2_axis().normalized()};
+  ExtractContext c{log, log_name, "plan does not match the log " + log_name + ": ",
+                   {meta.hinge1_axis().normalized(), meta.hinge2_axis().normalized()}};
+  if (log.empty()) throw std::invalid_argument(c.mismatch + "the log holds no samples");
   rep.sample_rate_hz = meta.sample_rate_hz();
   rep.latitude_deg = std::isfinite(plan.latitude_deg) ? plan.latitude_deg : meta.latitude_deg();
-  const bool have_ref_q = std::any_of(log.begin(), log.end(), [](const Sample& s) {
-    return s.ref_q_wxyz.allFinite();
-  });
+  const bool have_ref_q = std::any_of(log.begin(), log.end(), [](const Sample& s) { return s.ref_q_wxyz.allFinite(); });
   rep.earth_rate_removed = have_ref_q && std::isfinite(rep.latitude_deg);
   if (!have_ref_q) rep.notes.push_back("the log has no ref_q: the Earth rate is not removed");
   else if (!std::isfinite(rep.latitude_deg))
     rep.notes.push_back("no latitude_deg in the log or the plan: the Earth rate is not removed");
-  const Eigen::Vector3d w_earth_enu_dps = rep.earth_rate_removed
-                                              ? Eigen::Vector3d(geo::earth_rate_enu_radps(rep.latitude_deg) * kDegPerRad)
-                                              : Eigen::Vector3d::Zero();
+  if (rep.earth_rate_removed) c.w_earth_enu_dps = geo::earth_rate_enu_radps(rep.latitude_deg) * kDegPerRad;
+  c.fs_sat_dps = plan.gyro_full_scale_dps;
   const double t_log0 = log.front().t_s, t_log1 = log.back().t_s;
-  const double fs_sat = plan.gyro_full_scale_dps;
-  double temp_sum[2] = {0, 0};
-  std::size_t temp_n[2] = {0, 0};
 
   std::vector<est::CalibSegment> out;
   for (const auto& ps : plan.segments) {
     const std::string seg_where = fmt::format("segment '{}' (t = {} .. {} s)", ps.name, ps.t_start_s, ps.t_end_s);
     if (ps.t_start_s < t_log0 || ps.t_end_s > t_log1 + 0.5) {
-      throw std::invalid_argument(fmt::format("{}{} lies outside the log (t = {} .. {} s)", mismatch,
+      throw std::invalid_argument(fmt::format("{}{} lies outside the log (t = {} .. {} s)", c.mismatch,
                                               seg_where, t_log0, t_log1));
     }
-    est::CalibSegment seg;
-    seg.name = ps.name;
-    seg.orientation = ps.orientation;
-    seg.pos = {ps.position(0), ps.position(1)};
-    seg.axis_box = ps.axis_box;
-    seg.rate_dps = ps.rate_dps;
-    auto first = std::lower_bound(log.begin(), log.end(), ps.t_start_s,
-                                  [](const Sample& s, double t) { return s.t_s < t; });
-    Eigen::Vector3d turn_sum = Eigen::Vector3d::Zero();
-    double turn_n = 0;
-    Eigen::Vector3d f_sum[2] = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
-    double f_n[2] = {0, 0}, tc_sum[2] = {0, 0}, tc_n[2] = {0, 0};
-    const Sample* prev_plateau = nullptr;
-    for (auto it = first; it != log.end() && it->t_s < ps.t_end_s; ++it) {
-      const Sample& s = *it;
-      // platform angles as the log knows them must sit at the planned end stops
-      const double plat[2] = {s.plat1_deg, s.plat2_deg};
-      const double want[2] = {ps.plat1_deg, ps.plat2_deg};
-      for (int i = 0; i < 2; ++i) {
-        if (!std::isfinite(plat[i]) || std::abs(plat[i] - want[i]) > 2.0) {
-          throw std::invalid_argument(fmt::format(
-              "{}{}: at t = {} s plat{}_deg is {} but the plan puts platform {} at {} deg",
-              mismatch, seg_where, s.t_s, i + 1,
-              std::isfinite(plat[i]) ? fmt::format("{}", plat[i]) : std::string("empty (moving)"),
-              i + 1, want[i]));
-        }
-      }
-      if (!s.gyros_finite()) {
-        ++rep.rows_skipped_nan;
-        prev_plateau = nullptr;
-        continue;
-      }
-      for (int i = 0; i < 2; ++i) {
-        const Eigen::Vector3d& y = i == 0 ? s.gyro1_dps : s.gyro2_dps;
-        if (y.cwiseAbs().maxCoeff() >= 0.999 * fs_sat) {
-          throw std::invalid_argument(fmt::format(
-              "{}: {}: gyro {} reads {} deg/s at t = {} s, at its full scale +-{} deg/s: the rate "
-              "table saturates the gyro (lower rate_dps, or set gyro_full_scale_dps to the "
-              "sensor's range)", log_name, seg_where, i + 1, vtext(y, 2), s.t_s, fs_sat));
-        }
-      }
-      const double temp[2] = {s.temp1_c, s.temp2_c};
-      for (int i = 0; i < 2; ++i)
-        if (std::isfinite(temp[i])) temp_sum[i] += temp[i], ++temp_n[i];
-      if (!ps.on_plateau(s.t_s)) {
-        prev_plateau = nullptr;
-        continue;
-      }
-      est::CalibSample x;
-      x.t_s = s.t_s;
-      x.sign = ps.sign_at(s.t_s);
-      x.gyro_dps = {s.gyro1_dps, s.gyro2_dps};
-      const bool q_ok = s.ref_q_wxyz.allFinite();
-      if (q_ok && rep.earth_rate_removed)
-        x.earth_rate_box_dps = s.q_enu_from_body().normalized().conjugate() * w_earth_enu_dps;
-      // the table's turn as ref_q shows it, box axes: 2 vec(q_k^-1 q_k+1) / dt
-      if (q_ok && prev_plateau && prev_plateau->ref_q_wxyz.allFinite() &&
-          ps.sign_at(prev_plateau->t_s) == x.sign) {
-        const Eigen::Quaterniond dq =
-            prev_plateau->q_enu_from_body().normalized().conjugate() * s.q_enu_from_body().normalized();
-        const double dt = s.t_s - prev_plateau->t_s;
-        turn_sum += x.sign * geo::rotvec_rad(dq) * kDegPerRad / dt;
-        turn_n += 1;
-      }
-      prev_plateau = &s;
-      seg.samples.push_back(x);
-      // gravity in sensor axes for the g-sensitivity fit
-      const Eigen::Vector3d* f[2] = {&s.accel1_mps2, &s.accel2_mps2};
-      const double tc[2] = {s.temp1_c, s.temp2_c};
-      for (int i = 0; i < 2; ++i) {
-        if (std::isfinite(tc[i])) tc_sum[i] += tc[i], tc_n[i] += 1;
-        if (!f[i]->allFinite()) continue;
-        f_sum[i] += *f[i] / kStandardGravityMps2;
-        f_n[i] += 1;
-      }
-    }
-    for (int i = 0; i < 2; ++i) {
-      const auto iu = static_cast<std::size_t>(i);
-      const double half = 0.5 * static_cast<double>(seg.samples.size());
-      if (f_n[i] > half) seg.f_mean_g[iu] = f_sum[i] / f_n[i];
-      if (tc_n[i] > half) seg.temp_mean_c[iu] = tc_sum[i] / tc_n[i];
-    }
-    if (seg.samples.empty()) {
-      throw std::invalid_argument(mismatch + seg_where + " holds no usable plateau samples");
-    }
-    // the reference attitude must show the planned turn
-    if (turn_n > 10) {
-      const Eigen::Vector3d turn = turn_sum / turn_n;
-      if (angle_deg(turn, ps.axis_box) > 10.0 || std::abs(turn.norm() / ps.rate_dps - 1.0) > 0.1) {
-        throw std::invalid_argument(fmt::format(
-            "{}{}: the reference attitude (ref_q) shows the box turning at {:.1f} deg/s about box "
-            "{}, the plan says {} deg/s about box {} (orientation {}, first_sign {:+g}); check the "
-            "orientation, rate_dps, t_start_s, half_period_s and first_sign",
-            mismatch, seg_where, turn.norm(), vtext(turn.normalized()), ps.rate_dps,
-            vtext(ps.axis_box, 0), ps.orientation, ps.first_sign));
-      }
-    }
-    // a clipped sensor shows a flat top below the level the turn should give: one extreme
-    // value repeated over much of a plateau, short of the nominal response |R_i(p)^T a| rate
-    for (int i = 0; i < 2; ++i)
-      for (int j = 0; j < 3; ++j)
-        for (double sgn : {1.0, -1.0}) {
-          const double nominal = std::abs(
-              (geo::rot_about_axis_deg(hinge[i], est::position_deg(seg.pos[i])).transpose() * ps.axis_box)[j] *
-              ps.rate_dps);
-          double extreme = 0.0;
-          std::size_t n = 0, at = 0;
-          for (const auto& x : seg.samples)
-            if (x.sign == sgn) extreme = std::max(extreme, std::abs(x.gyro_dps[i][j])), ++n;
-          for (const auto& x : seg.samples)
-            if (x.sign == sgn && std::abs(x.gyro_dps[i][j]) >= extreme - 1e-9) ++at;
-          if (n > 20 && at > n / 20 && extreme > 0.5 * ps.rate_dps && extreme < 0.9 * nominal) {
-            throw std::invalid_argument(fmt::format(
-                "{}: {}: gyro {} axis {} sits at {:.4f} deg/s in {:.0f} % of the {} plateau: it is "
-                "clipped, the rate table saturates the gyro (lower rate_dps or raise the sensor's "
-                "full scale, FS_SEL)", log_name, seg_where, i + 1, "xyz"[j], extreme,
-                100.0 * static_cast<double>(at) / static_cast<double>(n), sgn > 0 ? "+rate" : "-rate"));
-          }
-        }
-    // each sensor must follow the planned square wave: mean(sign y) ~ R_i(p)^T a rate
-    for (int i = 0; i < 2; ++i) {
-      Eigen::Vector3d d = Eigen::Vector3d::Zero();
-      for (const auto& x : seg.samples) d += x.sign * x.gyro_dps[i];
-      d /= static_cast<double>(seg.samples.size());
-      const Eigen::Vector3d expected =
-          geo::rot_about_axis_deg(hinge[i], est::position_deg(seg.pos[i])).transpose() * ps.axis_box * ps.rate_dps;
-      if (d.norm() < 0.5 * ps.rate_dps || angle_deg(d, expected) > 30.0) {
-        throw std::invalid_argument(fmt::format(
-            "{}{}: sensor {}'s output does not follow the planned +-{} deg/s square wave: its mean "
-            "signed response is {} deg/s, a turn about box {} with platform {} at {} should give "
-            "about {} deg/s (check t_start_s, half_period_s, first_sign, the orientation and "
-            "plat{}_deg)",
-            mismatch, seg_where, i + 1, ps.rate_dps, vtext(d, 2), vtext(ps.axis_box, 0), i + 1,
-            est::position_name(seg.pos[i]), vtext(expected, 1), i + 1));
-      }
-    }
+    SegmentSums sums;
+    est::CalibSegment seg = collect_segment(c, ps, seg_where, rep, sums);
+    check_turn(c, ps, seg_where, sums);
+    check_clipping(c, ps, seg_where, seg);
+    check_square_wave(c, ps, seg_where, seg);
     rep.samples_used.push_back(seg.samples.size());
     out.push_back(std::move(seg));
   }
   for (int i = 0; i < 2; ++i)
-    if (temp_n[i] > 0) rep.mean_temp_c[i] = temp_sum[i] / static_cast<double>(temp_n[i]);
+    if (c.temp_n[i] > 0) rep.mean_temp_c[i] = c.temp_sum[i] / static_cast<double>(c.temp_n[i]);
   if (report) *report = rep;
   return out;
 }

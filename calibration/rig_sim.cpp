@@ -90,7 +90,7 @@ double smoothstep(double x) {
 }
 
 Eigen::Quaterniond rz_deg(double deg) {
-  return Eigen::Quaterniond(Eigen::AngleAxisd(deg * kRadPerDeg, Eigen::Vector3d::UnitZ()));
+  return geo::quat_from_rotvec(Eigen::Vector3d::UnitZ() * (deg * kRadPerDeg));
 }
 
 // the pan/tilt unit as a rate table: the box mounted with the segment axis up, turned about up

@@ -23,8 +23,18 @@ enum class Stream : std::uint64_t {
   kFaultInjection = 401,    // studies: planted sensor faults
 };
 
+/// The splitmix64 step (Steele, Lea, Flood 2014): a bijective 64-bit mix of `z`.
+inline std::uint64_t mix64(std::uint64_t z) {
+  z += 0x9E3779B97F4A7C15ull;
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+
 /// A seed for sub-stream `stream` of `seed` (splitmix64 mixing; streams never collide in practice).
-std::uint64_t derive_seed(std::uint64_t seed, std::uint64_t stream);
+inline std::uint64_t derive_seed(std::uint64_t seed, std::uint64_t stream) {
+  return mix64(mix64(seed) ^ mix64(stream * 0xD1B54A32D192ED03ull + 0x632BE59BD9B4E019ull));
+}
 /// The seed of a named stream.
 inline std::uint64_t stream_seed(std::uint64_t seed, Stream s) {
   return derive_seed(seed, static_cast<std::uint64_t>(s));

@@ -1,6 +1,8 @@
 // Sweep file, grid expansion, parallel runner and result table. Format: docs/sweep.md.
 #include "studies/sweep.hpp"
 
+#include "estimator/random.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -47,13 +49,6 @@ std::string csv_text(std::string s) {
     if (c == ',' || c == '"' || c == '\n' || c == '\r') c = ';';
   }
   return s;
-}
-
-std::uint64_t splitmix64(std::uint64_t x) {
-  x += 0x9E3779B97F4A7C15ull;
-  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
-  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
-  return x ^ (x >> 31);
 }
 
 }  // namespace
@@ -209,7 +204,7 @@ SweepConfig load_sweep(const std::filesystem::path& path) {
 
 std::uint64_t run_seed(std::uint64_t base_seed, int mc) {
   // 31 bits: scenario files and other tools read a seed as a plain integer
-  return splitmix64(base_seed * 0x100000001B3ull + static_cast<std::uint64_t>(mc)) >> 33;
+  return rnd::mix64(base_seed * 0x100000001B3ull + static_cast<std::uint64_t>(mc)) >> 33;
 }
 
 std::vector<RunSpec> expand(const SweepConfig& cfg) {

@@ -70,7 +70,7 @@ struct RunSpec {
 
 /// Every run, in index order (last grid axis varies fastest, then the Monte-Carlo index).
 std::vector<RunSpec> expand(const SweepConfig& cfg);
-/// The seed of Monte-Carlo run `mc` (31 bits of splitmix64 of the base seed and mc; same for every point).
+/// The seed of Monte-Carlo run `mc` (31 bits of rnd::mix64 of the base seed and mc; same for every point).
 std::uint64_t run_seed(std::uint64_t base_seed, int mc);
 
 /// Named results of one run, in a fixed order.

@@ -157,7 +157,7 @@ TEST(TwinMotors, BridgeFlipScheduleDrivesTheTwinInTheLiveLoop) {
   const std::filesystem::path path = std::filesystem::temp_directory_path() /
                                      ("driftless-twin-bridge-" + std::to_string(::getpid()) + ".csv");
   // the paper's filter (mode: paper) expects eq. (5)'s order of positions
-  est::DriftlessFilter filter(est::paper_config(), meta);
+  est::DriftlessFilter filter(est::paper_config(), est::box_geometry_from_metadata(meta));
   LiveStats st;
   {
     log::LogWriter writer(path, meta, rig->source->fields());

@@ -1,4 +1,4 @@
-#include "twin/compare/compare_model.hpp"
+#include "diagnose/compare_model.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -8,9 +8,12 @@
 #include <fmt/core.h>
 #include <mujoco/mujoco.h>
 
+#include "estimator/geometry.hpp"
 #include "twin/world.hpp"
 
-namespace driftless::twin {
+namespace driftless::diagnose {
+
+using namespace driftless::twin;  // the sensor model, box and scenario types
 
 ModelConfig CompareModel::config() const {
   ModelConfig c;
@@ -218,8 +221,8 @@ SensorPrediction predict_sensor(const Replay& r, int s, const SensorParams& p, c
   // the error about the hinge axis relative to the logged angle (twin/world.hpp stop_rad)
   const Eigen::Vector2d err = (s == 0 ? box.stop1_error_deg : box.stop2_error_deg) +
                               Eigen::Vector2d(settled_offset_deg.row(s).transpose());  // [-stop, +stop]
-  const Eigen::Matrix3d Rt_minus = platform_rotation(r.hinge_axis[s], err[0]).transpose();
-  const Eigen::Matrix3d Rt_plus = platform_rotation(r.hinge_axis[s], err[1]).transpose();
+  const Eigen::Matrix3d Rt_minus = geo::rot_about_axis_deg(r.hinge_axis[s], err[0]).transpose();
+  const Eigen::Matrix3d Rt_plus = geo::rot_about_axis_deg(r.hinge_axis[s], err[1]).transpose();
   const bool stop_errors = err.cwiseAbs().maxCoeff() > 0.0;
   // time offset: the sensors sample at t - offset (linear interpolation of the replayed truth)
   const double shift = time_offset_s * r.sample_rate_hz;
@@ -286,4 +289,4 @@ double dlpf_lag1_autocorrelation(const SensorParams& p, double fs) {
   return g0 > 0 ? g1 / g0 : 0.0;
 }
 
-}  // namespace driftless::twin
+}  // namespace driftless::diagnose
