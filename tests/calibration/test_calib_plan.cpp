@@ -10,12 +10,13 @@
 #include "tests/calibration/calib_closed_form_rig.hpp"
 #include "calibration/calib_file.hpp"
 #include "calibration/rig_plan.hpp"
+#include "tests/temp_path.hpp"
 
 namespace driftless::calib {
 namespace {
 
 std::filesystem::path temp_path(const std::string& name) {
-  auto dir = std::filesystem::temp_directory_path() / "driftless_test_calib_plan";
+  auto dir = test::temp_path("driftless_test_calib_plan");
   std::filesystem::create_directories(dir);
   return dir / name;
 }

@@ -20,6 +20,7 @@
 #include "hil_bridge/source_rig.hpp"
 #include "hil_bridge/twin/sensor_model_generator.hpp"
 #include "hil_bridge/twin/twin_source.hpp"
+#include "tests/temp_path.hpp"
 
 namespace driftless::hil {
 namespace {
@@ -216,7 +217,7 @@ std::vector<Sample> emu_serial_samples(const std::string& preset, std::size_t n)
   opt.emu_sensor = preset;
   opt.seed = 5;
   const std::string tag = "emu-sensor-" + preset + "-" + std::to_string(::getpid());
-  opt.work_dir = (std::filesystem::temp_directory_path() / tag).string();
+  opt.work_dir = test::temp_path(tag).string();
   std::filesystem::create_directories(opt.work_dir);
   auto rig = make_source_rig("emu-serial", opt);
   EXPECT_EQ(rig->start(), "");

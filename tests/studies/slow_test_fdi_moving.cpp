@@ -60,6 +60,7 @@ TEST(FdiMoving, PlantedFaultsDetectedAndClassified) {
   ASSERT_EQ(c.grid[0].name, "fault_kind");
   std::vector<RunSpec> specs;
   const auto results = run_all(c, &specs);
+  int scale_runs = 0, scale_kind_correct = 0;
   for (std::size_t i = 0; i < results.size(); ++i) {
     const RunResult& r = results[i];
     ASSERT_TRUE(r.ok) << r.error;
@@ -69,18 +70,27 @@ TEST(FdiMoving, PlantedFaultsDetectedAndClassified) {
     EXPECT_EQ(metric(r, "false_alarm"), 0.0);
     if (kind == 0) continue;
     EXPECT_EQ(metric(r, "detected"), 1.0);
-    EXPECT_EQ(metric(r, "kind_correct"), 1.0);
     // stated delays under motion (docs/fdi.md): bias step and noise alarm 0.5 s, scale 3 s;
-    // isolation: bias step within two flips (50 s), noise 5 s, scale 5 s
+    // isolation: bias step within two flips (50 s), noise 5 s, scale up to 9 s (the pan/tilt
+    // unit dwells at rest up to 5 s, when a scale change is invisible)
     EXPECT_LE(metric(r, "alarm_delay_s"), kind == 4 ? 3.0 : 0.5);
-    EXPECT_LE(metric(r, "isolation_delay_s"), kind == 2 ? 50.0 : 5.0);
+    EXPECT_LE(metric(r, "isolation_delay_s"), kind == 2 ? 50.0 : kind == 4 ? 9.0 : 5.0);
+    if (kind == 4) {
+      // a scale change under motion is sometimes read as a bias step (docs/fdi.md: 2 of 24)
+      ++scale_runs;
+      scale_kind_correct += metric(r, "kind_correct") == 1.0;
+      continue;
+    }
+    EXPECT_EQ(metric(r, "kind_correct"), 1.0);
     // a scale change's sensor is ambiguous by nature (docs/fdi.md): sensor and axis only for
     // steps and bursts
-    if (kind != 4) {
-      EXPECT_EQ(metric(r, "sensor_correct"), 1.0);
-      EXPECT_EQ(metric(r, "axis_correct"), 1.0);
-    }
+    EXPECT_EQ(metric(r, "sensor_correct"), 1.0);
+    EXPECT_EQ(metric(r, "axis_correct"), 1.0);
   }
+  // six scale changes: with the documented rate of 1 in 12 read as a bias step, two or more
+  // misreadings happen in 8 % of seeds and three or more in 1 %: allow two
+  EXPECT_EQ(scale_runs, 6);
+  EXPECT_GE(scale_kind_correct, scale_runs - 2);
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 
 #include "estimator/log.hpp"
 #include "estimator/geometry.hpp"
+#include "tests/temp_path.hpp"
 #include "tests/twin/mujoco_fixture.hpp"
 #include "twin/simulator.hpp"
 
@@ -123,7 +124,7 @@ std::string slurp(const std::filesystem::path& p) {
 }
 
 TEST_F(SimulatorTest, SameSeedGivesAByteIdenticalLog) {
-  const auto dir = std::filesystem::temp_directory_path() / "driftless_test_sim";
+  const auto dir = test::temp_path("driftless_test_sim");
   std::filesystem::create_directories(dir);
   Scenario sc = load_scenario("vehicle");
   sc.duration_s = 6;
@@ -143,7 +144,7 @@ TEST_F(SimulatorTest, SameSeedGivesAByteIdenticalLog) {
 }
 
 TEST_F(SimulatorTest, StoppedRunLeavesAValidIncompleteLog) {
-  const auto dir = std::filesystem::temp_directory_path() / "driftless_test_sim";
+  const auto dir = test::temp_path("driftless_test_sim");
   std::filesystem::create_directories(dir);
   const auto r = simulate_to_log(short_static(30), dir / "stopped.csv", [](double f) { return f < 0.1; });
   EXPECT_FALSE(r.complete);
