@@ -16,7 +16,7 @@
 #include "cli/estimate_outputs.hpp"
 #include "estimator/calibration.hpp"
 #include "estimator/pipeline.hpp"
-#include "twin/calib/calib_file.hpp"
+#include "calibration/calib_file.hpp"
 
 namespace driftless::cli {
 namespace {
@@ -53,7 +53,7 @@ int run_estimate_cmd(const EstimateArgs& a) {
   log::LogReader reader(a.log, read_opt);
   // --calib: the calibrated matrices M replace R in eq. (1)-(2) (docs/calibration.md)
   if (!a.calib.empty()) {
-    const twin::calib::CalibFile c = twin::calib::load_calib(a.calib);
+    const calib::CalibFile c = calib::load_calib(a.calib);
     const auto& meta = reader.metadata();
     if ((c.hinge1_axis.normalized() - meta.hinge1_axis().normalized()).norm() > 1e-6 ||
         (c.hinge2_axis.normalized() - meta.hinge2_axis().normalized()).norm() > 1e-6) {

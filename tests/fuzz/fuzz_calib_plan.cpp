@@ -6,7 +6,7 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include "twin/calib/rig_plan.hpp"
+#include "calibration/rig_plan.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
