@@ -367,19 +367,6 @@ std::size_t trim_short_taus(const AllanCurve& c, const NoiseFitOptions& opt, std
   return first;
 }
 
-// the tau beyond which a rate random walk of `k2` would be half the rest of the model
-double tau_where_k_shows(const NoiseModel& m, double k2, double from_s) {
-  NoiseModel rest = m;
-  rest.coef[idx(NoiseTerm::kK)] = 0.0;
-  NoiseModel k_only;
-  k_only.tau0_s = m.tau0_s;
-  k_only.coef[idx(NoiseTerm::kK)] = k2;
-  for (double tau = from_s; tau < 1e9; tau *= 1.2) {
-    if (k_only.avar(tau) >= rest.avar(tau)) return tau;
-  }
-  return kNaN;
-}
-
 void record_warnings(NoiseFit& f, double record_s) {
   if (!f.B_min.valid && f.B_min.note.rfind("upper bound", 0) == 0) {
     f.warnings.push_back("record too short for B: the Allan deviation has no minimum within the usable taus; "
@@ -389,11 +376,9 @@ void record_warnings(NoiseFit& f, double record_s) {
                          fmt_g(record_s) + " s record (10x the minimum's tau recommended)");
   }
   if (!f.K.valid) {
-    const double k2 = f.K.upper_95 * f.K.upper_95;
-    const double need = k2 > 0.0 ? tau_where_k_shows(f.model(), k2, f.tau_fit_lo_s) : kNaN;
-    f.warnings.push_back("record too short for K: a rate random walk up to its 95 % bound would dominate only beyond " +
-                         (std::isfinite(need) ? "~" + fmt_g(need) + " s" : std::string("the record")) +
-                         " (usable taus end at " + fmt_g(f.tau_fit_hi_s) + " s of a " + fmt_g(record_s) + " s record)");
+    f.warnings.push_back("record too short for K: no rate random walk shows within the usable taus (up to " +
+                         fmt_g(f.tau_fit_hi_s) + " s of a " + fmt_g(record_s) + " s record); K < " + fmt_g(f.K.upper_95) +
+                         " (95 %)");
   }
 }
 

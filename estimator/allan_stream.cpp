@@ -122,10 +122,11 @@ std::vector<double> StreamingOctaveDeviation::level_means(std::size_t k) const {
   return out;
 }
 
-AllanCurve StreamingOctaveDeviation::finish() const {
+AllanCurve StreamingOctaveDeviation::finish(double sample_rate_hz) const {
+  const double rate = sample_rate_hz > 0.0 ? sample_rate_hz : opt_.sample_rate_hz;
   AllanCurve curve;
   curve.deviation = opt_.deviation;
-  curve.sample_rate_hz = opt_.sample_rate_hz;
+  curve.sample_rate_hz = rate;
   curve.samples = samples_;
   curve.overlapping = true;
   curve.confidence = opt_.confidence;
@@ -137,7 +138,7 @@ AllanCurve StreamingOctaveDeviation::finish() const {
     if (sums_[k].terms == 0) continue;
     AllanPoint p;
     p.m = std::size_t{1} << k;
-    p.tau_s = static_cast<double>(p.m) / opt_.sample_rate_hz;
+    p.tau_s = static_cast<double>(p.m) / rate;
     p.terms = sums_[k].terms;
     p.adev = deviation_from_sum(opt_.deviation, sums_[k], p.m);
     curve.points.push_back(p);

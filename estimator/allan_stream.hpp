@@ -32,8 +32,9 @@ class StreamingOctaveDeviation {
   void push(std::span<const double> rate);
   /// Ends the current gap-free segment: no difference spans the break.
   void break_segment();
-  /// The curve with noise types, edf and intervals (the accumulator stays usable).
-  AllanCurve finish() const;
+  /// The curve with noise types, edf and intervals (the accumulator stays usable). A rate > 0
+  /// (Hz) replaces the options' rate (when it is known only after the pass, e.g. from stamps).
+  AllanCurve finish(double sample_rate_hz = 0.0) const;
   std::size_t samples() const { return samples_; }
 
  private:
