@@ -8,6 +8,7 @@
 #include <fmt/core.h>
 
 #include "estimator/allan_stream.hpp"
+#include "estimator/box_geometry.hpp"
 #include "estimator/filter.hpp"
 #include "estimator/log.hpp"
 
@@ -76,7 +77,7 @@ std::unique_ptr<est::DriftlessFilter> make_filter(const InputArgs& a, const log:
     cfg = est::parse_estimator_config(in, a.config);
   }
   if (!a.mode.empty()) est::set_config_value(cfg, "mode", a.mode);
-  return std::make_unique<est::DriftlessFilter>(cfg, meta);
+  return std::make_unique<est::DriftlessFilter>(cfg, est::box_geometry_from_metadata(meta));
 }
 
 Loaded load_log(const InputArgs& a) {
