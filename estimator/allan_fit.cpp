@@ -411,16 +411,19 @@ NoiseFit fit_noise_parameters(const AllanCurve& curve, const NoiseFitOptions& op
   f.gm_model = gm.best.model;
   // the Gauss-Markov model only when clearly better: its long correlation times mimic K, and the
   // flicker model's B and K are what datasheets and IEEE 952 quote
-  const double gain = (chi2_of(fl.best) - chi2_of(gm.best)) / inflation(fl.best, kappa);
-  f.preferred = gain > 10.0 ? BiasModel::kGaussMarkov : BiasModel::kFlicker;
+  f.gm_evidence = (chi2_of(fl.best) - chi2_of(gm.best)) / inflation(fl.best, kappa);
+  f.preferred = f.gm_evidence > opt.gm_preference ? BiasModel::kGaussMarkov : BiasModel::kFlicker;
   const bool use_fl = f.preferred == BiasModel::kFlicker;
   const Profile& pref = use_fl ? fl : gm;
   f.chi2_red = chi2_red(pref.best);
   f.white_lowpass_tau_s = fl.best.model.white_tau_s;
-  f.Q = make_param(pref, d, NoiseTerm::kQ, kappa);
-  f.N = make_param(pref, d, NoiseTerm::kN, kappa);
-  f.K = make_param(pref, d, NoiseTerm::kK, kappa);
-  f.R = make_param(pref, d, NoiseTerm::kR, kappa);
+  // the IEEE 952 terms always come from the flicker model: a Gauss-Markov bias below its
+  // correlation time is the rate random walk K that model reads (and chance bends at the longest
+  // taus must not move K); the preferred model only decides the drawn sum and B_min
+  f.Q = make_param(fl, d, NoiseTerm::kQ, kappa);
+  f.N = make_param(fl, d, NoiseTerm::kN, kappa);
+  f.K = make_param(fl, d, NoiseTerm::kK, kappa);
+  f.R = make_param(fl, d, NoiseTerm::kR, kappa);
   f.B = make_param(fl, d, NoiseTerm::kB, kappa);
   f.gm_sigma = make_param(gm, d, NoiseTerm::kGaussMarkov, kappa);
   f.gm_tau = gm_time(gm, f.gm_sigma);
@@ -430,6 +433,7 @@ NoiseFit fit_noise_parameters(const AllanCurve& curve, const NoiseFitOptions& op
     }
   } else {
     f.B.note += std::string(f.B.note.empty() ? "" : "; ") + "alternative model (the Gauss-Markov model fits better)";
+    if (f.K.valid) f.K.note = "the Gauss-Markov model fits better: K is the random walk its bias shows below the correlation time";
   }
   f.B_min = model_minimum(pref.best, d, kappa, record_s);
   if (f.white_lowpass_tau_s > 0.0) {

@@ -60,6 +60,9 @@ struct NoiseFitOptions {
   /// Extra variance inflation on top of the fit's own model of how neighbouring taus correlate
   /// (1 = none; the Monte Carlo calibration in docs/allan.md needs none).
   double correlation_inflation = 1.0;
+  /// The Gauss-Markov model is preferred when it lowers chi-square by more than this (scaled by the
+  /// flicker fit's inflation): long correlation times mimic K, so chance bends must not switch.
+  double gm_preference = 10.0;
 };
 
 /// Which bias-instability model the fit prefers.
@@ -78,7 +81,8 @@ struct NoiseFit {
   NoiseParameter R;        // rate ramp
   double white_lowpass_tau_s = 0.0;  // s: the white noise's low-pass time constant (0: white to tau0)
   NoiseModel flicker_model, gm_model;  // the two fitted models
-  BiasModel preferred = BiasModel::kFlicker;  // by the Akaike criterion
+  BiasModel preferred = BiasModel::kFlicker;  // see NoiseFitOptions::gm_preference
+  double gm_evidence = 0.0;  // chi-square the Gauss-Markov model saves over the flicker one, scaled
   double chi2_red = 0.0;   // reduced chi-square of the preferred fit (> 1: model error, inflates sigma)
   double tau_fit_lo_s = 0.0, tau_fit_hi_s = 0.0;  // s, the fitted range (after trimming)
   std::size_t points_fitted = 0;

@@ -4,6 +4,7 @@
 #include <array>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 #include <fast_float/fast_float.h>
@@ -492,7 +493,9 @@ TextLayout detect_text_layout(std::string_view head, const std::string& file, co
     const double r = preamble_rate(trim(lines[i].text));
     if (r > 0.0) {
       L.nominal_rate_hz = r;
-      L.assumptions.push_back("rate " + std::to_string(r) + " Hz from line " + std::to_string(lines[i].number));
+      char b[96];
+      std::snprintf(b, sizeof b, "rate %g Hz stated in line %zu", r, lines[i].number);
+      L.assumptions.push_back(b);
     }
   }
   if (!opt.no_header) L.header = header_before(lines, start, L.separator, L.fields, L.assumptions);
