@@ -20,7 +20,7 @@ namespace {
 enum class Family {
   kNone, kRate, kRateDensity, kRateRandomWalk, kTime, kTemp, kRatio, kRatePerG, kRatePerTemp,
   kRatioPerTemp, kAngle, kAccel, kAccelDensity, kGyroSensitivity, kAccelSensitivity,
-  kTempSensitivity, kAccelRange
+  kTempSensitivity, kAccelRange, kFrequency
 };
 
 struct UnitDef {
@@ -76,6 +76,8 @@ const std::vector<UnitDef>& units() {
       {"lsb_per_g", Family::kAccelSensitivity, 1.0, "LSB per g"},
       {"lsb_per_degc", Family::kTempSensitivity, 1.0, "LSB per degC"},
       {"g", Family::kAccelRange, 1.0, "g"},
+      {"hz", Family::kFrequency, 1.0, "Hz"},
+      {"khz", Family::kFrequency, 1e3, "kHz"},
   };
   return u;
 }
@@ -159,7 +161,9 @@ const std::vector<Effect>& effects() {
       DL_EFFECT(adc_nonlinearity,
                 DL_FIELD(adc_nonlinearity, quadratic_pct_fs, "quadratic_pct_fs", "", Kind::kDouble),
                 DL_FIELD(adc_nonlinearity, cubic_pct_fs, "cubic_pct_fs", "", Kind::kDouble)),
-      DL_EFFECT(lowpass_latency, DL_FIELD(lowpass_latency, dlpf_cfg, "dlpf_cfg", "", Kind::kInt)),
+      DL_EFFECT(lowpass_latency, DL_FIELD(lowpass_latency, dlpf_cfg, "dlpf_cfg", "", Kind::kInt),
+                DL_FIELD(lowpass_latency, delay_s, "delay", "s", Kind::kDouble),
+                DL_FIELD(lowpass_latency, bandwidth_hz, "bandwidth", "hz", Kind::kDouble)),
       DL_EFFECT(sample_jitter, DL_FIELD(sample_jitter, sigma_s, "sigma", "s", Kind::kDouble)),
       DL_EFFECT(mounting_misalignment,
                 DL_FIELD(mounting_misalignment, angles_deg, "angles", "deg", Kind::kVec3),
@@ -175,6 +179,7 @@ const std::vector<Effect>& effects() {
                 DL_FIELD(accel_quantization, sensitivity_lsb_per_g, "sensitivity", "lsb_per_g",
                          Kind::kDouble),
                 DL_FIELD(accel_quantization, full_scale_g, "full_scale", "g", Kind::kDouble)),
+      DL_EFFECT(sample_delay, DL_FIELD(sample_delay, delay_s, "delay", "s", Kind::kDouble)),
   };
   return e;
 }
@@ -516,6 +521,11 @@ void SensorParams::validate() const {
   if (lowpass_latency.dlpf_cfg < 0 || lowpass_latency.dlpf_cfg > 6)
     bad("lowpass_latency.dlpf_cfg",
         "must be 0..6 (MPU6050 register 26), got " + std::to_string(lowpass_latency.dlpf_cfg));
+  non_negative("lowpass_latency.delay_s", lowpass_latency.delay_s);
+  if (lowpass_latency.delay_s > 1.0) bad("lowpass_latency.delay_s", "must be <= 1 s");
+  non_negative("lowpass_latency.bandwidth_hz", lowpass_latency.bandwidth_hz);
+  non_negative("sample_delay.delay_s", sample_delay.delay_s);
+  if (sample_delay.delay_s > 1.0) bad("sample_delay.delay_s", "must be <= 1 s");
   non_negative("sample_jitter.sigma_s", sample_jitter.sigma_s);
   if (sample_jitter.sigma_s > 0.1) bad("sample_jitter.sigma_s", "must be <= 0.1 s");
   each(mounting_misalignment.angles_deg, [](double v) {
