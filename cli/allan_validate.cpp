@@ -46,18 +46,16 @@ void set_axis(twin::SensorParams& p, int ax, const est::NoiseFit& f, std::vector
   if (f.R.valid) notes.push_back("R (rate ramp) not simulated: not in the catalogue");
 }
 
-// the MPU6050 DLPF setting whose time constant 1/(2 pi bandwidth) is nearest the fitted one
-int nearest_dlpf(double tau_s) {
-  int best = 0;
-  double err = 1e300;
-  for (int cfg = 0; cfg <= 6; ++cfg) {
-    const double t = 1.0 / (2.0 * 3.14159265358979 * twin::mpu6050_dlpf(cfg).gyro_bandwidth_hz);
-    if (std::fabs(std::log(t / tau_s)) < err) err = std::fabs(std::log(t / tau_s)), best = cfg;
-  }
-  return best;
+// the sensor model's continuous low-pass as a pure first-order pole of time constant `tau_s`: the
+// bandwidth 1/(2 pi tau) and, as group delay, the pole's own (no added sample delay)
+void set_lowpass(twin::SensorParams& p, double tau_s, double rate_hz) {
+  const double pole = std::exp(-1.0 / (tau_s * rate_hz));
+  p.lowpass_latency.enabled = true;
+  p.lowpass_latency.bandwidth_hz = 1.0 / (2.0 * 3.14159265358979323846 * tau_s);
+  p.lowpass_latency.delay_s = pole / (1.0 - pole) / rate_hz;
 }
 
-twin::SensorParams params_for(const std::array<const ChannelResult*, 3>& axes, std::vector<std::string>& notes) {
+twin::SensorParams params_for(const std::array<const ChannelResult*, 3>& axes, double rate_hz, std::vector<std::string>& notes) {
   twin::SensorParams p = twin::ideal_sensor();
   p.white_noise.enabled = p.rate_random_walk.enabled = p.bias_instability.enabled = true;
   double tf = 0.0;
@@ -67,10 +65,9 @@ twin::SensorParams params_for(const std::array<const ChannelResult*, 3>& axes, s
     tf = std::max(tf, axes[ax]->fit.white_lowpass_tau_s);
   }
   if (tf > 0.0) {
-    p.lowpass_latency.enabled = true;
-    p.lowpass_latency.dlpf_cfg = nearest_dlpf(tf);
-    notes.push_back(fmt::format("white-noise low-pass ({:.3g} ms) simulated as the MPU6050 DLPF setting {}", 1e3 * tf,
-                                p.lowpass_latency.dlpf_cfg));
+    set_lowpass(p, tf, rate_hz);
+    notes.push_back(fmt::format("white-noise low-pass simulated as a first-order low-pass of {:.3g} ms ({:.3g} Hz)", 1e3 * tf,
+                                p.lowpass_latency.bandwidth_hz));
   }
   return p;
 }
@@ -102,7 +99,7 @@ Validation band_and_verdict(const est::AllanCurve& measured, std::vector<std::ve
 // simulates the triad `axes` (nullptr: unused axis) `records` times and attaches each band
 void validate_group(const Result& r, std::array<ChannelResult*, 3> axes, std::size_t records, std::uint64_t seed) {
   std::vector<std::string> notes;
-  const twin::SensorParams p = params_for({axes[0], axes[1], axes[2]}, notes);
+  const twin::SensorParams p = params_for({axes[0], axes[1], axes[2]}, r.rate_hz, notes);
   std::array<std::vector<std::vector<double>>, 3> sims;
   std::size_t n = 0;
   for (const auto* c : axes) n = std::max(n, c != nullptr ? c->fit_curve.samples : 0);
