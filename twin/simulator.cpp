@@ -28,7 +28,7 @@ Eigen::Vector3d earth_rate_enu_radps(double latitude_deg) {
 Simulator::Simulator(const Scenario& scenario, SimOptions options)
     : scenario_((scenario.validate(), scenario)),
       options_(options),
-      world_(scenario.model.box, scenario.physics_dt_s),
+      world_(scenario.model.box, scenario.physics_dt_s, ModelScope::physics),
       motion_(make_motion(scenario.motion, scenario.duration_s, scenario.seed, scenario.base_dir)),
       flips_(scenario.flip_schedule, scenario.model.box),
       earth_enu_radps_(earth_rate_enu_radps(scenario.latitude_deg)),
@@ -50,21 +50,16 @@ Simulator::Simulator(const Scenario& scenario, SimOptions options)
     world_.set_platform(i, flips_.initial_angle_rad(i), 0.0);
     world_.set_motor_reference(i, flips_.reference_rad(i));
   }
-  world_.pose_carrier(motion_->carrier(), m0.p_enu_m, m0.q_enu_from_body);
   // settle the platforms on their stops before t = 0 (the box held still at its t = 0 pose), so
   // the run starts at rest rather than with the stops' initial transient
-  mjModel* m = world_.model();
-  mjData* d = world_.data();
+  MotionState held = m0;
+  held.v_enu_mps = held.a_enu_mps2 = held.w_body_radps = held.dw_body_radps2 = Eigen::Vector3d::Zero();
+  const Eigen::Vector2d ref0(flips_.reference_rad(1), flips_.reference_rad(2));
   const long warmup_steps = std::lround(kWarmupS / scenario.physics_dt_s);
-  for (long n = 0; n < warmup_steps; ++n) {
-    world_.set_base(m0.p_enu_m, m0.q_enu_from_body, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
-    mj_step1(m, d);
-    world_.drive_base(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
-    mj_step2(m, d);
-  }
-  d->time = 0.0;
+  for (long n = 0; n < warmup_steps; ++n) world_.step_driven(0.0, held, ref0, false);
+  world_.data()->time = 0.0;
   world_.set_base(m0.p_enu_m, m0.q_enu_from_body, m0.v_enu_mps, m0.w_body_radps);
-  mj_forward(m, d);
+  mj_forward(world_.model(), world_.data());
 }
 
 Simulator::~Simulator() = default;
@@ -110,8 +105,6 @@ void Simulator::command_platform(int i, int sign) {
 // one physics step at t = step_ * dt: drive the base, command the motors, step MuJoCo;
 // with `output`, the truth at t is captured between the two halves of the step
 void Simulator::physics_step(bool output) {
-  const mjModel* m = world_.model();
-  mjData* d = world_.data();
   const double t = static_cast<double>(step_) * scenario_.physics_dt_s;
   const Eigen::Vector2d rates(world_.platform_rate_radps(1), world_.platform_rate_radps(2));
   flips_.update(t, rates);
@@ -129,26 +122,24 @@ void Simulator::physics_step(bool output) {
     frozen_ = false;  // a flip starts: back to full physics
   }
 
+  // MuJoCo's sensors are read on output steps and where the static fast path may engage
+  const bool may_freeze = options_.fast_standstill && motion_->is_static() && !flips_.any_moving();
   const MotionState ms = motion_->at(t);
-  world_.set_base(ms.p_enu_m, ms.q_enu_from_body, ms.v_enu_mps, ms.w_body_radps);
-  for (int i = 1; i <= 2; ++i) world_.set_motor_reference(i, flips_.reference_rad(i));
-  d->time = t;
-  mj_step1(m, d);  // kinematics, velocities, gyro sensors at t
-  world_.drive_base(ms.a_enu_mps2, ms.dw_body_radps2);
+  const HingeState h = world_.step_driven(t, ms, Eigen::Vector2d(flips_.reference_rad(1), flips_.reference_rad(2)),
+                                          output || may_freeze);
   if (output) {
     base_ = ms;
     truth_.t_s = t;
     for (int i = 0; i < 2; ++i) {
-      truth_.plat_rad[i] = world_.platform_angle_rad(i + 1);
-      truth_.plat_rate_radps[i] = world_.platform_rate_radps(i + 1);
+      truth_.plat_rad[i] = h.angle_rad[i];
+      truth_.plat_rate_radps[i] = h.rate_radps[i];
     }
   }
-  mj_step2(m, d);  // actuation, constraints (end stops), accelerometers at t; integrate to t + dt
   ++mj_steps_;
   if (output) capture_truth();
 
   // static fast path: a static box with settled platforms stays exactly as it is
-  if (options_.fast_standstill && motion_->is_static() && !flips_.any_moving()) {
+  if (may_freeze && !flips_.any_moving()) {
     bool still = true;
     for (int i = 1; i <= 2; ++i) {
       still = still && std::abs(world_.platform_rate_radps(i)) < kFreezeRateRadps &&

@@ -159,9 +159,11 @@ TEST_F(SimulatorTest, PoseFromSampleSetsBoxAndPlatforms) {
   sim.next(s);
   s.set_q_enu_from_body(Eigen::Quaterniond(Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ())));
   s.true_plat1_deg = 12.0;
-  pose_world_from_sample(sim.world(), s, Carrier::pan_tilt);
-  EXPECT_NEAR(sim.world().platform_angle_rad(1), 12.0 * kRadPerDeg, 1e-15);
-  const mjtNum* xq = sim.world().data()->xquat + 4 * sim.world().box_body();
+  World world(sim.scenario().model.box);  // the full model: the simulator's has no carriers
+  pose_world_from_sample(world, s, Carrier::pan_tilt);
+  EXPECT_NEAR(world.platform_angle_rad(1), 12.0 * kRadPerDeg, 1e-15);
+  EXPECT_THROW(pose_world_from_sample(sim.world(), s, Carrier::pan_tilt), std::logic_error);
+  const mjtNum* xq = world.data()->xquat + 4 * world.box_body();
   EXPECT_NEAR(xq[0], std::cos(0.25), 1e-12);
 }
 
