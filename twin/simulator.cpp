@@ -9,12 +9,33 @@
 namespace driftless::twin {
 namespace {
 
-// the static fast path engages once the platforms are this still (the state is then constant
-// to far below the 1e-9 rad/s truth tolerance)
-constexpr double kFreezeRateRadps = 1e-11;
-constexpr double kFreezeAccelRadps2 = 1e-8;
+// a static box: the platforms count as settled (state constant to far below the 1e-9 rad/s truth
+// tolerance; the leftover motion moves the angle by < rate / decay rate ~ 1e-12 rad) below these
+constexpr double kSettledRateRadps = 1e-10;
+constexpr double kSettledAccelRadps2 = 1e-7;
+// a moving box: a stop's transient has decayed by e^-25 ~ 1e-11 this many decay times after its
+// cause (a flip arriving, a base jolt), so what remains is the platform riding on its stop
+constexpr double kSettleDecayTimes = 25.0;
+// the kinematic rest path holds while the inertial load changes the stop's contact torque by
+// less than this fraction of the motor's press torque: the platform neither lifts off nor sinks
+// into the compliant stop by more than this fraction of its static penetration
+constexpr double kRestLoadFraction = 0.5;
+// a base rate change along a hinge that the interval's end-point accelerations leave unexplained
+// by more than this is a jolt (a rate step: the vehicle's turn entries), rad/s: it kicks the
+// platform on its stop, and MuJoCo steps it. Acceleration steps leave at most (step x interval / 2)
+// unexplained: <= 0.017 rad/s for the pan/tilt's 200 deg/s^2, 0.025 rad/s for the vehicle's 32 Hz
+// vibration; the vehicle's turns jump by >= 0.2 rad/s
+constexpr double kJoltRadps = 0.05;
 // platforms settle on their stops for this long before t = 0, s
 constexpr double kWarmupS = 1.0;
+
+// slowest decay time of MuJoCo's soft end stop (solref: time constant, damping ratio), s: the
+// envelope decays at 1/timeconst when underdamped; an overdamped stop's slow root is slower
+double stop_decay_time_s(const BoxParams& box) {
+  const double z = box.stop_dampratio;
+  const double slow = z <= 1.0 ? 1.0 : 1.0 - std::sqrt(1.0 - 1.0 / (z * z));
+  return box.stop_timeconst_s / slow;
+}
 
 std::string vec_text(const Eigen::Vector3d& v) { return fmt::format("{} {} {}", v.x(), v.y(), v.z()); }
 
@@ -33,7 +54,8 @@ Simulator::Simulator(const Scenario& scenario, SimOptions options)
       flips_(scenario.flip_schedule, scenario.model.box),
       earth_enu_radps_(earth_rate_enu_radps(scenario.latitude_deg)),
       steps_per_sample_(scenario.steps_per_sample()),
-      total_(scenario.total_samples()) {
+      total_(scenario.total_samples()),
+      settle_s_(kSettleDecayTimes * stop_decay_time_s(scenario.model.box)) {
   if (scenario.model.time_offset_s < 0) {
     throw std::invalid_argument(fmt::format(
         "model.time_offset_s = {} s: simulate models sensors sampling before the log's time stamp "
@@ -60,6 +82,9 @@ Simulator::Simulator(const Scenario& scenario, SimOptions options)
   world_.data()->time = 0.0;
   world_.set_base(m0.p_enu_m, m0.q_enu_from_body, m0.v_enu_mps, m0.w_body_radps);
   mj_forward(world_.model(), world_.data());
+  // the base starts moving at t = 0 (a jolt from the held warm-up pose): MuJoCo steps its transient
+  const double settled_at = motion_->is_static() ? -kWarmupS : 0.0;
+  event_s_[0] = event_s_[1] = settled_at;
 }
 
 Simulator::~Simulator() = default;
@@ -98,60 +123,121 @@ void Simulator::command_platform(int i, int sign) {
   if (!flips_.external_control()) {
     throw std::invalid_argument("command_platform: the scenario's flip schedule drives the servos (call take_flip_control() first)");
   }
-  // the move starts at the next physics step; a frozen (static fast path) state thaws there
+  // the move starts at the next physics step; the rest path hands over to MuJoCo there
   flips_.command(i, sign, static_cast<double>(step_) * scenario_.physics_dt_s);
 }
 
-// one physics step at t = step_ * dt: drive the base, command the motors, step MuJoCo;
-// with `output`, the truth at t is captured between the two halves of the step
-void Simulator::physics_step(bool output) {
+double Simulator::output_time_s(std::uint64_t sample) const {
+  return static_cast<double>(sample * static_cast<std::uint64_t>(steps_per_sample_)) * scenario_.physics_dt_s;
+}
+
+// one physics step at t = step_ * dt: the flip schedule, then MuJoCo or the kinematic rest path
+void Simulator::advance(bool output) {
   const double t = static_cast<double>(step_) * scenario_.physics_dt_s;
-  const Eigen::Vector2d rates(world_.platform_rate_radps(1), world_.platform_rate_radps(2));
+  const bool resting = mode_ == Mode::rest;
+  const Eigen::Vector2d rates = resting ? Eigen::Vector2d::Zero()
+                                        : Eigen::Vector2d(world_.platform_rate_radps(1), world_.platform_rate_radps(2));
+  const bool was_moving[2] = {flips_.moving(1), flips_.moving(2)};
   flips_.update(t, rates);
-
-  if (frozen_) {
-    if (!flips_.any_moving()) {
-      if (output) {
-        truth_ = frozen_truth_;
-        truth_.t_s = t;
-        base_ = motion_->at(t);
-      }
-      ++step_;
-      return;
-    }
-    frozen_ = false;  // a flip starts: back to full physics
+  for (int i = 0; i < 2; ++i) {
+    if (was_moving[i] && !flips_.moving(i + 1)) event_s_[i] = t;  // arrived and settled by the schedule's test
   }
-
-  // MuJoCo's sensors are read on output steps and where the static fast path may engage
-  const bool may_freeze = options_.fast_standstill && motion_->is_static() && !flips_.any_moving();
-  const MotionState ms = motion_->at(t);
-  const HingeState h = world_.step_driven(t, ms, Eigen::Vector2d(flips_.reference_rad(1), flips_.reference_rad(2)),
-                                          output || may_freeze);
-  if (output) {
-    base_ = ms;
-    truth_.t_s = t;
-    for (int i = 0; i < 2; ++i) {
-      truth_.plat_rad[i] = h.angle_rad[i];
-      truth_.plat_rate_radps[i] = h.rate_radps[i];
-    }
-  }
-  ++mj_steps_;
-  if (output) capture_truth();
-
-  // static fast path: a static box with settled platforms stays exactly as it is
-  if (may_freeze && !flips_.any_moving()) {
-    bool still = true;
-    for (int i = 1; i <= 2; ++i) {
-      still = still && std::abs(world_.platform_rate_radps(i)) < kFreezeRateRadps &&
-              std::abs(world_.platform_accel_radps2(i)) < kFreezeAccelRadps2;
-    }
-    if (still) {
-      if (!output) capture_truth();  // truth of this (constant) state
-      frozen_truth_ = truth_;
-      frozen_ = true;
-    }
+  if (resting && flips_.any_moving()) thaw();  // a flip starts: MuJoCo steps it
+  if (mode_ == Mode::rest) {
+    if (output) rest_output(t);
+  } else {
+    step_physics(t, output);
   }
   ++step_;
+}
+
+void Simulator::step_physics(double t, bool output) {
+  const MotionState ms = motion_->at(t);
+  const HingeState h = world_.step_driven(t, ms, Eigen::Vector2d(flips_.reference_rad(1), flips_.reference_rad(2)), output);
+  ++mj_steps_;
+  if (!output) return;
+  base_ = ms;
+  truth_.t_s = t;
+  for (int i = 0; i < 2; ++i) {
+    truth_.plat_rad[i] = h.angle_rad[i];
+    truth_.plat_rate_radps[i] = h.rate_radps[i];
+  }
+  capture_truth();
+  if (options_.fast_rest) try_rest(t, ms, h);
+}
+
+// after a stepped output sample: rest from here on if the platforms settled and the coming
+// interval's loads keep them on their stops
+void Simulator::try_rest(double t, const MotionState& base, const HingeState& hinge) {
+  if (flips_.any_moving() || !platforms_settled(t, hinge)) return;
+  if (!motion_->is_static()) {
+    if (!flips_.on_stops()) return;  // held by the soft servo alone: its dynamics always matter
+    if (!rest_holds(base, base_at_next_output(output_time_s(samples_ + 1)), hinge.angle_rad)) return;
+  }
+  for (int i = 0; i < 2; ++i) rest_angle_rad_[i] = hinge.angle_rad[i];
+  mode_ = Mode::rest;
+}
+
+bool Simulator::platforms_settled(double t, const HingeState& hinge) const {
+  for (int i = 0; i < 2; ++i) {
+    if (motion_->is_static()) {
+      if (!(std::abs(hinge.rate_radps[i]) < kSettledRateRadps &&
+            std::abs(world_.platform_accel_radps2(i + 1)) < kSettledAccelRadps2)) return false;
+    } else if (t - event_s_[i] < settle_s_) {
+      return false;
+    }
+  }
+  return true;
+}
+
+// the rigid rest holds over [a, b] (consecutive output samples): at both ends the inertial load
+// on each platform stays within the rest fraction of its press torque, and the base's rate
+// changes as its accelerations at the two ends say (no jolt: a rate step inside the interval)
+bool Simulator::rest_holds(const MotionState& a, const MotionState& b, const double angle_rad[2]) const {
+  const double dt_out = 1.0 / scenario_.sample_rate_hz;
+  const Eigen::Vector3d jolt_radps =
+      (b.w_body_radps - a.w_body_radps) - 0.5 * dt_out * (a.dw_body_radps2 + b.dw_body_radps2);
+  for (int i = 1; i <= 2; ++i) {
+    if (std::abs(scenario_.model.box.hinge_axis(i).dot(jolt_radps)) > kJoltRadps) return false;
+    const double th = angle_rad[i - 1];
+    const double limit = kRestLoadFraction * std::abs(world_.motor_rest_torque_nm(flips_.reference_rad(i), th));
+    if (std::abs(world_.rest_hinge_torque_nm(i, a, th)) > limit ||
+        std::abs(world_.rest_hinge_torque_nm(i, b, th)) > limit) {
+      return false;
+    }
+  }
+  return true;
+}
+
+const MotionState& Simulator::base_at_next_output(double t_next) {
+  if (next_base_t_s_ != t_next) {
+    next_base_ = motion_->at(t_next);
+    next_base_t_s_ = t_next;
+  }
+  return next_base_;
+}
+
+// an output sample on the rest path: the base from the motion, the platforms rigid on their stops
+void Simulator::rest_output(double t) {
+  if (motion_->is_static()) {
+    truth_.t_s = t;  // everything else stays as it was when the box came to rest
+    return;
+  }
+  base_ = base_at_next_output(t);
+  truth_.t_s = t;
+  capture_rest_truth(base_);
+  // the next interval: stay on the rest path, or step MuJoCo through it from the rigid state
+  const double t_next = output_time_s(samples_ + 1);
+  if (!rest_holds(base_, base_at_next_output(t_next), rest_angle_rad_)) {
+    thaw();
+    event_s_[0] = event_s_[1] = t_next;
+  }
+}
+
+// leaves the rest path: MuJoCo continues from the platforms at rest at their rest angles
+void Simulator::thaw() {
+  for (int i = 1; i <= 2; ++i) world_.set_platform(i, rest_angle_rad_[i - 1], 0.0);
+  mode_ = Mode::stepped;
 }
 
 // truth from MuJoCo's sensors (valid after mj_step2 for the time of that step) + Earth rate
@@ -168,6 +254,20 @@ void Simulator::capture_truth() {
   const mjtNum* cv = d->cvel + 6 * box;  // com-based velocity: [angular (world axes); linear]
   const Eigen::Vector3d w_world(cv[0], cv[1], cv[2]);
   truth_.w_body_radps = q_box.conjugate() * (w_world + earth_enu_radps_);
+}
+
+// truth on the rest path: the rigid-body kinematics of each sensor site on the moving base
+void Simulator::capture_rest_truth(const MotionState& base) {
+  const Eigen::Matrix3d R_enu_from_body = base.q_enu_from_body.normalized().toRotationMatrix();
+  const Eigen::Vector3d earth_body = R_enu_from_body.transpose() * earth_enu_radps_;
+  for (int i = 0; i < 2; ++i) {
+    const SiteMotion sm = world_.site_motion(i + 1, base, rest_angle_rad_[i]);
+    truth_.w_sensor_radps[i] = sm.w_radps + sm.R_body_from_sensor.transpose() * earth_body;
+    truth_.f_sensor_mps2[i] = sm.f_mps2;
+    truth_.plat_rad[i] = rest_angle_rad_[i];
+    truth_.plat_rate_radps[i] = 0.0;
+  }
+  truth_.w_body_radps = base.w_body_radps + earth_body;
 }
 
 void Simulator::fill_sample(Sample& out) {
@@ -229,8 +329,8 @@ void Simulator::fill_sample(Sample& out) {
 bool Simulator::next(Sample& out) {
   if (samples_ >= total_) return false;
   const std::uint64_t out_step = samples_ * static_cast<std::uint64_t>(steps_per_sample_);
-  while (step_ < out_step) physics_step(false);
-  physics_step(true);
+  while (step_ < out_step) advance(false);
+  advance(true);
   fill_sample(out);
   ++samples_;
   return true;

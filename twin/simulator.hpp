@@ -33,11 +33,14 @@ struct SampleTruth {
   double plat_rate_radps[2] = {0, 0};  // joint rates
 };
 
-/// Simulator switches (not part of the scenario: they change speed, never results beyond 1e-9).
+/// Simulator switches (not part of the scenario: they change speed; the differences they make are
+/// bounded in tests/twin/test_simulator.cpp and docs/model.md).
 struct SimOptions {
-  /// Skip MuJoCo steps while the box is static and both platforms have settled (state constant,
-  /// truth analytic); physics runs through every flip and whenever the base moves.
-  bool fast_standstill = true;
+  /// The kinematic rest path: while both platforms rest settled on their stops (or, on a static
+  /// box, wherever they settled), skip MuJoCo and take the truth from the rigid-body kinematics
+  /// of the base motion; MuJoCo steps every flip, its settling, and every base load that could
+  /// lift a platform off its stop. false: MuJoCo steps the whole run.
+  bool fast_rest = true;
 };
 
 /// Earth rotation rate in ENU at latitude phi: Omega (0, cos phi, sin phi), rad/s.
@@ -68,13 +71,14 @@ class Simulator {
   /// next physics step. Throws std::invalid_argument on a bad platform or sign, or without
   /// take_flip_control() first.
   void command_platform(int i, int sign);
-  /// The MuJoCo world (model and data at the last sample's physics state) for rendering.
+  /// The MuJoCo world (physics scope: no carriers; renders pose their own full World). Its data
+  /// holds the last stepped state (the kinematic rest path leaves it untouched).
   World& world() { return world_; }
   const World& world() const { return world_; }
 
   std::uint64_t samples_done() const { return samples_; }
   std::uint64_t total_samples() const { return total_; }
-  /// MuJoCo steps taken so far (physics steps skipped on the static fast path are not counted).
+  /// MuJoCo steps taken so far (steps on the kinematic rest path are not counted).
   std::uint64_t physics_steps() const { return mj_steps_; }
 
   /// Metadata for a log of this run (sample rate, latitude, hinge axes, seed, scenario, carrier).
@@ -83,8 +87,18 @@ class Simulator {
   static std::uint32_t fields();
 
  private:
-  void physics_step(bool output);
+  enum class Mode { stepped, rest };
+  void advance(bool output);
+  void step_physics(double t, bool output);
+  void rest_output(double t);
+  void try_rest(double t, const MotionState& base, const HingeState& hinge);
+  bool platforms_settled(double t, const HingeState& hinge) const;
+  bool rest_holds(const MotionState& a, const MotionState& b, const double angle_rad[2]) const;
+  const MotionState& base_at_next_output(double t_next);
+  double output_time_s(std::uint64_t sample) const;  // t of output sample k: its physics step's t
+  void thaw();
   void capture_truth();
+  void capture_rest_truth(const MotionState& base);
   void fill_sample(Sample& out);
 
   Scenario scenario_;
@@ -99,10 +113,14 @@ class Simulator {
   std::uint64_t samples_ = 0;
   std::uint64_t step_ = 0;       // next physics step index (t = step * dt)
   std::uint64_t mj_steps_ = 0;
-  bool frozen_ = false;          // static fast path active
+  double settle_s_ = 0;          // a stop's transient has died out this long after its cause, s
+  Mode mode_ = Mode::stepped;
+  double rest_angle_rad_[2] = {0, 0};  // hinge angles while resting
+  double event_s_[2] = {0, 0};   // last disturbance of platform i (flip settled, base jolt, start), s
   SampleTruth truth_;
-  SampleTruth frozen_truth_;
   MotionState base_;             // motion state at the last output sample
+  MotionState next_base_;        // look-ahead: motion state at the next output sample
+  double next_base_t_s_ = -1;
   std::deque<SampleTruth> history_;  // recent output truths (model.time_offset_s > 0)
 };
 

@@ -213,7 +213,9 @@ World::World(const BoxParams& box, double timestep_s, ModelScope scope)
     site_imu_[i] = id(mjOBJ_SITE, ("imu" + n).c_str());
     sadr_gyro_[i] = m->sensor_adr[id(mjOBJ_SENSOR, ("gyro" + n).c_str())];
     sadr_accel_[i] = m->sensor_adr[id(mjOBJ_SENSOR, ("accel" + n).c_str())];
+    cache_platform(i, j, site_imu_[i]);
   }
+  gravity_enu_mps2_ = Eigen::Vector3d(m->opt.gravity[0], m->opt.gravity[1], m->opt.gravity[2]);
   body_box_ = id(mjOBJ_BODY, "box");
   if (scope == ModelScope::full) {
     body_pan_ = id(mjOBJ_BODY, "pantilt_pan");
@@ -235,6 +237,82 @@ World::World(const BoxParams& box, double timestep_s, ModelScope scope)
   set_base(Eigen::Vector3d::Zero(), Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero(),
            Eigen::Vector3d::Zero());
   mj_forward(m, data_.get());
+}
+
+namespace {
+Eigen::Vector3d vec(const mjtNum* v) { return {v[0], v[1], v[2]}; }
+Eigen::Matrix3d mat(const mjtNum* q) { return Eigen::Quaterniond(q[0], q[1], q[2], q[3]).toRotationMatrix(); }
+}  // namespace
+
+void World::cache_platform(int i, int joint, int site) {
+  const mjModel* m = model_.get();
+  const int body = m->jnt_bodyid[joint];
+  const int box = id(mjOBJ_BODY, "box");
+  // the closed forms below take the box frame as the drive's frame and the platforms as its children
+  if (m->body_parentid[body] != box || vec(m->body_pos + 3 * box).norm() != 0.0 ||
+      m->body_quat[4 * box] != 1.0) {
+    throw std::logic_error("box model: the box body must sit at the drive's origin and carry the platforms");
+  }
+  if (m->site_bodyid[site] != body) throw std::logic_error("box model: sensor site off its platform");
+  Platform& p = plat_[i];
+  const Eigen::Vector3d jnt_pos = vec(m->jnt_pos + 3 * joint);
+  p.R_box_from_plat0 = mat(m->body_quat + 4 * body);
+  p.anchor_box_m = vec(m->body_pos + 3 * body) + p.R_box_from_plat0 * jnt_pos;
+  p.axis_plat = vec(m->jnt_axis + 3 * joint).normalized();
+  p.site_from_anchor_m = vec(m->site_pos + 3 * site) - jnt_pos;
+  p.R_plat_from_site = mat(m->site_quat + 4 * site);
+  p.mass_kg = m->body_mass[body];
+  p.com_from_anchor_m = vec(m->body_ipos + 3 * body) - jnt_pos;
+  const Eigen::Matrix3d R_iq = mat(m->body_iquat + 4 * body);
+  p.inertia_com_kgm2 = R_iq * vec(m->body_inertia + 3 * body).asDiagonal() * R_iq.transpose();
+}
+
+Eigen::Matrix3d World::R_box_from_plat(int i, double angle_rad) const {
+  const Platform& p = plat_[i - 1];
+  return p.R_box_from_plat0 * Eigen::AngleAxisd(angle_rad, p.axis_plat).toRotationMatrix();
+}
+
+SiteMotion World::site_motion(int i, const MotionState& base, double angle_rad, double rate_radps,
+                              double accel_radps2) const {
+  const Platform& p = plat_[i - 1];
+  const Eigen::Matrix3d R_bp = R_box_from_plat(i, angle_rad);
+  const Eigen::Matrix3d R_box_from_site = R_bp * p.R_plat_from_site;
+  const Eigen::Vector3d& w = base.w_body_radps;
+  const Eigen::Vector3d& dw = base.dw_body_radps2;
+  const Eigen::Vector3d axis = p.R_box_from_plat0 * p.axis_plat;  // box axes (turns with no angle)
+  // site position: box origin -> anchor -> site; its motion relative to the box is the hinge's
+  const Eigen::Vector3d rho = R_bp * p.site_from_anchor_m;
+  const Eigen::Vector3d r = p.anchor_box_m + rho;
+  const Eigen::Vector3d rho_dot = rate_radps * axis.cross(rho);
+  const Eigen::Vector3d rho_ddot = accel_radps2 * axis.cross(rho) + rate_radps * axis.cross(rho_dot);
+  const Eigen::Matrix3d R_enu_from_body = base.q_enu_from_body.normalized().toRotationMatrix();
+  const Eigen::Vector3d a_site_box = R_enu_from_body.transpose() * (base.a_enu_mps2 - gravity_enu_mps2_) +
+                                     dw.cross(r) + w.cross(w.cross(r)) + 2.0 * w.cross(rho_dot) + rho_ddot;
+  SiteMotion out;
+  out.w_radps = R_box_from_site.transpose() * (w + rate_radps * axis);
+  out.f_mps2 = R_box_from_site.transpose() * a_site_box;
+  out.R_body_from_sensor = R_box_from_site;
+  return out;
+}
+
+double World::rest_hinge_torque_nm(int i, const MotionState& base, double angle_rad) const {
+  const Platform& p = plat_[i - 1];
+  const Eigen::Matrix3d R_bp = R_box_from_plat(i, angle_rad);
+  const Eigen::Vector3d& w = base.w_body_radps;
+  const Eigen::Vector3d& dw = base.dw_body_radps2;
+  const Eigen::Vector3d c = R_bp * p.com_from_anchor_m;
+  const Eigen::Matrix3d I = R_bp * p.inertia_com_kgm2 * R_bp.transpose();
+  const Eigen::Vector3d r_com = p.anchor_box_m + c;
+  const Eigen::Matrix3d R_enu_from_body = base.q_enu_from_body.normalized().toRotationMatrix();
+  const Eigen::Vector3d a_com = R_enu_from_body.transpose() * (base.a_enu_mps2 - gravity_enu_mps2_) +
+                                dw.cross(r_com) + w.cross(w.cross(r_com));
+  const Eigen::Vector3d torque = I * dw + w.cross(I * w) + p.mass_kg * c.cross(a_com);
+  return (p.R_box_from_plat0 * p.axis_plat).dot(torque);
+}
+
+double World::motor_rest_torque_nm(double ref_rad, double angle_rad) const {
+  const MotorParams& m = box_.motor;
+  return std::clamp(m.kp_nm_per_rad * (ref_rad - angle_rad), -m.stall_torque_nm, m.stall_torque_nm);
 }
 
 int World::id(int type, const char* name) const {

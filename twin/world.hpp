@@ -75,6 +75,15 @@ struct HingeState {
   double rate_radps[2] = {0, 0};
 };
 
+/// What a sensor site feels, in the site's axes: angular rate w.r.t. the non-rotating world
+/// (rad/s, Earth not included) and specific force (m/s^2): what MuJoCo's gyro and accelerometer
+/// report.
+struct SiteMotion {
+  Eigen::Vector3d w_radps = Eigen::Vector3d::Zero();
+  Eigen::Vector3d f_mps2 = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d R_body_from_sensor = Eigen::Matrix3d::Identity();  // site axes to box axes
+};
+
 using ModelPtr = std::unique_ptr<mjModel, decltype(&mj_deleteModel)>;
 using DataPtr = std::unique_ptr<mjData, decltype(&mj_deleteData)>;
 
@@ -107,6 +116,9 @@ class World {
   /// Motor command of platform i: the servo reference angle, rad.
   void set_motor_reference(int i, double ref_rad);
 
+  /// The model's gravity in ENU, m/s^2.
+  const Eigen::Vector3d& gravity_enu_mps2() const { return gravity_enu_mps2_; }
+
   /// Motion driver: box pose (ENU), velocity (ENU, m/s) and body-axes angular rate (rad/s).
   void set_base(const Eigen::Vector3d& p_enu_m, const Eigen::Quaterniond& q_enu_from_body,
                 const Eigen::Vector3d& v_enu_mps, const Eigen::Vector3d& w_body_radps);
@@ -121,6 +133,20 @@ class World {
   /// sensor stage is skipped (it never feeds back into the dynamics).
   HingeState step_driven(double t_s, const MotionState& base, const Eigen::Vector2d& ref_rad,
                          bool sensors = true);
+
+  /// Rigid-body kinematics of platform i's sensor site (1 or 2): from the base motion and the
+  /// hinge angle (rad), rate (rad/s) and acceleration (rad/s^2), the site's rate and specific
+  /// force in closed form. Equals MuJoCo's gyro/accelerometer for the same state (the kinematic
+  /// rest path's truth; tests/twin/test_world.cpp ties the two).
+  SiteMotion site_motion(int i, const MotionState& base, double angle_rad, double rate_radps = 0.0,
+                         double accel_radps2 = 0.0) const;
+  /// Hinge torque (N m, about hinge i's axis) that carries platform i rigidly at `angle_rad` on a
+  /// base moving as `base`: the axis component of I dw + w x (I w) + m c x (a_c - g) about the
+  /// hinge anchor (Newton-Euler for the platform body; the rotor armature sees only hinge motion).
+  double rest_hinge_torque_nm(int i, const MotionState& base, double angle_rad) const;
+  /// Torque (N m) the servo of platform i exerts at rest at `angle_rad` with reference `ref_rad`:
+  /// kp (ref - angle), clipped to the stall torque (the MJCF actuator at zero rate).
+  double motor_rest_torque_nm(double ref_rad, double angle_rad) const;
 
   /// Sensor readings of MuJoCo's gyro (rad/s, site axes; rate w.r.t. the non-rotating world)
   /// and accelerometer (specific force, m/s^2, site axes) of platform i, from sensordata.
@@ -161,6 +187,21 @@ class World {
   int mocap_pan_ = -1, mocap_tilt_ = -1, mocap_vehicle_ = -1, mocap_ship_ = -1;
   int body_box_ = -1;
   int body_pan_ = -1, body_tilt_ = -1, body_vehicle_ = -1, body_ship_ = -1;
+  // platform i's geometry and mass from the compiled model (platform axes at hinge angle 0)
+  struct Platform {
+    Eigen::Vector3d anchor_box_m;           // hinge anchor, box axes
+    Eigen::Matrix3d R_box_from_plat0;       // platform axes at angle 0
+    Eigen::Vector3d axis_plat;              // hinge axis, platform axes (unit)
+    Eigen::Vector3d site_from_anchor_m;     // sensor site, from the anchor, platform axes
+    Eigen::Matrix3d R_plat_from_site;
+    double mass_kg = 0;
+    Eigen::Vector3d com_from_anchor_m;      // centre of mass, from the anchor, platform axes
+    Eigen::Matrix3d inertia_com_kgm2;       // about the centre of mass, platform axes
+  };
+  Platform plat_[2];
+  Eigen::Vector3d gravity_enu_mps2_ = Eigen::Vector3d::Zero();
+  void cache_platform(int i, int joint, int site);
+  Eigen::Matrix3d R_box_from_plat(int i, double angle_rad) const;
   std::vector<float> geom_alpha_;                   // shipped alpha of every geom (carriers are hidden by alpha 0)
   std::vector<mjtNum> scratch_qacc_, scratch_res_;  // drive_base work space (no per-step allocation)
 };
