@@ -165,6 +165,12 @@ void write_summary(const fs::path& path, const EstimateArgs& a, const est::Estim
           json_number(s.final_corrected.angle_deg), json_number(s.final_fixed.angle_deg),
           json_number(s.final_raw.angle_deg));
   o.print("  \"fixed_bias_dps\": {},\n", json_vec(s.fixed_bias_dps));
+  o.print("  \"relocks\": [");
+  for (std::size_t i = 0; i < s.relocks.size(); ++i) {
+    o.print("{}{{\"t_s\": {}, \"nis\": {}}}", i ? ", " : "", json_number(s.relocks[i].t_s),
+            json_number(s.relocks[i].nis));
+  }
+  o.print("],\n");
   if (s.truth.available) {
     const auto& t = s.truth;
     o.print("  \"truth\": {{\n");

@@ -74,7 +74,6 @@ const std::map<std::string, double EstimatorConfig::*>& numeric_fields() {
       {"angle_tolerance_deg", &EstimatorConfig::angle_tolerance_deg},
       {"gyro_motion_threshold_dps", &EstimatorConfig::gyro_motion_threshold_dps},
       {"standstill_period_s", &EstimatorConfig::standstill_period_s},
-      {"flip_angle_deg", &EstimatorConfig::flip_angle_deg},
       {"initial_plat1_deg", &EstimatorConfig::initial_plat1_deg},
       {"initial_plat2_deg", &EstimatorConfig::initial_plat2_deg},
       {"noise_density_dps_rthz", &EstimatorConfig::noise_density_dps_rthz},
