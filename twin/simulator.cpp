@@ -1,41 +1,22 @@
 #include "twin/simulator.hpp"
 
 #include <cmath>
+#include <condition_variable>
+#include <deque>
+#include <exception>
+#include <mutex>
 #include <stdexcept>
 #include <string>
+#include <thread>
+#include <vector>
 
 #include <fmt/core.h>
 
 namespace driftless::twin {
 namespace {
 
-// a static box: the platforms count as settled (state constant to far below the 1e-9 rad/s truth
-// tolerance; the leftover motion moves the angle by < rate / decay rate ~ 1e-12 rad) below these
-constexpr double kSettledRateRadps = 1e-10;
-constexpr double kSettledAccelRadps2 = 1e-7;
-// a moving box: a stop's transient has decayed by e^-25 ~ 1e-11 this many decay times after its
-// cause (a flip arriving, a base jolt), so what remains is the platform riding on its stop
-constexpr double kSettleDecayTimes = 25.0;
-// the kinematic rest path holds while the inertial load changes the stop's contact torque by
-// less than this fraction of the motor's press torque: the platform neither lifts off nor sinks
-// into the compliant stop by more than this fraction of its static penetration
-constexpr double kRestLoadFraction = 0.5;
-// a base rate change along a hinge that the interval's end-point accelerations leave unexplained
-// by more than this is a jolt (a rate step: the vehicle's turn entries), rad/s: it kicks the
-// platform on its stop, and MuJoCo steps it. Acceleration steps leave at most (step x interval / 2)
-// unexplained: <= 0.017 rad/s for the pan/tilt's 200 deg/s^2, 0.025 rad/s for the vehicle's 32 Hz
-// vibration; the vehicle's turns jump by >= 0.2 rad/s
-constexpr double kJoltRadps = 0.05;
 // platforms settle on their stops for this long before t = 0, s
 constexpr double kWarmupS = 1.0;
-
-// slowest decay time of MuJoCo's soft end stop (solref: time constant, damping ratio), s: the
-// envelope decays at 1/timeconst when underdamped; an overdamped stop's slow root is slower
-double stop_decay_time_s(const BoxParams& box) {
-  const double z = box.stop_dampratio;
-  const double slow = z <= 1.0 ? 1.0 : 1.0 - std::sqrt(1.0 - 1.0 / (z * z));
-  return box.stop_timeconst_s / slow;
-}
 
 std::string vec_text(const Eigen::Vector3d& v) { return fmt::format("{} {} {}", v.x(), v.y(), v.z()); }
 
@@ -52,10 +33,10 @@ Simulator::Simulator(const Scenario& scenario, SimOptions options)
       world_(scenario.model.box, scenario.physics_dt_s, ModelScope::physics),
       motion_(make_motion(scenario.motion, scenario.duration_s, scenario.seed, scenario.base_dir)),
       flips_(scenario.flip_schedule, scenario.model.box),
+      gate_(scenario.model.box, motion_->is_static(), scenario.sample_rate_hz),
       earth_enu_radps_(earth_rate_enu_radps(scenario.latitude_deg)),
       steps_per_sample_(scenario.steps_per_sample()),
-      total_(scenario.total_samples()),
-      settle_s_(kSettleDecayTimes * stop_decay_time_s(scenario.model.box)) {
+      total_(scenario.total_samples()) {
   if (scenario.model.time_offset_s < 0) {
     throw std::invalid_argument(fmt::format(
         "model.time_offset_s = {} s: simulate models sensors sampling before the log's time stamp "
@@ -83,8 +64,7 @@ Simulator::Simulator(const Scenario& scenario, SimOptions options)
   world_.set_base(m0.p_enu_m, m0.q_enu_from_body, m0.v_enu_mps, m0.w_body_radps);
   mj_forward(world_.model(), world_.data());
   // the base starts moving at t = 0 (a jolt from the held warm-up pose): MuJoCo steps its transient
-  const double settled_at = motion_->is_static() ? -kWarmupS : 0.0;
-  event_s_[0] = event_s_[1] = settled_at;
+  for (int i = 1; i <= 2; ++i) gate_.disturbed(i, motion_->is_static() ? -kWarmupS : 0.0);
 }
 
 Simulator::~Simulator() = default;
@@ -131,30 +111,64 @@ double Simulator::output_time_s(std::uint64_t sample) const {
   return static_cast<double>(sample * static_cast<std::uint64_t>(steps_per_sample_)) * scenario_.physics_dt_s;
 }
 
-// one physics step at t = step_ * dt: the flip schedule, then MuJoCo or the kinematic rest path
+// one physics step at t = step_ * dt: the flip schedule, then MuJoCo, the rest path or a replay
 void Simulator::advance(bool output) {
   const double t = static_cast<double>(step_) * scenario_.physics_dt_s;
-  const bool resting = mode_ == Mode::rest;
-  const Eigen::Vector2d rates = resting ? Eigen::Vector2d::Zero()
-                                        : Eigen::Vector2d(world_.platform_rate_radps(1), world_.platform_rate_radps(2));
+  Eigen::Vector2d rates = Eigen::Vector2d::Zero();
+  if (mode_ == Mode::stepped) rates = {world_.platform_rate_radps(1), world_.platform_rate_radps(2)};
+  if (mode_ == Mode::replay) rates[replay_->platform - 1] = replay_->steps[replay_pos_].rate_radps;
   const bool was_moving[2] = {flips_.moving(1), flips_.moving(2)};
   flips_.update(t, rates);
-  for (int i = 0; i < 2; ++i) {
-    if (was_moving[i] && !flips_.moving(i + 1)) event_s_[i] = t;  // arrived and settled by the schedule's test
+  for (int i = 1; i <= 2; ++i) {
+    if (was_moving[i - 1] && !flips_.moving(i)) gate_.disturbed(i, t);  // arrived, settled by the schedule's test
   }
-  if (resting && flips_.any_moving()) thaw();  // a flip starts: MuJoCo steps it
-  if (mode_ == Mode::rest) {
-    if (output) rest_output(t);
-  } else {
-    step_physics(t, output);
+  if (mode_ == Mode::rest && flips_.any_moving()) begin_flip(t);
+  if (mode_ == Mode::replay && (flips_.moving(3 - replay_->platform) || flips_.sign(replay_->platform) != replay_->sign)) {
+    // a command the recording never saw: MuJoCo takes over from the replayed state
+    const FlipReplay::Step& s = replay_->steps[replay_pos_];
+    rest_angle_rad_[replay_->platform - 1] = s.angle_rad;
+    double rate[2] = {0, 0};
+    rate[replay_->platform - 1] = s.rate_radps;
+    thaw(rate);
+  }
+  switch (mode_) {
+    case Mode::rest: if (output) rest_output(t); break;
+    case Mode::replay: replay_step(t, output); break;
+    case Mode::stepped: step_physics(t, output); break;
   }
   ++step_;
+}
+
+// a flip starts from the rest path: replay it when a static box saw this flip before, else let
+// MuJoCo step it (and record it, on a static box)
+void Simulator::begin_flip(double) {
+  const int moving = flips_.moving(1) && flips_.moving(2) ? 0 : (flips_.moving(1) ? 1 : 2);
+  if (!gate_.static_base() || moving == 0) {
+    thaw();
+    return;
+  }
+  const int sign = flips_.sign(moving);
+  replay_ = replays_.find(moving, sign, rest_angle_rad_[moving - 1]);
+  if (replay_ != nullptr) {
+    mode_ = Mode::replay;
+    replay_pos_ = 0;
+    return;
+  }
+  thaw();
+  replays_.start_recording(moving, sign, rest_angle_rad_[moving - 1]);
 }
 
 void Simulator::step_physics(double t, bool output) {
   const MotionState ms = motion_->at(t);
   const HingeState h = world_.step_driven(t, ms, Eigen::Vector2d(flips_.reference_rad(1), flips_.reference_rad(2)), output);
   ++mj_steps_;
+  if (const int i = replays_.recording_platform()) {
+    if (flips_.moving(3 - i) || flips_.sign(i) != replays_.recording_sign()) {
+      replays_.stop_recording(false);  // the other platform moves too, or a reversal: not one flip
+    } else {
+      replays_.record({h.angle_rad[i - 1], h.rate_radps[i - 1], world_.platform_accel_radps2(i)});
+    }
+  }
   if (!output) return;
   base_ = ms;
   truth_.t_s = t;
@@ -163,81 +177,82 @@ void Simulator::step_physics(double t, bool output) {
     truth_.plat_rate_radps[i] = h.rate_radps[i];
   }
   capture_truth();
-  if (options_.fast_rest) try_rest(t, ms, h);
+  if (options_.fast_rest) try_rest(ms, h, t);
 }
 
 // after a stepped output sample: rest from here on if the platforms settled and the coming
 // interval's loads keep them on their stops
-void Simulator::try_rest(double t, const MotionState& base, const HingeState& hinge) {
-  if (flips_.any_moving() || !platforms_settled(t, hinge)) return;
-  if (!motion_->is_static()) {
-    if (!flips_.on_stops()) return;  // held by the soft servo alone: its dynamics always matter
-    if (!rest_holds(base, base_at_next_output(output_time_s(samples_ + 1)), hinge.angle_rad)) return;
-  }
-  for (int i = 0; i < 2; ++i) rest_angle_rad_[i] = hinge.angle_rad[i];
+void Simulator::try_rest(const MotionState& base, const HingeState& hinge, double t) {
+  const double accel[2] = {world_.platform_accel_radps2(1), world_.platform_accel_radps2(2)};
+  if (flips_.any_moving() || !gate_.settled(t, hinge, accel)) return;
+  if (!gate_.holds(world_, flips_, base, base_at_output(samples_ + 1), hinge.angle_rad)) return;
+  replays_.stop_recording(true);
+  enter_rest(hinge.angle_rad);
+}
+
+void Simulator::enter_rest(const double angle_rad[2]) {
+  for (int i = 0; i < 2; ++i) rest_angle_rad_[i] = angle_rad[i];
   mode_ = Mode::rest;
-}
-
-bool Simulator::platforms_settled(double t, const HingeState& hinge) const {
-  for (int i = 0; i < 2; ++i) {
-    if (motion_->is_static()) {
-      if (!(std::abs(hinge.rate_radps[i]) < kSettledRateRadps &&
-            std::abs(world_.platform_accel_radps2(i + 1)) < kSettledAccelRadps2)) return false;
-    } else if (t - event_s_[i] < settle_s_) {
-      return false;
-    }
+  if (gate_.static_base()) {
+    const double zero[2] = {0, 0};
+    rest_truth(base_, rest_angle_rad_, zero, zero);
+    static_rest_truth_ = truth_;
   }
-  return true;
 }
 
-// the rigid rest holds over [a, b] (consecutive output samples): at both ends the inertial load
-// on each platform stays within the rest fraction of its press torque, and the base's rate
-// changes as its accelerations at the two ends say (no jolt: a rate step inside the interval)
-bool Simulator::rest_holds(const MotionState& a, const MotionState& b, const double angle_rad[2]) const {
-  const double dt_out = 1.0 / scenario_.sample_rate_hz;
-  const Eigen::Vector3d jolt_radps =
-      (b.w_body_radps - a.w_body_radps) - 0.5 * dt_out * (a.dw_body_radps2 + b.dw_body_radps2);
-  for (int i = 1; i <= 2; ++i) {
-    if (std::abs(scenario_.model.box.hinge_axis(i).dot(jolt_radps)) > kJoltRadps) return false;
-    const double th = angle_rad[i - 1];
-    const double limit = kRestLoadFraction * std::abs(world_.motor_rest_torque_nm(flips_.reference_rad(i), th));
-    if (std::abs(world_.rest_hinge_torque_nm(i, a, th)) > limit ||
-        std::abs(world_.rest_hinge_torque_nm(i, b, th)) > limit) {
-      return false;
-    }
-  }
-  return true;
-}
-
-const MotionState& Simulator::base_at_next_output(double t_next) {
-  if (next_base_t_s_ != t_next) {
-    next_base_ = motion_->at(t_next);
-    next_base_t_s_ = t_next;
+const MotionState& Simulator::base_at_output(std::uint64_t sample) {
+  if (next_base_sample_ != sample) {
+    next_base_ = motion_->at(output_time_s(sample));
+    next_base_sample_ = sample;
   }
   return next_base_;
 }
 
 // an output sample on the rest path: the base from the motion, the platforms rigid on their stops
 void Simulator::rest_output(double t) {
-  if (motion_->is_static()) {
-    truth_.t_s = t;  // everything else stays as it was when the box came to rest
+  if (gate_.static_base()) {
+    truth_ = static_rest_truth_;
+    truth_.t_s = t;
     return;
   }
-  base_ = base_at_next_output(t);
+  base_ = base_at_output(samples_);
+  const double zero[2] = {0, 0};
+  rest_truth(base_, rest_angle_rad_, zero, zero);
   truth_.t_s = t;
-  capture_rest_truth(base_);
   // the next interval: stay on the rest path, or step MuJoCo through it from the rigid state
-  const double t_next = output_time_s(samples_ + 1);
-  if (!rest_holds(base_, base_at_next_output(t_next), rest_angle_rad_)) {
+  if (!gate_.holds(world_, flips_, base_, base_at_output(samples_ + 1), rest_angle_rad_)) {
     thaw();
-    event_s_[0] = event_s_[1] = t_next;
+    for (int i = 1; i <= 2; ++i) gate_.disturbed(i, output_time_s(samples_ + 1));
   }
 }
 
-// leaves the rest path: MuJoCo continues from the platforms at rest at their rest angles
-void Simulator::thaw() {
-  for (int i = 1; i <= 2; ++i) world_.set_platform(i, rest_angle_rad_[i - 1], 0.0);
+// one step of a replayed flip; where the recording came to rest, so does the replay
+void Simulator::replay_step(double t, bool output) {
+  const int k = replay_->platform - 1;
+  const FlipReplay::Step& s = replay_->steps[replay_pos_];
+  double angle[2] = {rest_angle_rad_[0], rest_angle_rad_[1]}, rate[2] = {0, 0}, accel[2] = {0, 0};
+  angle[k] = s.angle_rad;
+  rate[k] = s.rate_radps;
+  accel[k] = s.accel_radps2;
+  if (output) {
+    rest_truth(base_, angle, rate, accel);
+    truth_.t_s = t;
+  }
+  if (++replay_pos_ < replay_->steps.size()) return;
+  rest_angle_rad_[k] = s.angle_rad;
+  if (flips_.any_moving()) {
+    thaw(rate);  // the schedule's settle test has not passed here: MuJoCo continues
+  } else {
+    enter_rest(rest_angle_rad_);
+  }
+}
+
+// leaves the rest path or a replay: MuJoCo continues from the platforms at their rest angles
+// (and the given rates, rad/s; at rest by default)
+void Simulator::thaw(const double rate_radps[2]) {
+  for (int i = 1; i <= 2; ++i) world_.set_platform(i, rest_angle_rad_[i - 1], rate_radps ? rate_radps[i - 1] : 0.0);
   mode_ = Mode::stepped;
+  replay_ = nullptr;
 }
 
 // truth from MuJoCo's sensors (valid after mj_step2 for the time of that step) + Earth rate
@@ -256,16 +271,17 @@ void Simulator::capture_truth() {
   truth_.w_body_radps = q_box.conjugate() * (w_world + earth_enu_radps_);
 }
 
-// truth on the rest path: the rigid-body kinematics of each sensor site on the moving base
-void Simulator::capture_rest_truth(const MotionState& base) {
-  const Eigen::Matrix3d R_enu_from_body = base.q_enu_from_body.normalized().toRotationMatrix();
-  const Eigen::Vector3d earth_body = R_enu_from_body.transpose() * earth_enu_radps_;
+// truth off MuJoCo: the rigid-body kinematics of each sensor site on the base, the hinges at the
+// given angles (rad), rates (rad/s) and accelerations (rad/s^2)
+void Simulator::rest_truth(const MotionState& base, const double angle_rad[2], const double rate_radps[2],
+                           const double accel_radps2[2]) {
+  const Eigen::Vector3d earth_body = base.q_enu_from_body.normalized().conjugate() * earth_enu_radps_;
   for (int i = 0; i < 2; ++i) {
-    const SiteMotion sm = world_.site_motion(i + 1, base, rest_angle_rad_[i]);
+    const SiteMotion sm = world_.site_motion(i + 1, base, angle_rad[i], rate_radps[i], accel_radps2[i]);
     truth_.w_sensor_radps[i] = sm.w_radps + sm.R_body_from_sensor.transpose() * earth_body;
     truth_.f_sensor_mps2[i] = sm.f_mps2;
-    truth_.plat_rad[i] = rest_angle_rad_[i];
-    truth_.plat_rate_radps[i] = 0.0;
+    truth_.plat_rad[i] = angle_rad[i];
+    truth_.plat_rate_radps[i] = rate_radps[i];
   }
   truth_.w_body_radps = base.w_body_radps + earth_body;
 }
@@ -336,22 +352,110 @@ bool Simulator::next(Sample& out) {
   return true;
 }
 
+namespace {
+
+// formats and writes the log on a second thread, so the simulation and the writing overlap; the
+// queue holds a few blocks of samples (constant memory), the file is the same as written inline
+class BackgroundLogWriter {
+ public:
+  explicit BackgroundLogWriter(log::LogWriter& writer) : writer_(writer), thread_([this] { run(); }) {}
+  ~BackgroundLogWriter() {
+    close();
+    thread_.join();
+  }
+  BackgroundLogWriter(const BackgroundLogWriter&) = delete;
+  BackgroundLogWriter& operator=(const BackgroundLogWriter&) = delete;
+
+  /// Queues a block (waits while the queue is full); rethrows the writer's error, if any.
+  void push(std::vector<Sample>&& block) {
+    std::unique_lock lock(mutex_);
+    changed_.wait(lock, [&] { return queue_.size() < kMaxQueued || error_; });
+    if (error_) std::rethrow_exception(error_);
+    queue_.push_back(std::move(block));
+    changed_.notify_all();
+  }
+  /// Waits until every queued block is written; rethrows the writer's error, if any.
+  void drain() {
+    std::unique_lock lock(mutex_);
+    changed_.wait(lock, [&] { return (queue_.empty() && !busy_) || error_; });
+    if (error_) std::rethrow_exception(error_);
+  }
+
+ private:
+  static constexpr std::size_t kMaxQueued = 4;
+
+  void close() {
+    std::lock_guard lock(mutex_);
+    closed_ = true;
+    changed_.notify_all();
+  }
+  void run() {
+    std::unique_lock lock(mutex_);
+    while (true) {
+      changed_.wait(lock, [&] { return !queue_.empty() || closed_; });
+      if (queue_.empty()) return;
+      std::vector<Sample> block = std::move(queue_.front());
+      queue_.pop_front();
+      busy_ = true;
+      changed_.notify_all();
+      lock.unlock();
+      std::exception_ptr error;
+      try {
+        for (const Sample& s : block) writer_.write(s);
+      } catch (...) {
+        error = std::current_exception();
+      }
+      lock.lock();
+      busy_ = false;
+      if (error) {
+        error_ = error;
+        queue_.clear();
+      }
+      changed_.notify_all();
+      if (error_) return;
+    }
+  }
+
+  log::LogWriter& writer_;
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  std::deque<std::vector<Sample>> queue_;
+  bool busy_ = false, closed_ = false;
+  std::exception_ptr error_;
+  std::thread thread_;
+};
+
+}  // namespace
+
 SimulateResult simulate_to_log(const Scenario& scenario, const std::filesystem::path& log_path,
                                const std::function<bool(double)>& keep_going, SimOptions options) {
   Simulator sim(scenario, options);
   log::LogWriter writer(log_path, sim.metadata(), Simulator::fields());
-  SimulateResult r;
-  Sample s;
   const std::uint64_t poll = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(scenario.sample_rate_hz / 10));
+  constexpr std::size_t kBlock = 1024;
   bool stopped = false;
-  while (sim.next(s)) {
-    writer.write(s);
-    if (keep_going && sim.samples_done() % poll == 0 &&
-        !keep_going(static_cast<double>(sim.samples_done()) / static_cast<double>(sim.total_samples()))) {
-      stopped = true;
-      break;
+  {
+    BackgroundLogWriter background(writer);
+    std::vector<Sample> block;
+    block.reserve(kBlock);
+    Sample s;
+    while (sim.next(s)) {
+      block.push_back(s);
+      if (block.size() == kBlock) {
+        background.push(std::move(block));
+        block = {};
+        block.reserve(kBlock);
+      }
+      if (keep_going && sim.samples_done() % poll == 0 &&
+          !keep_going(static_cast<double>(sim.samples_done()) / static_cast<double>(sim.total_samples()))) {
+        stopped = true;
+        break;
+      }
     }
+    if (!block.empty()) background.push(std::move(block));
+    background.drain();
   }
+  SimulateResult r;
   r.rows = writer.rows_written();
   r.physics_steps = sim.physics_steps();
   r.complete = !stopped;

@@ -15,8 +15,10 @@
 
 #include "estimator/log.hpp"
 #include "estimator/sample.hpp"
+#include "twin/flip_replay.hpp"
 #include "twin/flip_schedule.hpp"
 #include "twin/motion.hpp"
+#include "twin/rest_path.hpp"
 #include "twin/scenario.hpp"
 #include "twin/sensor/sensor_model.hpp"
 #include "twin/world.hpp"
@@ -87,18 +89,20 @@ class Simulator {
   static std::uint32_t fields();
 
  private:
-  enum class Mode { stepped, rest };
+  enum class Mode { stepped, rest, replay };
   void advance(bool output);
   void step_physics(double t, bool output);
   void rest_output(double t);
-  void try_rest(double t, const MotionState& base, const HingeState& hinge);
-  bool platforms_settled(double t, const HingeState& hinge) const;
-  bool rest_holds(const MotionState& a, const MotionState& b, const double angle_rad[2]) const;
-  const MotionState& base_at_next_output(double t_next);
+  void replay_step(double t, bool output);
+  void begin_flip(double t);
+  void try_rest(const MotionState& base, const HingeState& hinge, double t);
+  void enter_rest(const double angle_rad[2]);
+  const MotionState& base_at_output(std::uint64_t sample);
   double output_time_s(std::uint64_t sample) const;  // t of output sample k: its physics step's t
-  void thaw();
+  void thaw(const double rate_radps[2] = nullptr);
   void capture_truth();
-  void capture_rest_truth(const MotionState& base);
+  void rest_truth(const MotionState& base, const double angle_rad[2], const double rate_radps[2],
+                  const double accel_radps2[2]);
   void fill_sample(Sample& out);
 
   Scenario scenario_;
@@ -106,6 +110,8 @@ class Simulator {
   World world_;
   std::unique_ptr<Motion> motion_;
   FlipController flips_;
+  RestGate gate_;
+  FlipReplay replays_;
   std::vector<SensorModel> sensors_;  // sensor 1, sensor 2
   Eigen::Vector3d earth_enu_radps_;
   long steps_per_sample_;
@@ -113,14 +119,15 @@ class Simulator {
   std::uint64_t samples_ = 0;
   std::uint64_t step_ = 0;       // next physics step index (t = step * dt)
   std::uint64_t mj_steps_ = 0;
-  double settle_s_ = 0;          // a stop's transient has died out this long after its cause, s
   Mode mode_ = Mode::stepped;
-  double rest_angle_rad_[2] = {0, 0};  // hinge angles while resting
-  double event_s_[2] = {0, 0};   // last disturbance of platform i (flip settled, base jolt, start), s
+  double rest_angle_rad_[2] = {0, 0};    // hinge angles on the rest path and during a replay
+  const FlipReplay::Flip* replay_ = nullptr;  // the flip being replayed, and where in it
+  std::size_t replay_pos_ = 0;
   SampleTruth truth_;
+  SampleTruth static_rest_truth_;        // a static box at rest: the truth is constant
   MotionState base_;             // motion state at the last output sample
-  MotionState next_base_;        // look-ahead: motion state at the next output sample
-  double next_base_t_s_ = -1;
+  MotionState next_base_;        // look-ahead: motion state at an output sample
+  std::uint64_t next_base_sample_ = ~std::uint64_t{0};
   std::deque<SampleTruth> history_;  // recent output truths (model.time_offset_s > 0)
 };
 
