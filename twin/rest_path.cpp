@@ -9,8 +9,11 @@ namespace {
 // by < rate / decay rate ~ 1e-12 rad; far below the 1e-9 rad/s truth tolerance)
 constexpr double kSettledRateRadps = 1e-10;
 constexpr double kSettledAccelRadps2 = 1e-7;
-// a moving box: a stop's transient has decayed by e^-25 ~ 1e-11 this many decay times after its
-// cause, so what remains is the platform riding on its stop
+// a platform moving faster than this relative to the box is in a transient (a flip, a landing,
+// a bounce), rad/s; slower, it rides its stop (the vehicle's vibration moves it by <= 2e-4 rad/s)
+constexpr double kQuietRateRadps = 1e-3;
+// a stop's transient has decayed by e^-25 ~ 1e-11 this many decay times after the platform last
+// moved faster than the quiet rate, so what remains is the platform riding on its stop
 constexpr double kSettleDecayTimes = 25.0;
 // the inertial load may change the stop's contact torque by this fraction of the motor's press
 constexpr double kRestLoadFraction = 0.5;
@@ -33,13 +36,17 @@ RestGate::RestGate(const BoxParams& box, bool static_base, double sample_rate_hz
       dt_out_s_(1.0 / sample_rate_hz),
       settle_s_(kSettleDecayTimes * stop_decay_time_s(box)) {}
 
+void RestGate::observe(double t_s, const HingeState& hinge) {
+  for (int i = 0; i < 2; ++i) {
+    if (!(std::abs(hinge.rate_radps[i]) < kQuietRateRadps)) loud_s_[i] = t_s;
+  }
+}
+
 bool RestGate::settled(double t_s, const HingeState& hinge, const double accel_radps2[2]) const {
   for (int i = 0; i < 2; ++i) {
-    if (static_base_) {
-      if (!(std::abs(hinge.rate_radps[i]) < kSettledRateRadps && std::abs(accel_radps2[i]) < kSettledAccelRadps2)) {
-        return false;
-      }
-    } else if (t_s - event_s_[i] < settle_s_) {
+    if (t_s - loud_s_[i] < settle_s_) return false;
+    if (static_base_ &&
+        !(std::abs(hinge.rate_radps[i]) < kSettledRateRadps && std::abs(accel_radps2[i]) < kSettledAccelRadps2)) {
       return false;
     }
   }

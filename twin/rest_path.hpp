@@ -19,13 +19,15 @@ class RestGate {
   /// `static_base`: the box never moves; `sample_rate_hz`: the output interval the look-ahead spans.
   RestGate(const BoxParams& box, bool static_base, double sample_rate_hz);
 
-  /// Platform i (1 or 2) was disturbed at t_s (a flip settled by the schedule's test, a base
-  /// jolt, the base starting to move at t = 0).
-  void disturbed(int i, double t_s) { event_s_[i - 1] = t_s; }
+  /// Platform i (1 or 2) was disturbed at t_s (a base jolt, the base starting to move at t = 0).
+  void disturbed(int i, double t_s) { loud_s_[i - 1] = t_s; }
+  /// Watches the hinge state of every MuJoCo step at t_s: a platform moving faster than 1e-3 rad/s
+  /// relative to the box (a flip, a landing, a bounce) is disturbed.
+  void observe(double t_s, const HingeState& hinge);
 
-  /// Both platforms have settled at t_s: on a static box, below 1e-10 rad/s and 1e-7 rad/s^2
-  /// (`accel_radps2` from MuJoCo); on a moving box, 25 stop decay times after their last
-  /// disturbance (the transient is down by e^-25).
+  /// Both platforms have settled at t_s: each has moved slower than 1e-3 rad/s for 25 stop decay
+  /// times (any transient is down by e^-25 since), and on a static box they are below 1e-10 rad/s
+  /// and 1e-7 rad/s^2 (`accel_radps2` from MuJoCo).
   bool settled(double t_s, const HingeState& hinge, const double accel_radps2[2]) const;
 
   /// The rigid rest holds from output sample `a` to the next, `b`, with the platforms at
@@ -43,7 +45,8 @@ class RestGate {
   bool static_base_;
   double dt_out_s_;
   double settle_s_;
-  double event_s_[2] = {0, 0};
+  double loud_s_[2] = {-kNoTime, -kNoTime};  // last time platform i moved or was disturbed, s
+  static constexpr double kNoTime = 1e300;
 };
 
 }  // namespace driftless::twin

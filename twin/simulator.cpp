@@ -59,12 +59,17 @@ Simulator::Simulator(const Scenario& scenario, SimOptions options)
   held.v_enu_mps = held.a_enu_mps2 = held.w_body_radps = held.dw_body_radps2 = Eigen::Vector3d::Zero();
   const Eigen::Vector2d ref0(flips_.reference_rad(1), flips_.reference_rad(2));
   const long warmup_steps = std::lround(kWarmupS / scenario.physics_dt_s);
-  for (long n = 0; n < warmup_steps; ++n) world_.step_driven(0.0, held, ref0, false);
+  for (long n = 0; n < warmup_steps; ++n) {
+    const double t = static_cast<double>(n - warmup_steps) * scenario.physics_dt_s;
+    gate_.observe(t, world_.step_driven(t, held, ref0, false));
+  }
   world_.data()->time = 0.0;
   world_.set_base(m0.p_enu_m, m0.q_enu_from_body, m0.v_enu_mps, m0.w_body_radps);
   mj_forward(world_.model(), world_.data());
   // the base starts moving at t = 0 (a jolt from the held warm-up pose): MuJoCo steps its transient
-  for (int i = 1; i <= 2; ++i) gate_.disturbed(i, motion_->is_static() ? -kWarmupS : 0.0);
+  if (!motion_->is_static()) {
+    for (int i = 1; i <= 2; ++i) gate_.disturbed(i, 0.0);
+  }
 }
 
 Simulator::~Simulator() = default;
@@ -111,17 +116,24 @@ double Simulator::output_time_s(std::uint64_t sample) const {
   return static_cast<double>(sample * static_cast<std::uint64_t>(steps_per_sample_)) * scenario_.physics_dt_s;
 }
 
+// the first physics step whose time t = step * dt is >= t_s (the schedule's own test), at or
+// after the current step
+std::uint64_t Simulator::first_step_at(double t_s) const {
+  const double dt = scenario_.physics_dt_s;
+  if (!(t_s < static_cast<double>(total_ * static_cast<std::uint64_t>(steps_per_sample_)) * dt)) return ~std::uint64_t{0};
+  auto n = static_cast<std::uint64_t>(std::max(0.0, std::ceil(t_s / dt)));
+  while (n > 0 && static_cast<double>(n - 1) * dt >= t_s) --n;
+  while (static_cast<double>(n) * dt < t_s) ++n;
+  return std::max(n, step_);
+}
+
 // one physics step at t = step_ * dt: the flip schedule, then MuJoCo, the rest path or a replay
 void Simulator::advance(bool output) {
   const double t = static_cast<double>(step_) * scenario_.physics_dt_s;
   Eigen::Vector2d rates = Eigen::Vector2d::Zero();
   if (mode_ == Mode::stepped) rates = {world_.platform_rate_radps(1), world_.platform_rate_radps(2)};
   if (mode_ == Mode::replay) rates[replay_->platform - 1] = replay_->steps[replay_pos_].rate_radps;
-  const bool was_moving[2] = {flips_.moving(1), flips_.moving(2)};
   flips_.update(t, rates);
-  for (int i = 1; i <= 2; ++i) {
-    if (was_moving[i - 1] && !flips_.moving(i)) gate_.disturbed(i, t);  // arrived, settled by the schedule's test
-  }
   if (mode_ == Mode::rest && flips_.any_moving()) begin_flip(t);
   if (mode_ == Mode::replay && (flips_.moving(3 - replay_->platform) || flips_.sign(replay_->platform) != replay_->sign)) {
     // a command the recording never saw: MuJoCo takes over from the replayed state
@@ -162,6 +174,7 @@ void Simulator::step_physics(double t, bool output) {
   const MotionState ms = motion_->at(t);
   const HingeState h = world_.step_driven(t, ms, Eigen::Vector2d(flips_.reference_rad(1), flips_.reference_rad(2)), output);
   ++mj_steps_;
+  gate_.observe(t, h);
   if (const int i = replays_.recording_platform()) {
     if (flips_.moving(3 - i) || flips_.sign(i) != replays_.recording_sign()) {
       replays_.stop_recording(false);  // the other platform moves too, or a reversal: not one flip
@@ -345,7 +358,11 @@ void Simulator::fill_sample(Sample& out) {
 bool Simulator::next(Sample& out) {
   if (samples_ >= total_) return false;
   const std::uint64_t out_step = samples_ * static_cast<std::uint64_t>(steps_per_sample_);
-  while (step_ < out_step) advance(false);
+  while (step_ < out_step) {
+    // on the rest path nothing happens until the schedule starts the next flip
+    if (mode_ == Mode::rest) step_ = std::min(out_step, first_step_at(flips_.next_flip_s()));
+    if (step_ < out_step) advance(false);
+  }
   advance(true);
   fill_sample(out);
   ++samples_;

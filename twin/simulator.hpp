@@ -99,6 +99,7 @@ class Simulator {
   void enter_rest(const double angle_rad[2]);
   const MotionState& base_at_output(std::uint64_t sample);
   double output_time_s(std::uint64_t sample) const;  // t of output sample k: its physics step's t
+  std::uint64_t first_step_at(double t_s) const;
   void thaw(const double rate_radps[2] = nullptr);
   void capture_truth();
   void rest_truth(const MotionState& base, const double angle_rad[2], const double rate_radps[2],
