@@ -9,6 +9,7 @@
 #include <mujoco/mujoco.h>
 
 #include "estimator/geometry.hpp"
+#include "twin/motion.hpp"
 #include "twin/world.hpp"
 
 namespace driftless::diagnose {
@@ -166,25 +167,17 @@ Eigen::Matrix2d settled_stop_offsets_deg(const BoxParams& box) {
   // platform presses into MuJoCo's soft stop: settle each platform on each stop, level box held
   // still, and read how far past (nominal + error) it rests
   Eigen::Matrix2d out = Eigen::Matrix2d::Zero();
-  World world(box, 0.001);
-  mjModel* m = world.model();
-  mjData* d = world.data();
+  World world(box, 0.001, ModelScope::physics);
+  const MotionState held;  // level box at the origin, at rest
   for (int side : {-1, 1}) {
-    mj_resetData(m, d);
-    const Eigen::Vector3d p0 = Eigen::Vector3d::Zero();
-    const Eigen::Quaterniond q0 = Eigen::Quaterniond::Identity();
-    for (int i = 1; i <= 2; ++i) {
-      // start just short of the stop: the servo drives it on and presses, as after a flip
-      world.set_platform(i, box.stop_rad(i, side) - side * 0.2 * kRadPerDeg, 0.0);
-      world.set_motor_reference(i, side * (box.end_stop_deg + box.motor.overtravel_deg) * kRadPerDeg);
-    }
+    mj_resetData(world.model(), world.data());
+    // start just short of the stop: the servo drives it on and presses, as after a flip
+    for (int i = 1; i <= 2; ++i) world.set_platform(i, box.stop_rad(i, side) - side * 0.2 * kRadPerDeg, 0.0);
+    const Eigen::Vector2d ref = Eigen::Vector2d::Constant(side * (box.end_stop_deg + box.motor.overtravel_deg) * kRadPerDeg);
     const int steps = 3000, average_from = 2000;  // 3 s at 1 ms; the last second averaged
     Eigen::Vector2d sum = Eigen::Vector2d::Zero();
     for (int step = 0; step < steps; ++step) {
-      world.set_base(p0, q0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
-      mj_step1(m, d);
-      world.drive_base(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
-      mj_step2(m, d);
+      world.step_driven(0.0, held, ref, false);
       if (step >= average_from) {
         for (int i = 1; i <= 2; ++i) sum[i - 1] += world.platform_angle_rad(i) - box.stop_rad(i, side);
       }

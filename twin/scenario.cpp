@@ -327,7 +327,12 @@ void Scenario::validate() const {
   auto require = [](bool ok, const std::string& what) {
     if (!ok) throw std::invalid_argument(what);
   };
-  require(duration_s > 0 && std::isfinite(duration_s), "duration_s must be > 0 s");
+  // beyond 1e7 s (116 days) a double time stamp resolves less than 2e-6 of a 1 ms physics step,
+  // and the log would hold 1e9 rows (~370 GB) at 100 Hz
+  require(duration_s > 0 && duration_s <= 1e7,
+          fmt::format("duration_s = {} s must be in (0, 1e7] s (1e7 s = 116 days: at 100 Hz the log would "
+                      "already hold 1e9 rows, ~370 GB); run longer studies as several runs with their own seeds",
+                      duration_s));
   require(latitude_deg >= -90 && latitude_deg <= 90, "latitude_deg must be in [-90, 90] deg");
   require(sample_rate_hz > 0 && sample_rate_hz <= 1000, "sample_rate_hz must be in (0, 1000] Hz");
   require(physics_dt_s > 0 && physics_dt_s <= 0.005, "physics_dt_s must be in (0, 0.005] s");
