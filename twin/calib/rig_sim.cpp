@@ -176,7 +176,7 @@ double known_deg(const PlatformPlan& pp, const BoxParams& box, double t) {
 
 std::string read_text(const std::filesystem::path& path) {
   std::ifstream f(path);
-  if (!f) throw std::invalid_argument(path.string() + ": cannot open calibration scenario");
+  if (!f) throw InputError(path.string(), 0, "", "cannot open calibration scenario");
   std::stringstream ss;
   ss << f.rdbuf();
   return ss.str();
@@ -212,11 +212,7 @@ RigParams parse_rig(const YAML::Node& n, const std::string& file) {
     p.orientations.clear();
     for (const auto& x : o) p.orientations.push_back(as_string(x, file, "calibration.orientations"));
   }
-  try {
-    r.validate();
-  } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument(where(file, n) + ": calibration: " + e.what());
-  }
+  with_location(file, line_of(n), "calibration", [&] { r.validate(); });
   return r;
 }
 
@@ -244,11 +240,11 @@ CalibScenario load_calib_scenario(const std::filesystem::path& path) {
   try {
     root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
-    throw std::invalid_argument(file + ": " + e.what());
+    throw InputError(file, static_cast<std::size_t>(e.mark.line) + 1, "", "broken YAML: " + e.msg);
   }
   if (!root.IsMap() || !root["calibration"]) {
-    throw std::invalid_argument(file + ": no `calibration:` block: not a calibration scenario "
-                                       "(see models/scenarios/calibration.yaml, docs/calibration.md)");
+    throw InputError(file, 0, "", "no `calibration:` block: not a calibration scenario "
+                                  "(see models/scenarios/calibration.yaml, docs/calibration.md)");
   }
   CalibScenario cs;
   cs.rig = parse_rig(root["calibration"], file);

@@ -9,17 +9,19 @@
 #include <Eigen/Core>
 #include <yaml-cpp/yaml.h>
 
+#include "estimator/input_error.hpp"
+
 namespace driftless::twin::calib::yio {
 
-inline std::string where(const std::string& file, const YAML::Node& n) {
+// the 1-based line of a node (0 when yaml-cpp knows none)
+inline std::size_t line_of(const YAML::Node& n) {
   const YAML::Mark m = n.Mark();
-  if (m.line < 0) return file;
-  return file + ":" + std::to_string(m.line + 1);
+  return m.line < 0 ? 0 : static_cast<std::size_t>(m.line) + 1;
 }
 
 [[noreturn]] inline void fail(const std::string& file, const YAML::Node& n, const std::string& key,
                               const std::string& msg) {
-  throw std::invalid_argument(where(file, n) + ": " + key + ": " + msg);
+  throw InputError(file, line_of(n), key, msg);
 }
 
 inline double as_double(const YAML::Node& n, const std::string& file, const std::string& key) {

@@ -15,15 +15,13 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "estimator/input_error.hpp"
+
 namespace driftless::twin::sweep {
 namespace {
 
-std::string where(const std::string& file, const YAML::Node& n) {
-  return file + ":" + std::to_string(n.Mark().line + 1);
-}
-
 [[noreturn]] void fail(const std::string& file, const YAML::Node& n, const std::string& msg) {
-  throw std::runtime_error(where(file, n) + ": " + msg);
+  throw InputError(file, static_cast<std::size_t>(n.Mark().line + 1), "", msg);
 }
 
 double as_double(const std::string& file, const YAML::Node& n, const std::string& key) {
@@ -97,9 +95,9 @@ SweepConfig parse_sweep(const std::string& yaml_text, const std::string& file,
   try {
     root = YAML::Load(yaml_text);
   } catch (const YAML::Exception& e) {
-    throw std::runtime_error(file + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
+    throw InputError(file, static_cast<std::size_t>(e.mark.line) + 1, "", "broken YAML: " + e.msg);
   }
-  if (!root.IsMap()) throw std::runtime_error(file + ": a sweep file is a YAML map (docs/sweep.md)");
+  if (!root.IsMap()) throw InputError(file, 0, "", "a sweep file is a YAML map (docs/sweep.md)");
   SweepConfig c;
   c.file = file;
   static const std::set<std::string> known = {"name",  "description", "runner", "scenario",
@@ -191,17 +189,13 @@ SweepConfig parse_sweep(const std::string& yaml_text, const std::string& file,
       c.plots.push_back(std::move(s));
     }
   }
-  try {
-    c.validate();
-  } catch (const std::invalid_argument& e) {
-    throw std::runtime_error(e.what());
-  }
+  with_location("", 0, "", [&] { c.validate(); });  // validate() names the file itself
   return c;
 }
 
 SweepConfig load_sweep(const std::filesystem::path& path) {
   std::ifstream in(path);
-  if (!in) throw std::runtime_error(path.string() + ": cannot open sweep file");
+  if (!in) throw InputError(path.string(), 0, "", "cannot open sweep file");
   std::stringstream ss;
   ss << in.rdbuf();
   return parse_sweep(ss.str(), path.string(), path.parent_path());
