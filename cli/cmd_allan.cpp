@@ -18,6 +18,7 @@
 #include "cli/plot.hpp"
 #include "estimator/allan.hpp"
 #include "estimator/filter.hpp"
+#include "estimator/log.hpp"
 
 namespace driftless::cli {
 namespace {
@@ -190,7 +191,7 @@ std::vector<Channel> read_log(const AllanArgs& a, double& rate_hz, std::vector<s
       cfg = est::parse_estimator_config(in, a.config);
     }
     if (!a.mode.empty()) est::set_config_value(cfg, "mode", a.mode);
-    filter = std::make_unique<est::DriftlessFilter>(cfg, meta);
+    filter = std::make_unique<est::DriftlessFilter>(cfg, est::box_geometry_from_metadata(meta));
     for (const auto& n : names) {
       int k = -1;
       if (n.size() == 7 && n.rfind("gyro", 0) == 0 && (n[4] == '1' || n[4] == '2') && n[5] == '_' &&

@@ -7,8 +7,8 @@
 #include <fmt/core.h>
 
 #include "cli/command.hpp"
-#include "twin/compare/compare.hpp"
-#include "twin/compare/report.hpp"
+#include "diagnose/compare.hpp"
+#include "diagnose/report.hpp"
 
 namespace driftless::cli {
 namespace {
@@ -22,27 +22,27 @@ struct CompareArgs {
 
 int run_compare(const CompareArgs& a) {
   Progress progress("compare");
-  twin::CompareModel model = a.model.empty() ? twin::default_compare_model() : twin::load_compare_model(a.model);
-  twin::CompareOptions opt;
+  diagnose::CompareModel model = a.model.empty() ? diagnose::default_compare_model() : diagnose::load_compare_model(a.model);
+  diagnose::CompareOptions opt;
   opt.block_s = a.block_s;
   opt.evidence_threshold = a.threshold;
   opt.replay.model_sample_rate_hz = model.sample_rate_hz;
   opt.replay.resample = a.resample;
   if (std::isfinite(model.latitude_deg)) opt.replay.default_latitude_deg = model.latitude_deg;
-  const twin::Replay replay = twin::replay_log(a.log, opt.replay);
+  const diagnose::Replay replay = diagnose::replay_log(a.log, opt.replay);
   for (const auto& n : replay.notes) fmt::print("note: {}\n", n);
   progress.update(0.3, "replayed");
   if (!a.before.empty()) {
     // before/after: the same log against the earlier model, then the given one
-    const twin::CompareModel old = twin::load_compare_model(a.before);
-    const twin::CompareResult r0 = twin::compare(replay, old, opt);
-    const twin::CompareResult r1 = twin::compare(replay, model, opt);
-    twin::ReportExtras x{&r1, model.source, "model changed from " + old.source};
-    twin::write_report(r0, a.out, x);
+    const diagnose::CompareModel old = diagnose::load_compare_model(a.before);
+    const diagnose::CompareResult r0 = diagnose::compare(replay, old, opt);
+    const diagnose::CompareResult r1 = diagnose::compare(replay, model, opt);
+    diagnose::ReportExtras x{&r1, model.source, "model changed from " + old.source};
+    diagnose::write_report(r0, a.out, x);
     fmt::print("before ({}): {}\nafter  ({}): {}\n", old.source, r0.statement, model.source, r1.statement);
   } else {
-    const twin::CompareResult r = twin::compare(replay, model, opt);
-    twin::write_report(r, a.out);
+    const diagnose::CompareResult r = diagnose::compare(replay, model, opt);
+    diagnose::write_report(r, a.out);
     fmt::print("{}: {}\n", r.verdict, r.statement);
   }
   progress.done();

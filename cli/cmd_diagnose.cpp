@@ -7,8 +7,8 @@
 #include <fmt/core.h>
 
 #include "cli/command.hpp"
-#include "twin/compare/compare.hpp"
-#include "twin/compare/report.hpp"
+#include "diagnose/compare.hpp"
+#include "diagnose/report.hpp"
 
 namespace driftless::cli {
 namespace {
@@ -21,15 +21,15 @@ struct DiagnoseArgs {
 
 int run_diagnose(const DiagnoseArgs& a) {
   Progress progress("diagnose");
-  twin::CompareModel model = a.model.empty() ? twin::default_compare_model() : twin::load_compare_model(a.model);
-  twin::CompareOptions opt;
+  diagnose::CompareModel model = a.model.empty() ? diagnose::default_compare_model() : diagnose::load_compare_model(a.model);
+  diagnose::CompareOptions opt;
   opt.evidence_threshold = a.threshold;
   opt.replay.model_sample_rate_hz = model.sample_rate_hz;
   opt.replay.resample = a.resample;
   if (std::isfinite(model.latitude_deg)) opt.replay.default_latitude_deg = model.latitude_deg;
-  const twin::Replay replay = twin::replay_log(a.log, opt.replay);
+  const diagnose::Replay replay = diagnose::replay_log(a.log, opt.replay);
   for (const auto& n : replay.notes) fmt::print("note: {}\n", n);
-  const twin::CompareResult r = twin::compare(replay, model, opt);
+  const diagnose::CompareResult r = diagnose::compare(replay, model, opt);
   progress.update(0.5, "compared");
   fmt::print("{}: {}\n", r.verdict, r.statement);
   int top = 0;
@@ -40,20 +40,20 @@ int run_diagnose(const DiagnoseArgs& a) {
   }
   if (!a.apply.empty()) {
     if (r.verdict != "missing_effect") {
-      twin::write_report(r, a.out);
+      diagnose::write_report(r, a.out);
       throw std::runtime_error(fmt::format("--apply: nothing to apply ({}); {} not written", r.verdict, a.apply));
     }
-    const twin::Candidate& best = r.ranking.front();
-    twin::CompareModel updated = model;
-    twin::apply_candidate(updated, best);
-    twin::save_compare_model(updated, a.apply);
+    const diagnose::Candidate& best = r.ranking.front();
+    diagnose::CompareModel updated = model;
+    diagnose::apply_candidate(updated, best);
+    diagnose::save_compare_model(updated, a.apply);
     updated.source = a.apply;
-    const twin::CompareResult after = twin::compare(replay, updated, opt);
-    twin::ReportExtras x{&after, a.apply, fmt::format("{} on sensor {} axis {}", best.effect, best.sensor, best.axis)};
-    twin::write_report(r, a.out, x);
+    const diagnose::CompareResult after = diagnose::compare(replay, updated, opt);
+    diagnose::ReportExtras x{&after, a.apply, fmt::format("{} on sensor {} axis {}", best.effect, best.sensor, best.axis)};
+    diagnose::write_report(r, a.out, x);
     fmt::print("wrote {} with {} added; after: {}: {}\n", a.apply, best.effect, after.verdict, after.statement);
   } else {
-    twin::write_report(r, a.out);
+    diagnose::write_report(r, a.out);
   }
   progress.done();
   fmt::print("wrote {}/report.html and {}/diagnosis.json\n", a.out, a.out);

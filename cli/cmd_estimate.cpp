@@ -13,8 +13,7 @@
 #include <fmt/os.h>
 
 #include "cli/command.hpp"
-#include "cli/plot.hpp"
-#include "estimator/allan.hpp"
+#include "cli/estimate_figures.hpp"
 #include "estimator/calibration.hpp"
 #include "estimator/pipeline.hpp"
 #include "twin/calib/calib_file.hpp"
@@ -89,20 +88,7 @@ class FileSink : public est::EstimateSink {
     for (int i = 0; i < 3; ++i) put(b, o.rate_body_dps[i], 7);
     fmt::format_to(std::back_inserter(b), ",{}\n", est::to_string(o.status));
     if (b.size() > (1u << 20)) flush();
-    if (keep_series_ && s.gyros_finite()) {
-      if (o.status == est::PushStatus::kMoving) platforms_moved_ = true;
-      // fused body rate, holding the last value while no platform is at rest
-      if (o.rate_body_dps.allFinite()) {
-        last_rate_ = o.rate_body_dps;
-        last_raw_rate_ = o.rate_body_raw_dps;
-      }
-      for (int i = 0; i < 3; ++i) {
-        raw1_[i].push_back(static_cast<float>(s.gyro1_dps[i]));
-        cor1_[i].push_back(static_cast<float>(o.y1c_dps[i]));
-        raw_rate_[i].push_back(static_cast<float>(last_raw_rate_[i]));
-        cor_rate_[i].push_back(static_cast<float>(last_rate_[i]));
-      }
-    }
+    if (keep_series_) series_.add(s, o);
   }
 
   void on_update(const est::UpdateRecord& r, const est::Matrix6d&, const Sample& s) override {
@@ -145,12 +131,10 @@ class FileSink : public est::EstimateSink {
     attitude_.close();
   }
 
-  std::vector<float> raw1_[3], cor1_[3];          // sensor 1 output, raw and corrected
-  std::vector<float> raw_rate_[3], cor_rate_[3];  // fused body rate, raw and corrected
-  bool platforms_moved_ = false;
+  const FigureSeries& series() const { return series_; }
 
  private:
-  Eigen::Vector3d last_rate_ = Eigen::Vector3d::Zero(), last_raw_rate_ = Eigen::Vector3d::Zero();
+  FigureSeries series_;
   fmt::ostream corrected_, estimate_, attitude_;
   fmt::memory_buffer buf_;
   bool truth_;
@@ -181,6 +165,12 @@ void write_summary(const fs::path& path, const EstimateArgs& a, const est::Estim
           json_number(s.final_corrected.angle_deg), json_number(s.final_fixed.angle_deg),
           json_number(s.final_raw.angle_deg));
   o.print("  \"fixed_bias_dps\": {},\n", json_vec(s.fixed_bias_dps));
+  o.print("  \"relocks\": [");
+  for (std::size_t i = 0; i < s.relocks.size(); ++i) {
+    o.print("{}{{\"t_s\": {}, \"nis\": {}}}", i ? ", " : "", json_number(s.relocks[i].t_s),
+            json_number(s.relocks[i].nis));
+  }
+  o.print("],\n");
   if (s.truth.available) {
     const auto& t = s.truth;
     o.print("  \"truth\": {{\n");
@@ -199,83 +189,6 @@ void write_summary(const fs::path& path, const EstimateArgs& a, const est::Estim
   o.print("  \"warnings\": [");
   for (std::size_t i = 0; i < s.warnings.size(); ++i) o.print("{}{}", i ? ", " : "", json_string(s.warnings[i]));
   o.print("]\n}}\n");
-}
-
-std::vector<std::string> make_plots(const fs::path& dir, FileSink& sink, bool truth, bool attitude,
-                                    double rate_hz) {
-  std::vector<std::string> warnings;
-  // Fig. 4: bias estimate (and truth) against time, one panel per sensor
-  {
-    std::string body = "  set multiplot layout 2,1 title 'Fig. 4: bias estimates'\n"
-                       "  set xlabel 't [s]'; set ylabel 'bias [deg/s]'\n";
-    for (int sensor = 1; sensor <= 2; ++sensor) {
-      const int c0 = sensor == 1 ? 2 : 5;
-      body += fmt::format("  set title 'sensor {}'\n  plot ", sensor);
-      static constexpr const char* kColour[3] = {"#d62728", "#2ca02c", "#1f77b4"};
-      for (int a = 0; a < 3; ++a) {
-        body += fmt::format("'estimate.csv' using 1:{} with lines lw 2 lc rgb '{}' title 'b{}_{} estimate', ",
-                            c0 + a, kColour[a], sensor, "xyz"[a]);
-        if (truth) {
-          body += fmt::format("'estimate.csv' using 1:{} with lines dt 2 lc rgb '{}' title 'b{}_{} true', ",
-                              c0 + a + 19, kColour[a], sensor, "xyz"[a]);
-        }
-      }
-      body.resize(body.size() - 2);
-      body += "\n";
-    }
-    body += "  unset multiplot\n";
-    if (auto w = render_gnuplot(dir, "fig4_bias", body); !w.empty()) warnings.push_back(w);
-  }
-  // Fig. 5: Allan deviation raw against corrected: sensor 1's axes on a static run (the paper's
-  // Fig. 5); when the platforms flip, the sensor outputs carry the flips, so the fused body rate
-  if (!sink.raw1_[0].empty() && sink.raw1_[0].size() >= 3 && std::isfinite(rate_hz)) {
-    std::vector<AllanTableColumn> cols;
-    est::AllanOptions opt;
-    opt.sample_rate_hz = rate_hz;
-    const bool fused = sink.platforms_moved_;
-    for (int pass = 0; pass < 2; ++pass) {
-      for (int a = 0; a < 3; ++a) {
-        const auto& src = fused ? (pass == 0 ? sink.raw_rate_[a] : sink.cor_rate_[a])
-                                : (pass == 0 ? sink.raw1_[a] : sink.cor1_[a]);
-        std::vector<double> x(src.begin(), src.end());
-        const auto curve = est::allan_deviation(x, opt);
-        AllanTableColumn c;
-        c.name = fmt::format("{}{}_{}", pass == 0 ? "raw_" : "corrected_", fused ? "rate" : "gyro1", "xyz"[a]);
-        for (const auto& p : curve.points) {
-          c.tau_s.push_back(p.tau_s);
-          c.adev.push_back(p.adev);
-          c.lo.push_back(p.adev_lo);
-          c.hi.push_back(p.adev_hi);
-        }
-        cols.push_back(std::move(c));
-      }
-    }
-    write_allan_table(dir / "allan_fig5.csv", cols);
-    std::string body = fmt::format(
-        "  set logscale xy; set xlabel 'tau [s]'; set ylabel 'Allan deviation [deg/s]'\n"
-        "  set title 'Fig. 5: Allan deviation of {}, raw (red) and DriftLess-corrected (black)'\n"
-        "  plot ",
-        fused ? "the fused body rate" : "sensor 1");
-    for (int i = 0; i < 6; ++i) {
-      body += fmt::format("'allan_fig5.csv' using 1:{} with linespoints lc rgb '{}' dt {} title columnhead({}){}",
-                          2 + 3 * i, i < 3 ? "red" : "black", 1 + i % 3, 2 + 3 * i, i < 5 ? ", " : "\n");
-    }
-    if (auto w = render_gnuplot(dir, "fig5_allan", body); !w.empty()) warnings.push_back(w);
-  }
-  // Fig. 9: attitude error with and without DriftLess
-  if (attitude) {
-    std::string body =
-        "  set xlabel 't [s]'; set ylabel 'attitude error [deg]'\n"
-        "  set title 'Fig. 9: attitude error, bias fixed at the start (red) and DriftLess (blue)'\n"
-        "  plot 'attitude.csv' using 1:10 with lines lc rgb 'red' dt 1 title 'roll (bias fixed)', "
-        "'' using 1:11 with lines lc rgb 'red' dt 2 title 'pitch (bias fixed)', "
-        "'' using 1:12 with lines lc rgb 'red' dt 3 title 'heading (bias fixed)', "
-        "'' using 1:2 with lines lc rgb 'blue' dt 1 title 'roll', "
-        "'' using 1:3 with lines lc rgb 'blue' dt 2 title 'pitch', "
-        "'' using 1:4 with lines lc rgb 'blue' dt 3 title 'heading'\n";
-    if (auto w = render_gnuplot(dir, "fig9_attitude", body); !w.empty()) warnings.push_back(w);
-  }
-  return warnings;
 }
 
 bool stop_polled() { return stop_requested().load(); }
@@ -347,7 +260,8 @@ int run_estimate_cmd(const EstimateArgs& a) {
   if (a.plot) {
     double rate = reader.metadata().sample_rate_hz();
     if (!std::isfinite(rate) && summary.rows > 1) rate = double(summary.rows - 1) / (summary.t_last_s - summary.t_first_s);
-    for (auto& w : make_plots(dir, sink, truth, attitude, rate)) warnings.push_back(w);
+    const EstimateFigureInputs fig{&sink.series(), truth, attitude, rate};
+    for (auto& w : write_estimate_figures(dir, fig)) warnings.push_back(w);
   }
   auto final_summary = summary;
   final_summary.warnings = warnings;

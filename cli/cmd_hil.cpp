@@ -89,7 +89,7 @@ int run_hil(const HilOptions& o) {
     if (!in) throw std::runtime_error(o.estimator_config + ": cannot open the estimator configuration");
     cfg = est::parse_estimator_config(in, o.estimator_config, cfg);
   }
-  est::DriftlessFilter filter(cfg, meta);
+  est::DriftlessFilter filter(cfg, est::box_geometry_from_metadata(meta));
 
   const std::filesystem::path log_path = std::filesystem::path(o.out_dir) / "log.csv";
   log::LogWriter writer(log_path, meta, fields);

@@ -5,7 +5,7 @@
 #include <ostream>
 
 #include "estimator/fields.hpp"
-#include "estimator/filter.hpp"
+#include "estimator/config.hpp"
 #include "estimator/input_error.hpp"
 
 namespace driftless::est {
@@ -49,7 +49,6 @@ const fields::Table<C>& config_table() {
       fields::number<C>("bias_instability", "dps", &C::bias_instability_dps),
       fields::number<C>("bias_instability_tau", "s", &C::bias_instability_tau_s),
       fields::number<C>("end_margin", "s", &C::end_margin_s),
-      fields::number<C>("flip_angle", "deg", &C::flip_angle_deg),
       fields::number<C>("gyro_motion_threshold", "dps", &C::gyro_motion_threshold_dps),
       fields::number<C>("initial_bias", "dps", &C::initial_bias_dps),
       fields::number<C>("initial_plat1", "deg", &C::initial_plat1_deg),

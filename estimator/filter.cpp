@@ -9,6 +9,7 @@
 #include <Eigen/LU>
 
 #include "estimator/stats.hpp"
+#include "estimator/standstill.hpp"
 
 namespace driftless::est {
 namespace {
@@ -70,7 +71,6 @@ void EstimatorConfig::validate() const {
   positive(angle_tolerance_deg, "angle_tolerance_deg", "deg");
   positive(gyro_motion_threshold_dps, "gyro_motion_threshold_dps", "deg/s");
   positive(standstill_period_s, "standstill_period_s", "s");
-  positive(flip_angle_deg, "flip_angle_deg", "deg");
   if (!finite(initial_plat1_deg) || !finite(initial_plat2_deg)) {
     throw std::invalid_argument("estimator config: initial_plat1_deg/initial_plat2_deg must be numbers (deg)");
   }
@@ -134,9 +134,8 @@ const char* to_string(PushStatus s) {
 // ---------------------------------------------------------------------------------------------
 // the filter
 
-DriftlessFilter::DriftlessFilter(const EstimatorConfig& cfg, const log::Metadata& meta) : cfg_(cfg) {
-  cfg_.validate();
-  set_metadata(meta);
+DriftlessFilter::DriftlessFilter(const EstimatorConfig& cfg, const BoxGeometry& box)
+    : cfg_(cfg), box_(box), standstill_((cfg_.validate(), cfg_), (box_.validate(), box_)) {
   q_rate_dps2_per_s_ = cfg_.q_dps2_per_s();
   x_.setConstant(cfg_.initial_bias_dps);
   P_ = Matrix6d::Identity() * (cfg_.initial_sigma_dps * cfg_.initial_sigma_dps);
@@ -144,37 +143,18 @@ DriftlessFilter::DriftlessFilter(const EstimatorConfig& cfg, const log::Metadata
                                            : std::numeric_limits<double>::infinity();
   gate6_ = cfg_.nis_gate_probability < 1.0 ? chi2_quantile(cfg_.nis_gate_probability, 6.0)
                                            : std::numeric_limits<double>::infinity();
-  gyro_.p1 = cfg_.initial_plat1_deg;
-  gyro_.p2 = cfg_.initial_plat2_deg;
 }
 
-void DriftlessFilter::set_metadata(const log::Metadata& meta) {
-  // metadata values were validated by the reader; a bad one here is a caller error
-  hinge1_ = meta.hinge1_axis();
-  hinge2_ = meta.hinge2_axis();
-  if (!(hinge1_.norm() > 0.0) || !(hinge2_.norm() > 0.0)) {
-    throw std::invalid_argument("estimator: hinge1_axis / hinge2_axis must be non-zero vectors");
+void DriftlessFilter::on_source_switch(const BoxGeometry* box) {
+  if (box != nullptr) {
+    BoxGeometry b = *box;
+    b.validate();
+    box_ = b;
+    cache_deg_ = {kNaN, kNaN};
   }
-  hinge1_.normalize();
-  hinge2_.normalize();
-  meta_rate_hz_ = meta.sample_rate_hz();
-  cache_deg_ = {kNaN, kNaN};
-  // the end-margin ring, sized once (unknown rate: assume up to 1 kHz)
-  const double rate = finite(meta_rate_hz_) && meta_rate_hz_ > 0.0 ? meta_rate_hz_ : 1000.0;
-  ring_capacity_ = static_cast<std::size_t>(std::ceil(cfg_.end_margin_s * rate - 1e-9));
-  ring_.assign(ring_capacity_ + 1, Pending{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), 0.0});
-  ring_head_ = ring_count_ = 0;
-}
-
-void DriftlessFilter::on_source_switch(const log::Metadata* meta) {
-  if (meta != nullptr) set_metadata(*meta);
-  seg_ = Segment{};
+  standstill_.restart(box_);
   prev_res_.valid = false;
   last_t_s_ = kNaN;
-  prev_p1_ = prev_p2_ = prev_t_plat_s_ = kNaN;
-  sched_start_s_ = kNaN;
-  gyro_.moving = false;
-  gyro_.have_base = false;
   // P and x stay; the time base of the prediction restarts with the next sample
   t_filter_s_ = kNaN;
   ++counters_.source_switches;
@@ -184,7 +164,7 @@ Eigen::Matrix3d DriftlessFilter::body_from_sensor(int sensor, double plat_deg) c
   const std::size_t i = sensor == 1 ? 0 : 1;
   if (cache_deg_[i] == plat_deg) return cache_M_[i];
   const auto& list = sensor == 1 ? cfg_.calibration.sensor1 : cfg_.calibration.sensor2;
-  Eigen::Matrix3d M = rot_deg(sensor == 1 ? hinge1_ : hinge2_, plat_deg);
+  Eigen::Matrix3d M = rot_deg(sensor == 1 ? box_.hinge1_axis : box_.hinge2_axis, plat_deg);
   double best = cfg_.calibration.match_tolerance_deg;
   for (const auto& p : list) {
     const double d = std::fabs(p.plat_deg - plat_deg);
@@ -196,22 +176,6 @@ Eigen::Matrix3d DriftlessFilter::body_from_sensor(int sensor, double plat_deg) c
   cache_deg_[i] = plat_deg;
   cache_M_[i] = M;
   return M;
-}
-
-// eq. (5)'s position sequence: (+,+), (+,-), (-,-), (-,+)
-int DriftlessFilter::pattern_of(double p1, double p2) const {
-  const bool s1 = p1 >= 0.0, s2 = p2 >= 0.0;
-  if (s1 && s2) return 0;
-  if (s1 && !s2) return 1;
-  if (!s1 && !s2) return 2;
-  return 3;
-}
-
-double DriftlessFilter::pattern_angle(int pattern, int sensor) const {
-  static constexpr int kSign1[4] = {+1, +1, -1, -1};
-  static constexpr int kSign2[4] = {+1, -1, -1, +1};
-  const int p = ((pattern % 4) + 4) % 4;
-  return cfg_.flip_angle_deg * (sensor == 1 ? kSign1[p] : kSign2[p]);
 }
 
 void DriftlessFilter::predict_to(double t_s) {
@@ -248,6 +212,7 @@ bool DriftlessFilter::update(const Eigen::Matrix<double, D, 1>& r, const Eigen::
     }
     P_.diagonal().array() += innov.squaredNorm();
     ++counters_.relocks;
+    rec.relocked = true;
     return update<D>(r, H, R, rec);
   }
   consecutive_rejections_ = 0;
@@ -275,69 +240,37 @@ void DriftlessFilter::emit_update(const UpdateRecord& in, bool accepted) {
   if (!accepted) ++counters_.rejected;
 }
 
-void DriftlessFilter::start_segment(double t_s, double p1, double p2, std::int64_t tag) {
-  seg_ = Segment{};
-  ring_head_ = ring_count_ = 0;
-  seg_.active = true;
-  seg_.t_rest_s = t_s;
-  seg_.p1 = p1;
-  seg_.p2 = p2;
-  seg_.tag = tag;
+// paper mode: a standstill that could not be used still advances eq. (5)'s counter
+void DriftlessFilter::skip_paper_step() {
+  prev_res_.valid = false;
+  if (cfg_.mode == FilterMode::kPaper && paper_k_ >= 0) ++paper_k_;
 }
 
-// closes the standstill in progress; the end margin (samples just before the motion) is dropped
-int DriftlessFilter::end_standstill() {
-  ring_head_ = ring_count_ = 0;
-  return close_segment();
-}
-
-// turns the committed samples into an update; returns +1 accepted, -1 rejected, 0 none
-int DriftlessFilter::close_segment() {
-  if (!seg_.active) return 0;
-  Segment s = seg_;
-  seg_.active = false;
-  if (cfg_.per_sample_updates) return 0;  // its samples were used one by one
-  if (s.n == 0) {
-    ++counters_.standstills_too_short;
-    prev_res_.valid = false;
-    if (cfg_.mode == FilterMode::kPaper && paper_k_ >= 0) ++paper_k_;
-    return 0;
-  }
-  const double span = s.n >= 2 ? (s.t_last_s - s.t_first_s) : 0.0;
-  const double rate_hz = finite(meta_rate_hz_) && meta_rate_hz_ > 0.0
-                             ? meta_rate_hz_
-                             : (s.n >= 2 && span > 0.0 ? double(s.n - 1) / span : kNaN);
-  const double duration = finite(rate_hz) ? double(s.n) / rate_hz : 0.0;
-  if (!finite(rate_hz) || duration + 1e-9 < cfg_.min_standstill_s) {
-    ++counters_.standstills_too_short;
-    prev_res_.valid = false;
-    if (cfg_.mode == FilterMode::kPaper && paper_k_ >= 0) ++paper_k_;
-    return 0;
-  }
-
+// turns a standstill's averages into an update; returns +1 accepted, -1 rejected, 0 none
+int DriftlessFilter::use_segment(const StandstillSegment& s) {
+  const double rate_hz = standstill_.rate_hz(s);
   // positions used for H: measured (general) or eq. (5)'s sequence (paper)
-  double p1 = s.p1, p2 = s.p2;
+  double p1 = s.plat1_deg, p2 = s.plat2_deg;
   int pattern = 0;
   if (cfg_.mode == FilterMode::kPaper) {
-    if (paper_k_ < 0) paper_k_ = finite(p1) && finite(p2) ? pattern_of(p1, p2) : 0;
+    if (paper_k_ < 0) paper_k_ = finite(p1) && finite(p2) ? eq5_pattern_of(p1, p2) : 0;
     pattern = static_cast<int>(paper_k_ % 4);
-    if (finite(p1) && finite(p2) && pattern_of(p1, p2) != pattern) ++counters_.schedule_mismatches;
-    p1 = pattern_angle(pattern, 1);
-    p2 = pattern_angle(pattern, 2);
+    if (finite(p1) && finite(p2) && eq5_pattern_of(p1, p2) != pattern) ++counters_.schedule_mismatches;
+    p1 = eq5_position_deg(pattern, 1, box_.flip_angle_deg);
+    p2 = eq5_position_deg(pattern, 2, box_.flip_angle_deg);
     ++paper_k_;
   }
   const Eigen::Matrix3d M1 = body_from_sensor(1, p1);
   const Eigen::Matrix3d M2 = body_from_sensor(2, p2);
-  const Eigen::Vector3d y1 = s.sum1 / double(s.n), y2 = s.sum2 / double(s.n);
   Residual3 cur;
   cur.valid = true;
   cur.pattern = pattern;
-  cur.r = M1 * y1 - M2 * y2;  // eq. (2): r = R1 y1 - R2 y2
+  cur.r = M1 * s.mean_gyro1_dps() - M2 * s.mean_gyro2_dps();  // eq. (2): r = R1 y1 - R2 y2
   cur.H.block<3, 3>(0, kBias1.start) = M1;
   cur.H.block<3, 3>(0, kBias2.start) = -M2;
   // eq. (2)'s noise R1 n1 - R2 n2, averaged over n samples; the bias random walk adds q T / 12
   // (its mean over the standstill scatters about its value at the midpoint)
-  const double var = cfg_.sample_variance_dps2(rate_hz) / double(s.n) + q_rate_dps2_per_s_ * span / 12.0;
+  const double var = cfg_.sample_variance_dps2(rate_hz) / double(s.n) + q_rate_dps2_per_s_ * s.span_s() / 12.0;
   cur.R = var * (M1 * M1.transpose() + M2 * M2.transpose());
 
   UpdateRecord rec;
@@ -346,6 +279,7 @@ int DriftlessFilter::close_segment() {
   rec.samples = s.n;
   rec.plat1_deg = p1;
   rec.plat2_deg = p2;
+  rec.at_end = s.end == SegmentEnd::kFinish;
   // the average measures the bias at the standstill's midpoint: update there, then carry P on
   const double t_mid = 0.5 * (s.t_first_s + s.t_last_s);
   predict_to(std::max(t_mid, finite(t_filter_s_) ? t_filter_s_ : t_mid));
@@ -374,149 +308,25 @@ int DriftlessFilter::close_segment() {
   return result;
 }
 
-// at-rest test for the platform columns; p1/p2 get the angles (deg) used for H
-bool DriftlessFilter::classify(const Sample& s, double& p1, double& p2, bool& p1_rest, bool& p2_rest) {
-  p1 = s.plat1_deg;
-  p2 = s.plat2_deg;
-  const double tol = cfg_.angle_tolerance_deg;
-  p1_rest = finite(p1) && finite(prev_p1_) && std::fabs(p1 - prev_p1_) <= tol;
-  p2_rest = finite(p2) && finite(prev_p2_) && std::fabs(p2 - prev_p2_) <= tol;
-  // the very first sample with both angles known counts as at rest only from the next one on
-  prev_p1_ = p1;
-  prev_p2_ = p2;
-  prev_t_plat_s_ = s.t_s;
-  return p1_rest && p2_rest;
-}
-
-// gyro-only flip detection: |y1| - |y2| is independent of the box rate (rotations keep norms),
-// so a jump in it is a platform moving; the hinge-rate integral y_i . a_i says which and how far
-bool DriftlessFilter::track_gyro_positions(const Sample& s, double dt_s) {
-  const Eigen::Vector3d y1 = s.gyro1_dps - x_.segment<3>(kBias1.start);
-  const Eigen::Vector3d y2 = s.gyro2_dps - x_.segment<3>(kBias2.start);
-  const double d = y1.norm() - y2.norm();
-  const double h1 = y1.dot(hinge1_), h2 = y2.dot(hinge2_);
-  auto& g = gyro_;
-  if (!g.have_base) {
-    g.have_base = true;
-    g.d_base = d;
-    g.h1_base = h1;
-    g.h2_base = h2;
-    g.prev_d = d;
-    return true;
-  }
-  const double thr = cfg_.gyro_motion_threshold_dps;
-  if (!g.moving) {
-    if (std::fabs(d - g.d_base) > thr) {
-      g.moving = true;
-      g.turn1_deg = g.turn2_deg = 0.0;
-      g.quiet = 0;
-    } else {
-      // slow rest levels (time constant ~1 s)
-      const double a = std::min(1.0, finite(dt_s) ? dt_s / 1.0 : 0.01);
-      g.d_base += a * (d - g.d_base);
-      g.h1_base += a * (h1 - g.h1_base);
-      g.h2_base += a * (h2 - g.h2_base);
-    }
-  }
-  if (g.moving) {
-    if (finite(dt_s)) {
-      g.turn1_deg += (h1 - g.h1_base) * dt_s;
-      g.turn2_deg += (h2 - g.h2_base) * dt_s;
-    }
-    // the flip is over when the statistic stays steady for ~0.25 s
-    g.quiet = std::fabs(d - g.prev_d) < 0.2 * thr ? g.quiet + 1 : 0;
-    const double rate = finite(meta_rate_hz_) && meta_rate_hz_ > 0.0 ? meta_rate_hz_ : 100.0;
-    if (g.quiet >= std::max(3, static_cast<int>(0.25 * rate))) {
-      g.moving = false;
-      auto apply = [&](double& p, double turn) {
-        if (std::fabs(turn) < 0.5 * cfg_.flip_angle_deg) return;
-        p += turn;
-        // snap to the nearest end position
-        if (std::fabs(p - cfg_.flip_angle_deg) < std::fabs(p + cfg_.flip_angle_deg)) p = cfg_.flip_angle_deg;
-        else p = -cfg_.flip_angle_deg;
-      };
-      apply(g.p1, g.turn1_deg);
-      apply(g.p2, g.turn2_deg);
-      g.d_base = d;
-      g.h1_base = h1;
-      g.h2_base = h2;
-    }
-  }
-  g.prev_d = d;
-  return !g.moving;
-}
-
-// a resting sample enters the ring; the one falling out of the end margin is committed
-void DriftlessFilter::accumulate(const Sample& s, PushStatus& status, int& result) {
-  status = PushStatus::kAccumulating;
-  if (ring_capacity_ == 0) {
-    commit(s.gyro1_dps, s.gyro2_dps, s.t_s, result);
-    return;
-  }
-  const std::size_t slots = ring_.size();
-  if (ring_count_ == ring_capacity_) {
-    const Pending old = ring_[ring_head_];
-    ring_head_ = (ring_head_ + 1) % slots;
-    --ring_count_;
-    commit(old.y1, old.y2, old.t_s, result);
-  }
-  ring_[(ring_head_ + ring_count_) % slots] = Pending{s.gyro1_dps, s.gyro2_dps, s.t_s};
-  ++ring_count_;
-}
-
-void DriftlessFilter::commit(const Eigen::Vector3d& y1, const Eigen::Vector3d& y2, double t_s, int& result) {
-  if (seg_.n == 0) seg_.t_first_s = t_s;
-  seg_.t_last_s = t_s;
-  ++seg_.n;
-  seg_.sum1 += y1;
-  seg_.sum2 += y2;
-  if (cfg_.per_sample_updates) {
-    // one 3-dim update per sample: r = M1 y1 - M2 y2, R from one sample's noise
-    const Eigen::Matrix3d M1 = body_from_sensor(1, seg_.p1), M2 = body_from_sensor(2, seg_.p2);
-    Eigen::Matrix<double, 3, 6> H;
-    H << M1, -M2;
-    const double rate_hz = finite(meta_rate_hz_) && meta_rate_hz_ > 0.0 ? meta_rate_hz_ : 100.0;
-    const Eigen::Vector3d r = M1 * y1 - M2 * y2;
-    const Eigen::Matrix3d R = cfg_.sample_variance_dps2(rate_hz) * (M1 * M1.transpose() + M2 * M2.transpose());
-    UpdateRecord rec;
-    rec.t_s = rec.t_start_s = t_s;
-    rec.samples = 1;
-    rec.plat1_deg = seg_.p1;
-    rec.plat2_deg = seg_.p2;
-    predict_to(t_s);
-    const bool ok = update<3>(r, H, R, rec);
-    emit_update(rec, ok);
-    result = ok ? 1 : -1;
-  } else if (cfg_.max_standstill_s > 0.0 && t_s - seg_.t_first_s >= cfg_.max_standstill_s) {
-    // split a long standstill: update now, keep accumulating the same position (no settle);
-    // the ring of pending samples carries over
-    const Segment keep = seg_;
-    result = close_segment();
-    seg_ = Segment{};
-    seg_.active = true;
-    seg_.t_rest_s = keep.t_rest_s;
-    seg_.p1 = keep.p1;
-    seg_.p2 = keep.p2;
-    seg_.tag = keep.tag;
-  }
-}
-
-void DriftlessFilter::fuse_rate(const Sample& s, double p1, double p2, bool p1_rest, bool p2_rest) {
+void DriftlessFilter::fuse_rate(const Sample& s, const StandstillStep& st) {
   out_.y1c_dps = s.gyro1_dps - x_.segment<3>(kBias1.start);
   out_.y2c_dps = s.gyro2_dps - x_.segment<3>(kBias2.start);
+  out_.plat1_deg = st.plat1_deg;
+  out_.plat2_deg = st.plat2_deg;
+  out_.at_rest = st.plat1_rest && st.plat2_rest && finite(st.plat1_deg) && finite(st.plat2_deg);
   Eigen::Vector3d sum = Eigen::Vector3d::Zero(), raw = Eigen::Vector3d::Zero(),
                   fixed = Eigen::Vector3d::Zero();
   int n = 0;
   // a sensor on a moving platform also reads its hinge rate; only resting ones enter the fusion
-  if (p1_rest && finite(p1)) {
-    const Eigen::Matrix3d M1 = body_from_sensor(1, p1);
+  if (st.plat1_rest && finite(st.plat1_deg)) {
+    const Eigen::Matrix3d M1 = body_from_sensor(1, st.plat1_deg);
     sum += M1 * out_.y1c_dps;
     raw += M1 * s.gyro1_dps;
     fixed += M1 * (s.gyro1_dps - fixed_bias_.segment<3>(kBias1.start));
     ++n;
   }
-  if (p2_rest && finite(p2)) {
-    const Eigen::Matrix3d M2 = body_from_sensor(2, p2);
+  if (st.plat2_rest && finite(st.plat2_deg)) {
+    const Eigen::Matrix3d M2 = body_from_sensor(2, st.plat2_deg);
     sum += M2 * out_.y2c_dps;
     raw += M2 * s.gyro2_dps;
     fixed += M2 * (s.gyro2_dps - fixed_bias_.segment<3>(kBias2.start));
@@ -559,55 +369,38 @@ PushStatus DriftlessFilter::push_corrected(const Sample& s) {
   last_t_s_ = s.t_s;
   if (!finite(t_filter_s_)) t_filter_s_ = s.t_s;
 
-  // 1. where are the platforms, and are they at rest?
-  double p1 = kNaN, p2 = kNaN;
-  bool r1 = false, r2 = false, at_rest = false;
-  std::int64_t tag = 0;
-  switch (cfg_.standstill) {
-    case StandstillSource::kPlatformColumns:
-      at_rest = classify(s, p1, p2, r1, r2);
-      break;
-    case StandstillSource::kGyroSignal:
-      at_rest = track_gyro_positions(s, dt);
-      p1 = gyro_.p1;
-      p2 = gyro_.p2;
-      r1 = r2 = at_rest;
-      break;
-    case StandstillSource::kSchedule: {
-      if (!finite(sched_start_s_)) sched_start_s_ = s.t_s;
-      tag = static_cast<std::int64_t>(std::floor((s.t_s - sched_start_s_) / cfg_.standstill_period_s));
-      const int first = pattern_of(cfg_.initial_plat1_deg, cfg_.initial_plat2_deg);
-      p1 = pattern_angle(first + static_cast<int>(tag % 4), 1);
-      p2 = pattern_angle(first + static_cast<int>(tag % 4), 2);
-      r1 = r2 = at_rest = true;
-      break;
-    }
+  // 1. where are the platforms, are they at rest, did a standstill end?
+  const StandstillStep st = standstill_.push(s, dt, bias1_dps(), bias2_dps());
+  switch (st.state) {
+    case StandstillStep::State::kMoving: out_.status = PushStatus::kMoving; break;
+    case StandstillStep::State::kSettling: out_.status = PushStatus::kSettling; break;
+    case StandstillStep::State::kAccumulating: out_.status = PushStatus::kAccumulating; break;
   }
-
-  // 2. standstill bookkeeping: a change of position or motion closes the segment
+  // 2. each standstill handed over becomes an update
   int result = 0;
-  const double tol = cfg_.angle_tolerance_deg;
-  if (!at_rest) {
-    result = end_standstill();
-    out_.status = PushStatus::kMoving;
-  } else {
-    const bool same = seg_.active && seg_.tag == tag && std::fabs(p1 - seg_.p1) <= tol &&
-                      std::fabs(p2 - seg_.p2) <= tol;
-    if (!same) {
-      result = end_standstill();
-      start_segment(s.t_s, p1, p2, tag);
-    }
-    if (s.t_s - seg_.t_rest_s < cfg_.settle_s) {
-      out_.status = PushStatus::kSettling;
-    } else {
-      accumulate(s, out_.status, result);
-    }
+  if (standstill_.discarded_last()) skip_paper_step();
+  for (int i = 0; i < st.closed; ++i) {
+    const int r = use_segment(standstill_.closed(i));
+    if (r != 0) result = r;
   }
+  counters_.standstills_too_short = standstill_.too_short();
   if (result != 0) out_.status = result > 0 ? PushStatus::kUpdated : PushStatus::kRejected;
 
   // 3. outputs with the estimate now in force
-  fuse_rate(s, p1, p2, r1, r2);
+  fuse_rate(s, st);
   return out_.status;
+}
+
+PushStatus DriftlessFilter::finish() {
+  const int n = standstill_.finish();
+  if (standstill_.discarded_last()) skip_paper_step();
+  counters_.standstills_too_short = standstill_.too_short();
+  int result = 0;
+  for (int i = 0; i < n; ++i) {
+    const int r = use_segment(standstill_.closed(i));
+    if (r != 0) result = r;
+  }
+  return result > 0 ? PushStatus::kUpdated : result < 0 ? PushStatus::kRejected : PushStatus::kMoving;
 }
 
 template bool DriftlessFilter::update<3>(const Eigen::Matrix<double, 3, 1>&, const Eigen::Matrix<double, 3, 6>&,

@@ -11,8 +11,10 @@
 
 #include <Eigen/Core>
 
-#include "estimator/log.hpp"
+#include "estimator/box_geometry.hpp"
+#include "estimator/config.hpp"
 #include "estimator/sample.hpp"
+#include "estimator/standstill.hpp"
 
 namespace driftless::est {
 
@@ -27,105 +29,6 @@ struct StateSlice {
 inline constexpr StateSlice kBias1{0, 3};  // b1, deg/s, sensor-1 axes
 inline constexpr StateSlice kBias2{3, 3};  // b2, deg/s, sensor-2 axes
 inline constexpr int kStateDim = 6;
-
-/// paper: H_k switches by k mod 4 as in eq. (5), 6-dim stacked residuals of consecutive
-/// standstills. general: H from the platform attitudes in force (or calibrated matrices), one
-/// 3-dim residual per standstill (or per sample).
-enum class FilterMode { kPaper, kGeneral };
-
-/// Where standstills (both platforms at rest relative to the box) come from.
-enum class StandstillSource {
-  kPlatformColumns,  // plat1_deg / plat2_deg: at rest when both are finite and unchanged
-  kGyroSignal,       // the gyros alone (hardware without angle read-back): flips show as a
-                     // rate difference between the sensors; positions tracked from the flips
-  kSchedule,         // a fixed clock: one standstill every standstill_period_s (the paper's
-                     // static Fig. 5 run, where the platforms never moved)
-};
-
-/// How P is updated after a gain: the paper's printed (I - W H)(P + Q), or Joseph form.
-enum class CovarianceUpdate { kPrinted, kJoseph };
-
-/// One calibrated matrix M of one sensor at one platform position (paper section 4):
-/// y = M^-1 x + b, so M replaces R (and M^-1 replaces R^T) in eqs. (1), (2) and (5).
-struct CalibratedPosition {
-  double plat_deg = 0.0;                                        // deg, the platform angle
-  Eigen::Matrix3d M_body_from_sensor = Eigen::Matrix3d::Identity();  // includes scale, misalignment
-};
-
-/// Calibrated matrices per sensor. An empty list means "use Rot(hinge axis, angle)".
-struct Calibration {
-  std::vector<CalibratedPosition> sensor1;
-  std::vector<CalibratedPosition> sensor2;
-  double match_tolerance_deg = 10.0;  // deg, a platform angle this close uses that position's M
-  /// g-sensitivity per sensor, deg/s per g of specific force (sensor axes): push() subtracts
-  /// G f / g from the gyros of samples whose accel columns are finite. Zero = none.
-  std::array<Eigen::Matrix3d, 2> G_dps_per_g{Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero()};
-  bool empty() const { return sensor1.empty() && sensor2.empty(); }
-  bool has_g_sensitivity() const { return !G_dps_per_g[0].isZero(0.0) || !G_dps_per_g[1].isZero(0.0); }
-  /// Throws std::invalid_argument when a matrix is singular or not finite.
-  void validate() const;
-};
-
-/// Filter configuration: plain values with units; defaults are MPU6050-like (paper section 4).
-struct EstimatorConfig {
-  FilterMode mode = FilterMode::kGeneral;
-  CovarianceUpdate covariance_update = CovarianceUpdate::kJoseph;  // paper mode: kPrinted
-  bool per_sample_updates = false;  // general mode: update on every standstill sample
-
-  // standstill detection
-  StandstillSource standstill = StandstillSource::kPlatformColumns;
-  double settle_s = 0.5;               // s, samples skipped after the platforms come to rest
-  double min_standstill_s = 1.0;       // s, shorter standstills are discarded
-  double max_standstill_s = 0.0;       // s, split longer standstills into updates (0 = never)
-  double end_margin_s = 0.1;           // s, samples dropped before motion is seen (its onset
-                                       // hides below angle_tolerance_deg for a sample or two)
-  double angle_tolerance_deg = 0.001;  // deg, platform angle change between samples = motion
-  double gyro_motion_threshold_dps = 5.0;  // deg/s, | |y1| - |y2| | above this = a flip
-  double standstill_period_s = 10.0;   // s, kSchedule: length of one standstill
-  double flip_angle_deg = 90.0;        // deg, positions +-flip_angle (paper mode, gyro/schedule)
-  double initial_plat1_deg = 90.0;     // deg, kGyroSignal / kSchedule start positions
-  double initial_plat2_deg = 90.0;     // deg
-
-  // tuning. R: per-axis white noise of one sample = noise_density^2 * sample rate
-  double noise_density_dps_rthz = 0.005;   // deg/s/sqrt(Hz), MPU6050 data sheet (paper sec. 4)
-  // Q: the bias wanders like a random walk that reaches the bias-instability level B at tau_B:
-  // K = 0.664 B sqrt(3 / tau_B), Q = K^2 dt per axis
-  double bias_instability_dps = 0.01;      // deg/s (36 deg/h)
-  double bias_instability_tau_s = 100.0;   // s, where the Allan minimum lies (paper: ~100 s)
-  double q_override_dps2_per_s = 0.0;      // (deg/s)^2/s, > 0 replaces the spec-derived Q rate
-  double r_override_dps2 = 0.0;            // (deg/s)^2 per sample and axis, > 0 replaces R
-  double initial_bias_dps = 0.0;           // deg/s, every component of x0
-  double initial_sigma_dps = 20.0;         // deg/s, sqrt of P0's diagonal (MPU6050 turn-on +-20)
-  double variance_floor_dps2 = 1e-14;      // (deg/s)^2, P's diagonal never drops below this
-  double nis_gate_probability = 0.9999;    // chi-square probability of the NIS gate (1 = off)
-  /// after this many consecutive gate rejections the filter re-locks: P is widened by the
-  /// innovation and the update is taken (a real bias jump or a switch to other hardware,
-  /// not an outlier). 0 = never re-lock.
-  int gate_relock_after = 3;
-
-  Calibration calibration;  // optional calibrated matrices (issue 4); empty = rotations
-
-  /// Throws std::invalid_argument naming the field on a bad value.
-  void validate() const;
-  /// Q rate per axis, (deg/s)^2/s, from the spec (or the override).
-  double q_dps2_per_s() const;
-  /// White-noise variance of one sample per axis, (deg/s)^2, at `sample_rate_hz`.
-  double sample_variance_dps2(double sample_rate_hz) const;
-};
-
-/// Paper-mode defaults: printed recursion, platform columns.
-EstimatorConfig paper_config();
-
-/// Reads a `key: value` configuration (a flat YAML subset: '#' comments, blank lines) on top of
-/// `base`. Keys are the EstimatorConfig field names; enums as text (mode: paper|general, ...).
-/// Keys may use another unit of the field's quantity (`bias_instability_dph: 36`). Throws
-/// driftless::InputError naming `name`, the line and the key on a bad line or a key given twice.
-EstimatorConfig parse_estimator_config(std::istream& in, const std::string& name,
-                                       EstimatorConfig base = {});
-/// The same, applied to one key (for the CLI and YAML front ends).
-void set_config_value(EstimatorConfig& cfg, const std::string& key, const std::string& value);
-/// Writes every field as `key: value` lines (parse_estimator_config reads it back).
-void write_estimator_config(std::ostream& out, const EstimatorConfig& cfg);
 
 /// What push() did with a sample. It never throws per sample.
 enum class PushStatus {
@@ -154,6 +57,8 @@ struct UpdateRecord {
   double nis = kNaN;          // innovation^T S^-1 innovation
   double nis_gate = kNaN;     // chi-square gate at nis_gate_probability and `dim`
   bool accepted = false;
+  bool relocked = false;      // taken after gate_relock_after rejections in a row, P widened
+  bool at_end = false;        // the stream ended inside this standstill (finish())
 };
 
 /// Outputs for the sample last pushed.
@@ -168,6 +73,10 @@ struct SampleOutput {
   // the same, corrected by the fixed bias of set_fixed_bias_dps() (the uncorrected rate until set)
   Eigen::Vector3d rate_body_fixed_dps = Eigen::Vector3d::Constant(kNaN);
   int sensors_fused = 0;  // 0, 1 or 2
+  // platform positions in force (deg; NaN = unknown) and whether both platforms are at rest, i.e.
+  // the residual of eq. (2) is valid for this sample (fault detection watches it)
+  double plat1_deg = kNaN, plat2_deg = kNaN;
+  bool at_rest = false;
   PushStatus status = PushStatus::kInvalid;
 };
 
@@ -187,16 +96,19 @@ struct FilterCounters {
 /// The streaming DriftLess filter.
 class DriftlessFilter {
  public:
-  /// Builds the filter; hinge axes, sample rate and latitude come from `meta` (defaults if absent).
-  /// Throws std::invalid_argument on a bad config.
-  DriftlessFilter(const EstimatorConfig& cfg, const log::Metadata& meta);
+  /// Builds the filter for the box `box` (hinge axes, sample rate, latitude, flip angle; from a
+  /// log with box_geometry_from_metadata()). Throws std::invalid_argument on a bad config or box.
+  DriftlessFilter(const EstimatorConfig& cfg, const BoxGeometry& box);
 
   /// Feeds one sample; returns what happened. Never throws; NaN samples never touch the state.
   PushStatus push(const Sample& s);
+  /// The stream ended: a standstill in progress (the log ends at rest, or never moved) is used
+  /// with all its samples. Returns kUpdated / kRejected when it made an update, else kMoving.
+  PushStatus finish();
   /// A new source takes over (HIL switch-over, a gap): the standstill in progress is dropped and
-  /// paper-mode stacking restarts; the estimate and P are kept. `meta` (optional) may change the
+  /// paper-mode stacking restarts; the estimate and P are kept. `box` (optional) may change the
   /// hinge axes and sample rate; time may restart.
-  void on_source_switch(const log::Metadata* meta = nullptr);
+  void on_source_switch(const BoxGeometry* box = nullptr);
 
   /// A bias [b1; b2] (deg/s) held fixed for the comparison output rate_body_fixed_dps: what a box
   /// whose gyros were calibrated once and never again would use. Zero until set; the filter's
@@ -217,6 +129,7 @@ class DriftlessFilter {
   const SampleOutput& output() const { return out_; }
   const FilterCounters& counters() const { return counters_; }
   const EstimatorConfig& config() const { return cfg_; }
+  const BoxGeometry& geometry() const { return box_; }
 
   /// M_body_from_sensor for sensor 1 or 2 at platform angle `plat_deg` (Rot(a_i, angle) or the
   /// calibrated matrix). For tests and diagnosis.
@@ -224,28 +137,17 @@ class DriftlessFilter {
 
  private:
   PushStatus push_corrected(const Sample& s);
-  struct Standstill;  // running sums of one standstill
-  void set_metadata(const log::Metadata& meta);
-  bool classify(const Sample& s, double& p1, double& p2, bool& p1_rest, bool& p2_rest);
-  void start_segment(double t_s, double p1, double p2, std::int64_t tag);
-  int end_standstill();
-  int close_segment();
+  int use_segment(const StandstillSegment& seg);
   void predict_to(double t_s);
   template <int D>
   bool update(const Eigen::Matrix<double, D, 1>& r, const Eigen::Matrix<double, D, 6>& H,
               const Eigen::Matrix<double, D, D>& R, UpdateRecord& rec);
   void emit_update(const UpdateRecord& rec, bool accepted);
-  void accumulate(const Sample& s, PushStatus& status, int& result);
-  void commit(const Eigen::Vector3d& y1, const Eigen::Vector3d& y2, double t_s, int& result);
-  void fuse_rate(const Sample& s, double p1, double p2, bool p1_rest, bool p2_rest);
-  bool track_gyro_positions(const Sample& s, double dt_s);
-  int pattern_of(double p1, double p2) const;
-  double pattern_angle(int pattern, int sensor) const;
+  void fuse_rate(const Sample& s, const StandstillStep& st);
+  void skip_paper_step();
 
   EstimatorConfig cfg_;
-  Eigen::Vector3d hinge1_ = Eigen::Vector3d::UnitZ();
-  Eigen::Vector3d hinge2_ = Eigen::Vector3d::UnitX();
-  double meta_rate_hz_ = kNaN;
+  BoxGeometry box_;
   double q_rate_dps2_per_s_ = 0.0;
 
   Vector6d x_ = Vector6d::Zero();
@@ -253,41 +155,9 @@ class DriftlessFilter {
   Matrix6d P_ = Matrix6d::Identity();
   int consecutive_rejections_ = 0;
   double t_filter_s_ = kNaN;  // time P and x refer to
-
-  // standstill tracking
-  struct Segment {
-    bool active = false;
-    double t_rest_s = kNaN;   // when rest began
-    double t_first_s = kNaN;  // first sample used
-    double t_last_s = kNaN;
-    double p1 = kNaN, p2 = kNaN;  // deg
-    std::int64_t tag = 0;         // schedule slot (kSchedule)
-    std::size_t n = 0;
-    Eigen::Vector3d sum1 = Eigen::Vector3d::Zero();
-    Eigen::Vector3d sum2 = Eigen::Vector3d::Zero();
-  } seg_;
-  // samples of the current standstill not yet committed (the end margin), a fixed ring
-  struct Pending {
-    Eigen::Vector3d y1, y2;
-    double t_s;
-  };
-  std::vector<Pending> ring_;
-  std::size_t ring_head_ = 0, ring_count_ = 0, ring_capacity_ = 0;
   double last_t_s_ = kNaN;
-  double prev_p1_ = kNaN, prev_p2_ = kNaN, prev_t_plat_s_ = kNaN;
-  double sched_start_s_ = kNaN;
-  std::uint64_t sched_index_ = 0;
-  // gyro-only position tracking
-  struct GyroTracker {
-    double p1 = 90.0, p2 = 90.0;           // deg, tracked positions
-    bool moving = false;
-    bool have_base = false;
-    double d_base = 0.0;                   // deg/s, rest level of |y1| - |y2|
-    double h1_base = 0.0, h2_base = 0.0;   // deg/s, rest level of y_i . a_i
-    double turn1_deg = 0.0, turn2_deg = 0.0;
-    double prev_d = 0.0;
-    int quiet = 0;
-  } gyro_;
+
+  StandstillDetector standstill_;
   double gate3_ = 0.0, gate6_ = 0.0;
   // cached M_body_from_sensor of the last angle asked for, per sensor
   mutable std::array<double, 2> cache_deg_{kNaN, kNaN};
@@ -302,7 +172,6 @@ class DriftlessFilter {
     int pattern = 0;  // position index 0..3 of eq. (5)'s sequence
   } prev_res_;
   std::int64_t paper_k_ = -1;   // k of eq. (5); -1 until the phase is known
-  Eigen::Vector3d last_rate_body_dps_ = Eigen::Vector3d::Constant(kNaN);
 
   UpdateRecord last_update_;
   SampleOutput out_;

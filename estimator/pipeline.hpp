@@ -59,6 +59,12 @@ struct TruthStats {
   double within_3sigma_fraction = kNaN;  // component errors inside +-3 sigma
 };
 
+/// A gate re-lock (docs/estimator.md: gate_relock_after).
+struct RelockEvent {
+  double t_s = kNaN;  // s, time of the update taken by the re-lock
+  double nis = kNaN;  // its NIS before P was widened
+};
+
 /// What a pass produced.
 struct EstimateSummary {
   std::uint64_t rows = 0;
@@ -76,6 +82,7 @@ struct EstimateSummary {
   AttitudeError final_corrected, final_raw, final_fixed;
   TruthStats truth;
   bool log_complete = true;
+  std::vector<RelockEvent> relocks;
   std::vector<std::string> warnings;
 };
 

@@ -14,7 +14,7 @@ Telemetry::Telemetry(const TelemetryParams& p, const log::Metadata& meta)
     : p_(p), residual_(meta.hinge1_axis(), meta.hinge2_axis(), p.window_s) {
   p_.validate();
   if (p_.run_estimator) {
-    filter_ = std::make_unique<est::DriftlessFilter>(est::EstimatorConfig{}, meta);
+    filter_ = std::make_unique<est::DriftlessFilter>(est::EstimatorConfig{}, est::box_geometry_from_metadata(meta));
     bias1_.emplace(1, p_.window_s);
     bias2_.emplace(2, p_.window_s);
     const double lat = meta.latitude_deg();

@@ -9,6 +9,7 @@
 
 #include "estimator/allan.hpp"
 #include "estimator/filter.hpp"
+#include "estimator/log.hpp"
 #include "estimator/pipeline.hpp"
 #include "tests/estimator/synth.hpp"
 
@@ -48,7 +49,7 @@ void BM_PushLive(benchmark::State& state) {
   const auto meta = test::synth_metadata(p);
   std::size_t n = 0;
   for (auto _ : state) {
-    est::DriftlessFilter f(est::EstimatorConfig{}, meta);
+    est::DriftlessFilter f(est::EstimatorConfig{}, est::box_geometry_from_metadata(meta));
     for (const auto& s : samples) benchmark::DoNotOptimize(f.push(s));
     n += samples.size();
   }

@@ -75,7 +75,7 @@ void LiveLoop1kHzRealtime(benchmark::State& state) {
   for (auto _ : state) {
     Rig<SteadyClock> rig;
     if (!rig.src.configure().ok()) state.SkipWithError("configure failed");
-    est::DriftlessFilter filter(est::EstimatorConfig{}, meta_1khz());
+    est::DriftlessFilter filter(est::EstimatorConfig{}, est::box_geometry_from_metadata(meta_1khz()));
     log::LogWriter writer(temp_log(), meta_1khz(), rig.src.fields());
     LiveParams lp;
     lp.duration_s = duration_s;
@@ -112,7 +112,7 @@ void LiveLoopEmulatedI2cAfap(benchmark::State& state) {
   for (auto _ : state) {
     Rig<VirtualClock> rig;
     if (!rig.src.configure().ok()) state.SkipWithError("configure failed");
-    est::DriftlessFilter filter(est::EstimatorConfig{}, meta_1khz());
+    est::DriftlessFilter filter(est::EstimatorConfig{}, est::box_geometry_from_metadata(meta_1khz()));
     log::LogWriter writer(temp_log(), meta_1khz(), rig.src.fields());
     LiveParams lp;
     lp.duration_s = duration_s;

@@ -37,7 +37,7 @@ TEST(FilterTest, NoisyErrorFollowsSigmaAndNeesStaysInTheChiSquareBand) {
     p.noise_sigma_dps = 0.05;
     p.seed = static_cast<std::uint64_t>(seed);
     p.body_rate_dps = [](double t) { return Eigen::Vector3d(2.0 * std::sin(0.1 * t), 0.0, 1.0); };
-    DriftlessFilter f(quiet_config(), test::synth_metadata(p));
+    DriftlessFilter f(quiet_config(), test::synth_geometry(p));
     test::synth_samples(p, [&](const Sample& s) {
       if (f.push(s) != PushStatus::kUpdated) return;
       const Vector6d e = f.bias_dps() - truth(p);
@@ -76,7 +76,7 @@ TEST(FilterTest, PaperStackingIsOverConfident) {
     p.seed = static_cast<std::uint64_t>(100 + seed);
     EstimatorConfig paper = paper_config();
     paper.q_override_dps2_per_s = 1e-14;
-    DriftlessFilter fp(paper, test::synth_metadata(p)), fg(quiet_config(), test::synth_metadata(p));
+    DriftlessFilter fp(paper, test::synth_geometry(p)), fg(quiet_config(), test::synth_geometry(p));
     test::synth_samples(p, [&](const Sample& s) {
       fp.push(s);
       fg.push(s);
@@ -106,7 +106,7 @@ TEST(FilterTest, LongRunWithBiasWanderTracksTruthAndKeepsPSymmetricPositiveDefin
   p.gm_tau_s = 1000.0;
   EstimatorConfig cfg;  // Q from the spec; here matched to the wander: K^2 = 2 sigma^2 / tau
   cfg.q_override_dps2_per_s = 2.0 * 0.02 * 0.02 / 1000.0;
-  DriftlessFilter f(cfg, test::synth_metadata(p));
+  DriftlessFilter f(cfg, test::synth_geometry(p));
   std::size_t updates = 0, within = 0, spd_fail = 0;
   test::synth_samples(p, [&](const Sample& s) {
     if (f.push(s) != PushStatus::kUpdated) return;
@@ -142,7 +142,7 @@ TEST(FilterTest, PaperRecursionKeepsPSymmetricPositiveDefiniteOver14Hours) {
   p.noise_sigma_dps = 0.005 * std::sqrt(p.rate_hz);
   p.gm_sigma_dps = 0.02;
   p.gm_tau_s = 1000.0;
-  DriftlessFilter f(paper_config(), test::synth_metadata(p));
+  DriftlessFilter f(paper_config(), test::synth_geometry(p));
   std::size_t updates = 0, spd_fail = 0;
   double worst_err = 0.0;
   test::synth_samples(p, [&](const Sample& s) {

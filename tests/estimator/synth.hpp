@@ -11,6 +11,7 @@
 
 #include <Eigen/Geometry>
 
+#include "estimator/box_geometry.hpp"
 #include "estimator/log.hpp"
 #include "estimator/sample.hpp"
 
@@ -50,6 +51,12 @@ inline log::Metadata synth_metadata(const SynthParams& p) {
   m.set("hinge2_axis", vec(p.hinge2));
   m.set("source", "synth");
   return m;
+}
+
+inline est::BoxGeometry synth_geometry(const SynthParams& p) {
+  est::BoxGeometry g = est::box_geometry_from_metadata(synth_metadata(p));
+  g.flip_angle_deg = p.flip_angle_deg;
+  return g;
 }
 
 /// Streams samples to `sink` (so 14 h runs need no memory).

@@ -4,6 +4,7 @@
 
 #include "estimator/calibration.hpp"
 #include "estimator/filter.hpp"
+#include "estimator/log.hpp"
 
 namespace driftless::est {
 namespace {
@@ -96,7 +97,7 @@ TEST(GSensitivityFit, FilterSubtractsGTimesTheSpecificForce) {
   meta.set("hinge2_axis", "1 0 0");
   EstimatorConfig plain, with_g;
   with_g.calibration.G_dps_per_g[0] << 0, 0, 0.1, 0, 0, 0, 0, 0, 0.05;  // x and z respond to f_z
-  DriftlessFilter a(plain, meta), b(with_g, meta);
+  DriftlessFilter a(plain, box_geometry_from_metadata(meta)), b(with_g, box_geometry_from_metadata(meta));
   Sample s;
   s.t_s = 0.0;
   s.gyro1_dps = Eigen::Vector3d(0.1, 0.0, 0.05);  // exactly G f: the g-sensitivity and nothing else

@@ -23,7 +23,7 @@ Vector6d truth(const SynthParams& p) {
 }
 
 DriftlessFilter run(const SynthParams& p, const EstimatorConfig& cfg) {
-  DriftlessFilter f(cfg, test::synth_metadata(p));
+  DriftlessFilter f(cfg, test::synth_geometry(p));
   test::synth_samples(p, [&](const Sample& s) { f.push(s); });
   return f;
 }
@@ -80,7 +80,7 @@ TEST(FilterTest, TwoPositionsLeaveTheHingeComponentUnobservable) {
   p.hold_platform2 = true;
   p.noise_sigma_dps = 0.05;
   p.duration_s = 300.0;
-  DriftlessFilter f(quiet_config(), test::synth_metadata(p));
+  DriftlessFilter f(quiet_config(), test::synth_geometry(p));
   test::synth_samples(p, [&](const Sample& s) { f.push(s); });
   const Vector6d sd = f.sigma_dps();
   // THEN b1 across the hinge is estimated, b1 along hinge 1 (z) is not: its sigma stays near P0
@@ -107,7 +107,7 @@ TEST(FilterTest, StaticBoxWithWrongRotationMatricesStillEstimatesTheBiases) {
     cfg.q_override_dps2_per_s = 1e-14;
     cfg.standstill = StandstillSource::kSchedule;
     cfg.standstill_period_s = 10.0;
-    DriftlessFilter f(cfg, test::synth_metadata(p));
+    DriftlessFilter f(cfg, test::synth_geometry(p));
     test::synth_samples(p, [&](const Sample& s) { f.push(s); });
     // THEN the biases come out anyway: x ~ 0 so a wrong R adds only Earth rate (0.004 deg/s) terms
     EXPECT_GT(f.counters().updates, 25u);
@@ -119,7 +119,7 @@ TEST(FilterTest, NanSamplesNeverEnterTheState) {
   test::SynthParams p;
   p.duration_s = 60.0;
   p.noise_sigma_dps = 0.05;
-  DriftlessFilter f(quiet_config(), test::synth_metadata(p));
+  DriftlessFilter f(quiet_config(), test::synth_geometry(p));
   std::size_t k = 0, nan_pushed = 0;
   test::synth_samples(p, [&](const Sample& s) {
     f.push(s);
@@ -151,7 +151,7 @@ TEST(FilterTest, SurvivesASourceSwitchWithANewTimeline) {
   test::SynthParams p;
   p.duration_s = 120.0;
   p.noise_sigma_dps = 0.05;
-  DriftlessFilter f(quiet_config(), test::synth_metadata(p));
+  DriftlessFilter f(quiet_config(), test::synth_geometry(p));
   test::synth_samples(p, [&](const Sample& s) { f.push(s); });
   const auto updates_before = f.counters().updates;
   f.on_source_switch();
@@ -172,7 +172,7 @@ TEST(FilterTest, GyroOnlyStandstillDetectionFindsTheFlips) {
   p.body_rate_dps = [](double t) { return Eigen::Vector3d(0.5 * std::sin(0.05 * t), 0.3, 0.0); };
   EstimatorConfig cfg = quiet_config();
   cfg.standstill = StandstillSource::kGyroSignal;
-  DriftlessFilter f(cfg, test::synth_metadata(p));
+  DriftlessFilter f(cfg, test::synth_geometry(p));
   test::synth_samples(p, [&](const Sample& s) {
     Sample blind = s;
     blind.plat1_deg = blind.plat2_deg = kNaN;
@@ -189,7 +189,7 @@ TEST(FilterTest, NisGateRejectsAnOutlierStandstillAndReportsIt) {
   test::SynthParams p;
   p.duration_s = 200.0;
   p.noise_sigma_dps = 0.05;
-  DriftlessFilter f(quiet_config(), test::synth_metadata(p));
+  DriftlessFilter f(quiet_config(), test::synth_geometry(p));
   bool saw_reject = false;
   test::synth_samples(p, [&](const Sample& s) {
     Sample x = s;
@@ -212,7 +212,7 @@ TEST(FilterTest, ARunOfRejectionsRelocksOntoABiasStep) {
   p.duration_s = 600.0;
   p.noise_sigma_dps = 0.05;
   EstimatorConfig cfg = quiet_config();
-  DriftlessFilter f(cfg, test::synth_metadata(p));
+  DriftlessFilter f(cfg, test::synth_geometry(p));
   test::synth_samples(p, [&](const Sample& s) {
     Sample x = s;
     if (s.t_s > 250.0) x.gyro1_dps.x() += 1.0;
@@ -228,7 +228,7 @@ TEST(FilterTest, ARunOfRejectionsRelocksOntoABiasStep) {
 
   // AND with re-locking off the estimate stays frozen on the old bias
   cfg.gate_relock_after = 0;
-  DriftlessFilter frozen(cfg, test::synth_metadata(p));
+  DriftlessFilter frozen(cfg, test::synth_geometry(p));
   test::synth_samples(p, [&](const Sample& s) {
     Sample x = s;
     if (s.t_s > 250.0) x.gyro1_dps.x() += 1.0;
@@ -244,7 +244,7 @@ TEST(FilterTest, PerSampleUpdatesAgreeWithStandstillAverages) {
   p.noise_sigma_dps = 0.05;
   EstimatorConfig a = quiet_config(), b = quiet_config();
   b.per_sample_updates = true;
-  DriftlessFilter fa(a, test::synth_metadata(p)), fb(b, test::synth_metadata(p));
+  DriftlessFilter fa(a, test::synth_geometry(p)), fb(b, test::synth_geometry(p));
   test::synth_samples(p, [&](const Sample& s) {
     fa.push(s);
     fb.push(s);
@@ -267,7 +267,7 @@ TEST(FilterTest, CalibratedMatricesReplaceTheRotations) {
     const Eigen::Matrix3d R = Eigen::AngleAxisd(a * kRadPerDeg, Eigen::Vector3d::UnitZ()).toRotationMatrix();
     cfg.calibration.sensor1.push_back({a, R * C});
   }
-  DriftlessFilter f(cfg, test::synth_metadata(p));
+  DriftlessFilter f(cfg, test::synth_geometry(p));
   test::synth_samples(p, [&](const Sample& s) {
     Sample x = s;
     const Eigen::Matrix3d R =

@@ -88,7 +88,7 @@ TEST(LiveLoop, EmulatedI2cRunConvergesAndLogsEveryRow) {
   EmuRig rig;
   ASSERT_TRUE(rig.src.configure().ok());
   const fs::path path = temp_file("converge.csv");
-  est::DriftlessFilter filter(est::EstimatorConfig{}, box_meta());
+  est::DriftlessFilter filter(est::EstimatorConfig{}, est::box_geometry_from_metadata(box_meta()));
   {
     log::LogWriter writer(path, box_meta(), rig.src.fields());
     LiveParams lp;
@@ -138,7 +138,7 @@ TEST(LiveLoop, SwitchOverKeepsTheEstimatorAndLosesNoSample) {
 
   // WHEN the loop switches from the replay to the hardware at T = 40 s
   const fs::path path = temp_file("switch.csv");
-  est::DriftlessFilter filter(est::EstimatorConfig{}, box_meta());
+  est::DriftlessFilter filter(est::EstimatorConfig{}, est::box_geometry_from_metadata(box_meta()));
   Eigen::Matrix<double, 6, 1> before = Eigen::Matrix<double, 6, 1>::Constant(kNaN), after = before;
   std::uint64_t updates_before = 0;
   std::string first_source_of_switch;

@@ -158,7 +158,7 @@ TEST(TwinMotors, BridgeFlipScheduleDrivesTheTwinInTheLiveLoop) {
   rig->source->describe(meta);
   const std::filesystem::path path = std::filesystem::temp_directory_path() /
                                      ("driftless-twin-bridge-" + std::to_string(::getpid()) + ".csv");
-  est::DriftlessFilter filter(est::EstimatorConfig{}, meta);
+  est::DriftlessFilter filter(est::EstimatorConfig{}, est::box_geometry_from_metadata(meta));
   LiveStats st;
   {
     log::LogWriter writer(path, meta, rig->source->fields());

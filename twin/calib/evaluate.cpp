@@ -33,7 +33,7 @@ EvalRow evaluate_log(const std::vector<Sample>& log, const log::Metadata& meta,
   if (log.size() < 2) throw std::invalid_argument("evaluation: the log holds fewer than 2 samples");
   if (!log.front().ref_q_wxyz.allFinite() || !log.front().true_bias1_dps.allFinite())
     throw std::invalid_argument("evaluation: the log needs ref_q and true_bias columns (a twin log)");
-  est::DriftlessFilter filter(cfg, meta);
+  est::DriftlessFilter filter(cfg, est::box_geometry_from_metadata(meta));
   const double lat = meta.latitude_deg() * kRadPerDeg;
   const Eigen::Vector3d w_earth_enu =
       std::isfinite(lat) ? Eigen::Vector3d(Eigen::Vector3d(0.0, std::cos(lat), std::sin(lat)) * kEarthRateRadps)

@@ -127,7 +127,7 @@ Metrics evaluate_bias(const RunSetup& setup, const log::Metadata& meta, const Sa
     att_out << "t_s,err_driftless_deg,err_zeroed_deg\n";
   }
   double next_att_out_s = 0.0;
-  est::DriftlessFilter filter(setup.estimator, meta);
+  est::DriftlessFilter filter(setup.estimator, est::box_geometry_from_metadata(meta));
   const double eval_start =
       setup.eval_start_s >= 0 ? setup.eval_start_s : 0.25 * setup.scenario.duration_s;
   Sample s;
@@ -237,7 +237,7 @@ Metrics evaluate_bias(const RunSetup& setup, const log::Metadata& meta, const Sa
 }
 
 Metrics evaluate_fdi(const RunSetup& setup, const log::Metadata& meta, const SampleSource& source) {
-  est::DriftlessFilter filter(setup.estimator, meta);
+  est::DriftlessFilter filter(setup.estimator, est::box_geometry_from_metadata(meta));
   est::FdiParams fp;
   fp.sample_rate_hz = setup.scenario.sample_rate_hz;
   est::FaultDetector fdi(fp);

@@ -8,6 +8,7 @@
 
 #include "estimator/fdi.hpp"
 #include "estimator/filter.hpp"
+#include "estimator/log.hpp"
 #include "twin/scenario.hpp"
 #include "twin/sweep/sweep.hpp"
 

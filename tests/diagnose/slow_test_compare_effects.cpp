@@ -7,10 +7,12 @@
 #include <cstdio>
 #include <string>
 
-#include "tests/twin/compare_test_log.hpp"
-#include "twin/compare/compare.hpp"
+#include "tests/diagnose/compare_test_log.hpp"
+#include "diagnose/compare.hpp"
 
-namespace driftless::twin {
+namespace driftless::diagnose {
+
+using namespace driftless::twin;  // the sensor model, scenario and simulator
 namespace {
 
 SensorParams base_sensor() {
@@ -196,4 +198,4 @@ TEST(CompareEffects, WhitenessFalseAlarmRateOnLongLogs) {
 }
 
 }  // namespace
-}  // namespace driftless::twin
+}  // namespace driftless::diagnose

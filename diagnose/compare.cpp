@@ -1,4 +1,4 @@
-#include "twin/compare/compare.hpp"
+#include "diagnose/compare.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -11,9 +11,11 @@
 #include <fmt/core.h>
 
 #include "estimator/stats.hpp"
-#include "twin/compare/bias_filter.hpp"
+#include "diagnose/bias_filter.hpp"
 
-namespace driftless::twin {
+namespace driftless::diagnose {
+
+using namespace driftless::twin;  // the sensor model, box and scenario types
 namespace {
 
 // the per-channel (or per-set) fits with positive evidence `ev`; if none has, the best one alone
@@ -1638,4 +1640,4 @@ void apply_candidate(CompareModel& model, const Candidate& c) {
                                        c.params.empty() ? std::string("-") : fmt::format("{} = {:.4g} {}", c.params[0].name, c.params[0].value, c.params[0].unit)));
 }
 
-}  // namespace driftless::twin
+}  // namespace driftless::diagnose

@@ -10,9 +10,11 @@
 #include <functional>
 #include <set>
 
-#include "tests/twin/compare_twin_log.hpp"
+#include "tests/diagnose/compare_twin_log.hpp"
 
-namespace driftless::twin {
+namespace driftless::diagnose {
+
+using namespace driftless::twin;  // the sensor model, scenario and simulator
 namespace {
 
 using twinlog::find_param;
@@ -297,4 +299,4 @@ TEST(CompareTwinEffects, TwoHiddenEffectsOverTwoRounds) {
 }
 
 }  // namespace
-}  // namespace driftless::twin
+}  // namespace driftless::diagnose

@@ -8,9 +8,11 @@
 #include <cmath>
 #include <cstdio>
 
-#include "tests/twin/compare_twin_log.hpp"
+#include "tests/diagnose/compare_twin_log.hpp"
 
-namespace driftless::twin {
+namespace driftless::diagnose {
+
+using namespace driftless::twin;  // the sensor model, scenario and simulator
 namespace {
 
 using twinlog::find_param;
@@ -136,4 +138,4 @@ TEST(CompareTwin, AnIdealSensorIsConsistentWithTheEmbeddedNominalModel) {
 }
 
 }  // namespace
-}  // namespace driftless::twin
+}  // namespace driftless::diagnose

@@ -5,8 +5,8 @@
 
 #include <filesystem>
 
-#include "twin/compare/compare.hpp"
-#include "twin/compare/report.hpp"
+#include "diagnose/compare.hpp"
+#include "diagnose/report.hpp"
 #include "twin/scenario.hpp"
 #include "twin/simulator.hpp"
 
@@ -15,7 +15,7 @@ namespace {
 using namespace driftless;
 
 twin::SensorParams log_sensor() {
-  twin::SensorParams p = twin::deterministic_part(twin::mpu6050_defaults());
+  twin::SensorParams p = diagnose::deterministic_part(twin::mpu6050_defaults());
   p.white_noise.enabled = p.bias_instability.enabled = p.rate_random_walk.enabled = p.quantization.enabled = true;
   return p;
 }
@@ -39,21 +39,21 @@ std::filesystem::path make_hour_log() {
 
 void BM_CompareDiagnose1h(benchmark::State& state) {
   const auto path = make_hour_log();
-  twin::CompareModel m = twin::default_compare_model();
+  diagnose::CompareModel m = diagnose::default_compare_model();
   const twin::Scenario sc = hour_scenario();
   m.sensor = {sc.model.sensor1, sc.model.sensor2};
   m.box = sc.model.box;
   for (auto _ : state) {
-    twin::CompareOptions opt;
+    diagnose::CompareOptions opt;
     opt.replay.model_sample_rate_hz = m.sample_rate_hz;
-    const twin::Replay r = twin::replay_log(path, opt.replay);
-    const twin::CompareResult res = twin::compare(r, m, opt);
-    benchmark::DoNotOptimize(twin::diagnosis_json(res));
+    const diagnose::Replay r = diagnose::replay_log(path, opt.replay);
+    const diagnose::CompareResult res = diagnose::compare(r, m, opt);
+    benchmark::DoNotOptimize(diagnose::diagnosis_json(res));
     // diagnose --apply: the winner added, compared again
-    twin::CompareModel upd = m;
-    if (res.verdict == "missing_effect") twin::apply_candidate(upd, res.ranking.front());
-    const twin::CompareResult after = twin::compare(r, upd, opt);
-    benchmark::DoNotOptimize(twin::diagnosis_json(after));
+    diagnose::CompareModel upd = m;
+    if (res.verdict == "missing_effect") diagnose::apply_candidate(upd, res.ranking.front());
+    const diagnose::CompareResult after = diagnose::compare(r, upd, opt);
+    benchmark::DoNotOptimize(diagnose::diagnosis_json(after));
     state.counters["evidence_best"] = res.ranking.front().evidence;
     state.counters["after_consistent"] = after.verdict == "consistent_with_noise" ? 1.0 : 0.0;
   }

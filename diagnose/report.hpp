@@ -5,9 +5,9 @@
 #include <filesystem>
 #include <string>
 
-#include "twin/compare/compare.hpp"
+#include "diagnose/compare.hpp"
 
-namespace driftless::twin {
+namespace driftless::diagnose {
 
 /// Optional second comparison of the same log (e.g. with the model after --apply).
 struct ReportExtras {
@@ -22,4 +22,4 @@ std::string diagnosis_json(const CompareResult& r, const ReportExtras& extras = 
 /// without it the report says so and keeps the tables.
 void write_report(const CompareResult& r, const std::filesystem::path& dir, const ReportExtras& extras = {});
 
-}  // namespace driftless::twin
+}  // namespace driftless::diagnose

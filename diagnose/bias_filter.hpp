@@ -9,7 +9,7 @@
 #include <span>
 #include <vector>
 
-namespace driftless::twin {
+namespace driftless::diagnose {
 
 /// Noise model of one channel. Units: deg/s, s.
 struct ChannelNoise {
@@ -64,4 +64,4 @@ class BiasWhitener {
 void block_means(std::span<const double> x, std::span<const std::uint8_t> mask,
                  std::size_t block_len, std::span<double> out);
 
-}  // namespace driftless::twin
+}  // namespace driftless::diagnose

@@ -1,4 +1,4 @@
-#include "twin/compare/compare_model.hpp"
+#include "diagnose/compare_model.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -12,7 +12,9 @@
 #include "twin/world.hpp"
 #include "twin/yaml_doc.hpp"
 
-namespace driftless::twin {
+namespace driftless::diagnose {
+
+using namespace driftless::twin;  // the sensor model, box and scenario types
 
 ModelConfig CompareModel::config() const {
   ModelConfig c;
@@ -278,4 +280,4 @@ double dlpf_lag1_autocorrelation(const SensorParams& p, double fs) {
   return g0 > 0 ? g1 / g0 : 0.0;
 }
 
-}  // namespace driftless::twin
+}  // namespace driftless::diagnose

@@ -8,11 +8,13 @@
 #include <set>
 #include <string>
 
-#include "tests/twin/compare_test_log.hpp"
-#include "tests/twin/compare_twin_log.hpp"
-#include "twin/compare/compare.hpp"
+#include "tests/diagnose/compare_test_log.hpp"
+#include "tests/diagnose/compare_twin_log.hpp"
+#include "diagnose/compare.hpp"
 
-namespace driftless::twin {
+namespace driftless::diagnose {
+
+using namespace driftless::twin;  // the sensor model, scenario and simulator
 namespace {
 
 constexpr double kDuration = 150.0;
@@ -157,4 +159,4 @@ TEST(CompareDiagnose, TwoHiddenEffectsOnePerRound) {
 }
 
 }  // namespace
-}  // namespace driftless::twin
+}  // namespace driftless::diagnose

@@ -11,7 +11,9 @@
 #include "estimator/log.hpp"
 #include "twin/sensor/sensor_model.hpp"
 
-namespace driftless::twin::testlog {
+namespace driftless::diagnose::testlog {
+
+using namespace driftless::twin;  // the sensor model, scenario and simulator
 
 struct TestLog {
   std::vector<Sample> samples;
@@ -123,4 +125,4 @@ inline TestLog make_log(const SensorParams& p1, const SensorParams& p2, double d
   return out;
 }
 
-}  // namespace driftless::twin::testlog
+}  // namespace driftless::diagnose::testlog

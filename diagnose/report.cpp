@@ -1,4 +1,4 @@
-#include "twin/compare/report.hpp"
+#include "diagnose/report.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -9,7 +9,7 @@
 
 #include <fmt/core.h>
 
-namespace driftless::twin {
+namespace driftless::diagnose {
 namespace {
 
 std::string esc_json(const std::string& s) {
@@ -345,4 +345,4 @@ void write_report(const CompareResult& r, const std::filesystem::path& dir, cons
   f << h.str();
 }
 
-}  // namespace driftless::twin
+}  // namespace driftless::diagnose

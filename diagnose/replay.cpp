@@ -1,4 +1,4 @@
-#include "twin/compare/replay.hpp"
+#include "diagnose/replay.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +9,7 @@
 #include <Eigen/Dense>
 #include <fmt/core.h>
 
-namespace driftless::twin {
+namespace driftless::diagnose {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -490,4 +490,4 @@ Replay replay_log(const std::filesystem::path& path, const ReplayOptions& opt) {
   return r;
 }
 
-}  // namespace driftless::twin
+}  // namespace driftless::diagnose

@@ -7,11 +7,13 @@
 #include <sstream>
 #include <string>
 
-#include "tests/twin/compare_test_log.hpp"
-#include "twin/compare/compare.hpp"
-#include "twin/compare/report.hpp"
+#include "tests/diagnose/compare_test_log.hpp"
+#include "diagnose/compare.hpp"
+#include "diagnose/report.hpp"
 
-namespace driftless::twin {
+namespace driftless::diagnose {
+
+using namespace driftless::twin;  // the sensor model, scenario and simulator
 namespace {
 
 SensorParams ideal() { return ideal_sensor(); }
@@ -157,4 +159,4 @@ TEST(CompareReport, EmbeddedPlotsAreNonEmpty) {
 }
 
 }  // namespace
-}  // namespace driftless::twin
+}  // namespace driftless::diagnose

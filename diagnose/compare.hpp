@@ -8,10 +8,10 @@
 #include <vector>
 
 #include "estimator/allan.hpp"
-#include "twin/compare/compare_model.hpp"
-#include "twin/compare/replay.hpp"
+#include "diagnose/compare_model.hpp"
+#include "diagnose/replay.hpp"
 
-namespace driftless::twin {
+namespace driftless::diagnose {
 
 /// Settings of a comparison. Units: s, deg/s.
 struct CompareOptions {
@@ -133,4 +133,4 @@ void apply_candidate(CompareModel& model, const Candidate& c);
 /// Channel name "gyro1_x" ... "gyro2_z".
 std::string channel_name(int channel);
 
-}  // namespace driftless::twin
+}  // namespace driftless::diagnose

@@ -1,10 +1,10 @@
-#include "twin/compare/bias_filter.hpp"
+#include "diagnose/bias_filter.hpp"
 
 #include <cmath>
 #include <stdexcept>
 #include <string>
 
-namespace driftless::twin {
+namespace driftless::diagnose {
 
 void ChannelNoise::validate() const {
   auto check = [](bool ok, const char* what) {
@@ -160,4 +160,4 @@ void block_means(std::span<const double> x, std::span<const std::uint8_t> mask,
   }
 }
 
-}  // namespace driftless::twin
+}  // namespace driftless::diagnose

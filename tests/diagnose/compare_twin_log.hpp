@@ -9,11 +9,13 @@
 
 #include <fmt/core.h>
 
-#include "twin/compare/compare.hpp"
+#include "diagnose/compare.hpp"
 #include "twin/scenario.hpp"
 #include "twin/simulator.hpp"
 
-namespace driftless::twin::twinlog {
+namespace driftless::diagnose::twinlog {
+
+using namespace driftless::twin;  // the sensor model, scenario and simulator
 
 /// The log's sensor: MPU6050 defaults with the run-to-run draws fixed at their means (so the
 /// planted effect is the only difference from the model), noise processes and ADC kept, and a
@@ -75,4 +77,4 @@ inline const FittedParam* find_param(const Candidate& c, const std::string& name
   return nullptr;
 }
 
-}  // namespace driftless::twin::twinlog
+}  // namespace driftless::diagnose::twinlog

@@ -14,7 +14,7 @@
 #include "estimator/log.hpp"
 #include "estimator/sample.hpp"
 
-namespace driftless::twin {
+namespace driftless::diagnose {
 
 /// How a log is replayed. Units: Hz, deg, deg/s, s.
 struct ReplayOptions {
@@ -81,4 +81,4 @@ Replay replay_samples(const std::vector<Sample>& samples, const log::Metadata& m
 /// Rotation of platform s's sensor frame in box axes: R_i = Rot(a_i, theta_i).
 Eigen::Matrix3d platform_rotation(const Eigen::Vector3d& axis, double angle_deg);
 
-}  // namespace driftless::twin
+}  // namespace driftless::diagnose

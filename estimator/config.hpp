@@ -1,0 +1,112 @@
+// The estimator's configuration: plain values with units and a validate() that names the field.
+// Read from `key: value` files (docs/estimator.md section 5) by config.cpp. Eigen + std only.
+#pragma once
+
+#include <array>
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace driftless::est {
+
+/// paper: H_k switches by k mod 4 as in eq. (5), 6-dim stacked residuals of consecutive
+/// standstills. general: H from the platform attitudes in force (or calibrated matrices), one
+/// 3-dim residual per standstill (or per sample).
+enum class FilterMode { kPaper, kGeneral };
+
+/// Where standstills (both platforms at rest relative to the box) come from.
+enum class StandstillSource {
+  kPlatformColumns,  // plat1_deg / plat2_deg: at rest when both are finite and unchanged
+  kGyroSignal,       // the gyros alone (hardware without angle read-back): flips show as a
+                     // rate difference between the sensors; positions tracked from the flips
+  kSchedule,         // a fixed clock: one standstill every standstill_period_s (the paper's
+                     // static Fig. 5 run, where the platforms never moved)
+};
+
+/// How P is updated after a gain: the paper's printed (I - W H)(P + Q), or Joseph form.
+enum class CovarianceUpdate { kPrinted, kJoseph };
+
+/// One calibrated matrix M of one sensor at one platform position (paper section 4):
+/// y = M^-1 x + b, so M replaces R (and M^-1 replaces R^T) in eqs. (1), (2) and (5).
+struct CalibratedPosition {
+  double plat_deg = 0.0;                                        // deg, the platform angle
+  Eigen::Matrix3d M_body_from_sensor = Eigen::Matrix3d::Identity();  // includes scale, misalignment
+};
+
+/// Calibrated matrices per sensor. An empty list means "use Rot(hinge axis, angle)".
+struct Calibration {
+  std::vector<CalibratedPosition> sensor1;
+  std::vector<CalibratedPosition> sensor2;
+  double match_tolerance_deg = 10.0;  // deg, a platform angle this close uses that position's M
+  /// g-sensitivity per sensor, deg/s per g of specific force (sensor axes): push() subtracts
+  /// G f / g from the gyros of samples whose accel columns are finite. Zero = none.
+  std::array<Eigen::Matrix3d, 2> G_dps_per_g{Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero()};
+  bool empty() const { return sensor1.empty() && sensor2.empty(); }
+  bool has_g_sensitivity() const { return !G_dps_per_g[0].isZero(0.0) || !G_dps_per_g[1].isZero(0.0); }
+  /// Throws std::invalid_argument when a matrix is singular or not finite.
+  void validate() const;
+};
+
+/// Filter configuration: plain values with units; defaults are MPU6050-like (paper section 4).
+struct EstimatorConfig {
+  FilterMode mode = FilterMode::kGeneral;
+  CovarianceUpdate covariance_update = CovarianceUpdate::kJoseph;  // paper mode: kPrinted
+  bool per_sample_updates = false;  // general mode: update on every standstill sample
+
+  // standstill detection
+  StandstillSource standstill = StandstillSource::kPlatformColumns;
+  double settle_s = 0.5;               // s, samples skipped after the platforms come to rest
+  double min_standstill_s = 1.0;       // s, shorter standstills are discarded
+  double max_standstill_s = 0.0;       // s, split longer standstills into updates (0 = never)
+  double end_margin_s = 0.1;           // s, samples dropped before motion is seen (its onset
+                                       // hides below angle_tolerance_deg for a sample or two)
+  double angle_tolerance_deg = 0.001;  // deg, platform angle change between samples = motion
+  double gyro_motion_threshold_dps = 5.0;  // deg/s, | |y1| - |y2| | above this = a flip
+  double standstill_period_s = 10.0;   // s, kSchedule: length of one standstill
+  double initial_plat1_deg = 90.0;     // deg, kGyroSignal / kSchedule start positions
+  double initial_plat2_deg = 90.0;     // deg
+
+  // tuning. R: per-axis white noise of one sample = noise_density^2 * sample rate
+  double noise_density_dps_rthz = 0.005;   // deg/s/sqrt(Hz), MPU6050 data sheet (paper sec. 4)
+  // Q: the bias wanders like a random walk that reaches the bias-instability level B at tau_B:
+  // K = 0.664 B sqrt(3 / tau_B), Q = K^2 dt per axis
+  double bias_instability_dps = 0.01;      // deg/s (36 deg/h)
+  double bias_instability_tau_s = 100.0;   // s, where the Allan minimum lies (paper: ~100 s)
+  double q_override_dps2_per_s = 0.0;      // (deg/s)^2/s, > 0 replaces the spec-derived Q rate
+  double r_override_dps2 = 0.0;            // (deg/s)^2 per sample and axis, > 0 replaces R
+  double initial_bias_dps = 0.0;           // deg/s, every component of x0
+  double initial_sigma_dps = 20.0;         // deg/s, sqrt of P0's diagonal (MPU6050 turn-on +-20)
+  double variance_floor_dps2 = 1e-14;      // (deg/s)^2, P's diagonal never drops below this
+  double nis_gate_probability = 0.9999;    // chi-square probability of the NIS gate (1 = off)
+  /// after this many consecutive gate rejections the filter re-locks: P is widened by the
+  /// innovation and the update is taken (a real bias jump or a switch to other hardware,
+  /// not an outlier). 0 = never re-lock.
+  int gate_relock_after = 3;
+
+  Calibration calibration;  // optional calibrated matrices (issue 4); empty = rotations
+
+  /// Throws std::invalid_argument naming the field on a bad value.
+  void validate() const;
+  /// Q rate per axis, (deg/s)^2/s, from the spec (or the override).
+  double q_dps2_per_s() const;
+  /// White-noise variance of one sample per axis, (deg/s)^2, at `sample_rate_hz`.
+  double sample_variance_dps2(double sample_rate_hz) const;
+};
+
+/// Paper-mode defaults: printed recursion, platform columns.
+EstimatorConfig paper_config();
+
+/// Reads a `key: value` configuration (a flat YAML subset: '#' comments, blank lines) on top of
+/// `base`. Keys are the EstimatorConfig field names; enums as text (mode: paper|general, ...).
+/// Keys may use another unit of the field's quantity (`bias_instability_dph: 36`). Throws
+/// driftless::InputError naming `name`, the line and the key on a bad line or a key given twice.
+EstimatorConfig parse_estimator_config(std::istream& in, const std::string& name,
+                                       EstimatorConfig base = {});
+/// The same, applied to one key (for the CLI and YAML front ends).
+void set_config_value(EstimatorConfig& cfg, const std::string& key, const std::string& value);
+/// Writes every field as `key: value` lines (parse_estimator_config reads it back).
+void write_estimator_config(std::ostream& out, const EstimatorConfig& cfg);
+
+}  // namespace driftless::est

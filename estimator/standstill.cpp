@@ -1,0 +1,304 @@
+#include "estimator/standstill.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Geometry>
+
+namespace driftless::est {
+namespace {
+
+bool finite(double v) { return std::isfinite(v); }
+
+}  // namespace
+
+StandstillDetector::StandstillDetector(const EstimatorConfig& cfg, const BoxGeometry& box) : cfg_(cfg) {
+  restart(box);
+  gyro_.p1 = cfg_.initial_plat1_deg;
+  gyro_.p2 = cfg_.initial_plat2_deg;
+}
+
+void StandstillDetector::restart(const BoxGeometry& box) {
+  box_ = box;
+  active_ = false;
+  seg_ = StandstillSegment{};
+  prev_p1_ = prev_p2_ = kNaN;
+  sched_start_s_ = kNaN;
+  gyro_.moving = false;
+  gyro_.have_base = false;
+  n_closed_ = 0;
+  // the end-margin ring, sized once (unknown rate: assume up to 1 kHz)
+  const double rate = finite(box_.sample_rate_hz) ? box_.sample_rate_hz : 1000.0;
+  ring_capacity_ = static_cast<std::size_t>(std::ceil(cfg_.end_margin_s * rate - 1e-9));
+  ring_.assign(ring_capacity_ + 1, Pending{});
+  ring_head_ = ring_count_ = 0;
+}
+
+double StandstillDetector::rate_hz(const StandstillSegment& seg) const {
+  if (finite(box_.sample_rate_hz)) return box_.sample_rate_hz;
+  const double span = seg.span_s();
+  return seg.n >= 2 && span > 0.0 ? double(seg.n - 1) / span : kNaN;
+}
+
+StandstillDetector::Pending StandstillDetector::pending_of(const Sample& s) {
+  Pending p;
+  p.y1 = s.gyro1_dps;
+  p.y2 = s.gyro2_dps;
+  p.f1 = s.accel1_mps2;
+  p.f2 = s.accel2_mps2;
+  // "up" in box axes from the reference attitude q_enu_from_body (gravity's direction reversed)
+  p.up = s.ref_q_wxyz.allFinite() ? Eigen::Vector3d(s.q_enu_from_body().conjugate() * Eigen::Vector3d::UnitZ())
+                                  : Eigen::Vector3d::Constant(kNaN);
+  p.temp1 = s.temp1_c;
+  p.temp2 = s.temp2_c;
+  p.t_s = s.t_s;
+  return p;
+}
+
+// at-rest test for the platform columns: a platform rests when its angle is finite and unchanged
+bool StandstillDetector::classify(const Sample& s, StandstillStep& st) {
+  st.plat1_deg = s.plat1_deg;
+  st.plat2_deg = s.plat2_deg;
+  const double tol = cfg_.angle_tolerance_deg;
+  st.plat1_rest = finite(s.plat1_deg) && finite(prev_p1_) && std::fabs(s.plat1_deg - prev_p1_) <= tol;
+  st.plat2_rest = finite(s.plat2_deg) && finite(prev_p2_) && std::fabs(s.plat2_deg - prev_p2_) <= tol;
+  // the very first sample with both angles known counts as at rest only from the next one on
+  prev_p1_ = s.plat1_deg;
+  prev_p2_ = s.plat2_deg;
+  return st.plat1_rest && st.plat2_rest;
+}
+
+// gyro-only flip detection: |y1| - |y2| is independent of the box rate (rotations keep norms),
+// so a jump in it is a platform moving; the hinge-rate integral y_i . a_i says which and how far
+bool StandstillDetector::track_gyro_positions(const Sample& s, double dt_s, const Eigen::Vector3d& b1,
+                                              const Eigen::Vector3d& b2) {
+  const Eigen::Vector3d y1 = s.gyro1_dps - b1, y2 = s.gyro2_dps - b2;
+  const double d = y1.norm() - y2.norm();
+  const double h1 = y1.dot(box_.hinge1_axis), h2 = y2.dot(box_.hinge2_axis);
+  auto& g = gyro_;
+  if (!g.have_base) {
+    g.have_base = true;
+    g.d_base = d;
+    g.h1_base = h1;
+    g.h2_base = h2;
+    g.prev_d = d;
+    return true;
+  }
+  const double thr = cfg_.gyro_motion_threshold_dps;
+  if (!g.moving) {
+    if (std::fabs(d - g.d_base) > thr) {
+      g.moving = true;
+      g.turn1_deg = g.turn2_deg = 0.0;
+      g.quiet = 0;
+    } else {
+      // slow rest levels (time constant ~1 s)
+      const double a = std::min(1.0, finite(dt_s) ? dt_s / 1.0 : 0.01);
+      g.d_base += a * (d - g.d_base);
+      g.h1_base += a * (h1 - g.h1_base);
+      g.h2_base += a * (h2 - g.h2_base);
+    }
+  }
+  if (g.moving) {
+    if (finite(dt_s)) {
+      g.turn1_deg += (h1 - g.h1_base) * dt_s;
+      g.turn2_deg += (h2 - g.h2_base) * dt_s;
+    }
+    // the flip is over when the statistic stays steady for ~0.25 s
+    g.quiet = std::fabs(d - g.prev_d) < 0.2 * thr ? g.quiet + 1 : 0;
+    const double rate = finite(box_.sample_rate_hz) ? box_.sample_rate_hz : 100.0;
+    if (g.quiet >= std::max(3, static_cast<int>(0.25 * rate))) {
+      g.moving = false;
+      const double flip = box_.flip_angle_deg;
+      auto apply = [&](double& p, double turn) {
+        if (std::fabs(turn) < 0.5 * flip) return;
+        p += turn;
+        // snap to the nearest end position
+        p = std::fabs(p - flip) < std::fabs(p + flip) ? flip : -flip;
+      };
+      apply(g.p1, g.turn1_deg);
+      apply(g.p2, g.turn2_deg);
+      g.d_base = d;
+      g.h1_base = h1;
+      g.h2_base = h2;
+    }
+  }
+  g.prev_d = d;
+  return !g.moving;
+}
+
+void StandstillDetector::schedule_positions(const Sample& s, StandstillStep& st) {
+  if (!finite(sched_start_s_)) sched_start_s_ = s.t_s;
+  const std::int64_t tag = static_cast<std::int64_t>(std::floor((s.t_s - sched_start_s_) / cfg_.standstill_period_s));
+  const int first = eq5_pattern_of(cfg_.initial_plat1_deg, cfg_.initial_plat2_deg);
+  st.plat1_deg = eq5_position_deg(first + static_cast<int>(tag % 4), 1, box_.flip_angle_deg);
+  st.plat2_deg = eq5_position_deg(first + static_cast<int>(tag % 4), 2, box_.flip_angle_deg);
+  st.plat1_rest = st.plat2_rest = true;
+  seg_tag_ = tag;
+}
+
+StandstillStep StandstillDetector::push(const Sample& s, double dt_s, const Eigen::Vector3d& bias1_dps,
+                                        const Eigen::Vector3d& bias2_dps) {
+  n_closed_ = 0;
+  discarded_last_ = false;
+  StandstillStep st;
+  bool at_rest = false;
+  seg_tag_ = 0;
+  switch (cfg_.standstill) {
+    case StandstillSource::kPlatformColumns:
+      at_rest = classify(s, st);
+      break;
+    case StandstillSource::kGyroSignal:
+      at_rest = track_gyro_positions(s, dt_s, bias1_dps, bias2_dps);
+      st.plat1_deg = gyro_.p1;
+      st.plat2_deg = gyro_.p2;
+      st.plat1_rest = st.plat2_rest = at_rest;
+      break;
+    case StandstillSource::kSchedule:
+      schedule_positions(s, st);
+      at_rest = true;
+      break;
+  }
+  // a change of position, or motion, closes the segment
+  if (!at_rest) {
+    end_standstill();
+    st.state = StandstillStep::State::kMoving;
+  } else {
+    const double tol = cfg_.angle_tolerance_deg;
+    const bool same = active_ && seg_.tag == seg_tag_ && std::fabs(st.plat1_deg - seg_.plat1_deg) <= tol &&
+                      std::fabs(st.plat2_deg - seg_.plat2_deg) <= tol;
+    if (!same) {
+      end_standstill();
+      start_segment(s.t_s, st.plat1_deg, st.plat2_deg, seg_tag_);
+    }
+    if (s.t_s - seg_.t_rest_s < cfg_.settle_s) {
+      st.state = StandstillStep::State::kSettling;
+    } else {
+      st.state = StandstillStep::State::kAccumulating;
+      accumulate(pending_of(s));
+    }
+  }
+  st.closed = n_closed_;
+  return st;
+}
+
+int StandstillDetector::finish() {
+  n_closed_ = 0;
+  discarded_last_ = false;
+  if (!active_) return 0;
+  // no motion follows: the samples of the end margin are good data
+  while (ring_count_ > 0) {
+    const Pending p = ring_[ring_head_];
+    ring_head_ = (ring_head_ + 1) % ring_.size();
+    --ring_count_;
+    commit(p);
+  }
+  close_segment(SegmentEnd::kFinish);
+  return n_closed_;
+}
+
+void StandstillDetector::start_segment(double t_s, double p1, double p2, std::int64_t tag) {
+  seg_ = StandstillSegment{};
+  ring_head_ = ring_count_ = 0;
+  active_ = true;
+  seg_.t_rest_s = t_s;
+  seg_.plat1_deg = p1;
+  seg_.plat2_deg = p2;
+  seg_.tag = tag;
+}
+
+// closes the standstill in progress; the end margin (samples just before the motion) is dropped
+void StandstillDetector::end_standstill() {
+  ring_head_ = ring_count_ = 0;
+  close_segment(SegmentEnd::kMotion);
+}
+
+// hands the committed samples over (or counts a standstill too short to use)
+void StandstillDetector::close_segment(SegmentEnd why) {
+  if (!active_) return;
+  active_ = false;
+  if (cfg_.per_sample_updates) return;  // its samples were handed over one by one
+  StandstillSegment s = seg_;
+  s.end = why;
+  const double rate = rate_hz(s);
+  const double duration = finite(rate) ? double(s.n) / rate : 0.0;
+  if (s.n == 0 || !finite(rate) || duration + 1e-9 < cfg_.min_standstill_s) {
+    ++too_short_;
+    discarded_last_ = true;
+    return;
+  }
+  hand_over(s);
+}
+
+void StandstillDetector::hand_over(const StandstillSegment& seg) {
+  if (n_closed_ < static_cast<int>(closed_.size())) closed_[static_cast<std::size_t>(n_closed_++)] = seg;
+}
+
+// a resting sample enters the ring; the one falling out of the end margin is committed
+void StandstillDetector::accumulate(const Pending& p) {
+  if (ring_capacity_ == 0) {
+    commit(p);
+    return;
+  }
+  const std::size_t slots = ring_.size();
+  if (ring_count_ == ring_capacity_) {
+    const Pending old = ring_[ring_head_];
+    ring_head_ = (ring_head_ + 1) % slots;
+    --ring_count_;
+    commit(old);
+  }
+  ring_[(ring_head_ + ring_count_) % slots] = p;
+  ++ring_count_;
+}
+
+void StandstillDetector::commit(const Pending& p) {
+  if (seg_.n == 0) seg_.t_first_s = p.t_s;
+  seg_.t_last_s = p.t_s;
+  ++seg_.n;
+  seg_.sum_gyro1_dps += p.y1;
+  seg_.sum_gyro2_dps += p.y2;
+  if (p.f1.allFinite() && p.f2.allFinite()) {
+    ++seg_.n_accel;
+    seg_.sum_accel1_mps2 += p.f1;
+    seg_.sum_accel2_mps2 += p.f2;
+  }
+  if (p.up.allFinite()) {
+    ++seg_.n_up;
+    seg_.sum_up_box += p.up;
+  }
+  if (finite(p.temp1) && finite(p.temp2)) {
+    ++seg_.n_temp;
+    seg_.sum_temp1_c += p.temp1;
+    seg_.sum_temp2_c += p.temp2;
+  }
+  if (cfg_.per_sample_updates) {
+    // one segment per sample
+    StandstillSegment one = seg_;
+    one.n = 1;
+    one.t_first_s = one.t_last_s = p.t_s;
+    one.sum_gyro1_dps = p.y1;
+    one.sum_gyro2_dps = p.y2;
+    one.n_accel = p.f1.allFinite() && p.f2.allFinite() ? 1 : 0;
+    one.sum_accel1_mps2 = one.n_accel ? p.f1 : Eigen::Vector3d::Zero();
+    one.sum_accel2_mps2 = one.n_accel ? p.f2 : Eigen::Vector3d::Zero();
+    one.n_up = p.up.allFinite() ? 1 : 0;
+    one.sum_up_box = one.n_up ? p.up : Eigen::Vector3d::Zero();
+    one.n_temp = finite(p.temp1) && finite(p.temp2) ? 1 : 0;
+    one.sum_temp1_c = one.n_temp ? p.temp1 : 0.0;
+    one.sum_temp2_c = one.n_temp ? p.temp2 : 0.0;
+    one.end = SegmentEnd::kSample;
+    hand_over(one);
+  } else if (cfg_.max_standstill_s > 0.0 && p.t_s - seg_.t_first_s >= cfg_.max_standstill_s) {
+    // split a long standstill: hand over now, keep accumulating the same position (no settle);
+    // the ring of pending samples carries over
+    const StandstillSegment keep = seg_;
+    close_segment(SegmentEnd::kSplit);
+    seg_ = StandstillSegment{};
+    active_ = true;
+    seg_.t_rest_s = keep.t_rest_s;
+    seg_.plat1_deg = keep.plat1_deg;
+    seg_.plat2_deg = keep.plat2_deg;
+    seg_.tag = keep.tag;
+  }
+}
+
+}  // namespace driftless::est
