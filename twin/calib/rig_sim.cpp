@@ -11,6 +11,7 @@
 #include <fmt/core.h>
 #include <yaml-cpp/yaml.h>
 
+#include "estimator/log_metadata.hpp"
 #include "twin/calib/yaml_io.hpp"
 #include "twin/flip_schedule.hpp"
 #include "twin/motion.hpp"
@@ -296,16 +297,17 @@ RigRun run_rig(const CalibScenario& cs, const std::function<bool(double)>& progr
   world.pose_carrier(Carrier::pan_tilt, m0.p_enu_m, m0.q_enu_from_body);
   mj_forward(world.model(), world.data());
 
-  run.meta.set("sample_rate_hz", fmt::format("{}", sc.sample_rate_hz));
-  run.meta.set("latitude_deg", fmt::format("{}", sc.latitude_deg));
-  const Eigen::Vector3d a1 = box.hinge_axis(1), a2 = box.hinge_axis(2);
-  run.meta.set("hinge1_axis", fmt::format("{} {} {}", a1.x(), a1.y(), a1.z()));
-  run.meta.set("hinge2_axis", fmt::format("{} {} {}", a2.x(), a2.y(), a2.z()));
-  run.meta.set("source", "twin");
-  run.meta.set("scenario", sc.name);
-  run.meta.set("seed", std::to_string(sc.seed));
-  run.meta.set("motion", "calibration_rig");
-  run.meta.set("carrier", "pan_tilt");
+  log::LogInfo info;
+  info.sample_rate_hz = sc.sample_rate_hz;
+  info.latitude_deg = sc.latitude_deg;
+  info.hinge1_axis = box.hinge_axis(1);
+  info.hinge2_axis = box.hinge_axis(2);
+  info.source = "twin";
+  info.scenario = sc.name;
+  info.seed = sc.seed;
+  info.motion = "calibration_rig";
+  info.carrier = "pan_tilt";
+  log::write_log_info(run.meta, info);
 
   const double duration_s = run.plan.segments.back().t_end_s + 1.0;
   const long steps_per_sample = sc.steps_per_sample();
@@ -366,7 +368,7 @@ RigRun run_rig(const CalibScenario& cs, const std::function<bool(double)>& progr
   if (progress) progress(1.0);
 
   // the true M: sensor calibration C from the realised model, T from the rest angles
-  const Eigen::Vector3d hinge[2] = {a1, a2};
+  const Eigen::Vector3d hinge[2] = {box.hinge_axis(1), box.hinge_axis(2)};
   for (int i = 0; i < 2; ++i) {
     const SensorInstance& inst = sensor[i].instance();
     const SensorParams& p = sensor[i].params();

@@ -10,6 +10,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "estimator/input_error.hpp"
+#include "estimator/numbers.hpp"
 
 namespace driftless::twin::calib::yio {
 
@@ -52,13 +53,8 @@ inline Eigen::Matrix3d as_mat3(const YAML::Node& n, const std::string& file,
   return m;
 }
 
-// numbers are written with 17 significant digits: a file read back gives the same doubles
-inline std::string num(double v) {
-  std::ostringstream s;
-  s.precision(17);
-  s << v;
-  return s.str();
-}
+// numbers are written in their shortest exact form: a file read back gives the same doubles
+inline std::string num(double v) { return exact_number(v); }
 
 inline void emit_vec3(YAML::Emitter& out, const Eigen::Vector3d& v) {
   out << YAML::Flow << YAML::BeginSeq << num(v[0]) << num(v[1]) << num(v[2]) << YAML::EndSeq;
