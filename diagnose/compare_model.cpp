@@ -142,7 +142,7 @@ struct LowpassRun {
 std::vector<double> dlpf_impulse(const SensorParams& p, double fs) {
   std::vector<double> h;
   if (!p.lowpass_latency.enabled) return {1.0};
-  const DlpfSetting set = mpu6050_dlpf(p.lowpass_latency.dlpf_cfg);
+  const DlpfSetting set = lowpass_setting(p.lowpass_latency);
   LowpassRun lp;
   lp.d = design_lowpass(set.gyro_bandwidth_hz, set.gyro_delay_s, fs);
   lp.apply(Eigen::Vector3d::Zero());
@@ -205,7 +205,7 @@ SensorPrediction predict_sensor(const Replay& r, int s, const SensorParams& p, c
   out.temp_from_log = r.has_temp;
   LowpassRun lp;
   if (d.lowpass_latency.enabled) {
-    const DlpfSetting set = mpu6050_dlpf(d.lowpass_latency.dlpf_cfg);
+    const DlpfSetting set = lowpass_setting(d.lowpass_latency);
     lp.d = design_lowpass(set.gyro_bandwidth_hz, set.gyro_delay_s, r.sample_rate_hz);
   }
   // end-stop errors: the platform rests at nominal + error, so the sensor frame is turned by
@@ -215,8 +215,10 @@ SensorPrediction predict_sensor(const Replay& r, int s, const SensorParams& p, c
   const Eigen::Matrix3d Rt_minus = platform_rotation(r.hinge_axis[s], err[0]).transpose();
   const Eigen::Matrix3d Rt_plus = platform_rotation(r.hinge_axis[s], err[1]).transpose();
   const bool stop_errors = err.cwiseAbs().maxCoeff() > 0.0;
-  // time offset: the sensors sample at t - offset (linear interpolation of the replayed truth)
-  const double shift = time_offset_s * r.sample_rate_hz;
+  // time offset and the sensor's own sample delay: the sensor reads the truth of that long ago
+  // (linear interpolation of the replayed truth)
+  const double delay_s = time_offset_s + (d.sample_delay.enabled ? d.sample_delay.delay_s : 0.0);
+  const double shift = delay_s * r.sample_rate_hz;
   auto truth_at = [&](const std::vector<Eigen::Vector3d>& v, std::size_t k) -> Eigen::Vector3d {
     if (shift == 0.0) return v[k];
     const double x = std::clamp(static_cast<double>(k) - shift, 0.0, static_cast<double>(n - 1));

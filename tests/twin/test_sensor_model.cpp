@@ -227,6 +227,77 @@ TEST(SensorModel, DlpfGroupDelayMatchesTheDatasheet) {
   EXPECT_NEAR(d.dc_group_delay_s(100.0), 18.6e-3, 1e-15);
 }
 
+TEST(SensorModel, ContinuousDlpfDelayFollowsTheDatasheetRelation) {
+  // GIVEN the datasheet rows: a continuous delay equal to a row's gives that row's bandwidth
+  for (int cfg = 0; cfg <= 6; ++cfg) {
+    const DlpfSetting d = mpu6050_dlpf(cfg);
+    EXPECT_NEAR(mpu6050_gyro_bandwidth_for_delay_hz(d.gyro_delay_s), d.gyro_bandwidth_hz, 1e-9 * d.gyro_bandwidth_hz);
+  }
+  // between rows the bandwidth falls monotonically, and halfway in log delay it is the
+  // geometric mean of the rows' bandwidths (log-log interpolation)
+  double last = 1e9;
+  for (double delay_ms = 0.2; delay_ms < 40.0; delay_ms *= 1.1) {
+    const double bw = mpu6050_gyro_bandwidth_for_delay_hz(delay_ms * 1e-3);
+    EXPECT_LT(bw, last) << delay_ms;
+    last = bw;
+  }
+  const DlpfSetting a = mpu6050_dlpf(3), b = mpu6050_dlpf(4);
+  EXPECT_NEAR(mpu6050_gyro_bandwidth_for_delay_hz(std::sqrt(a.gyro_delay_s * b.gyro_delay_s)),
+              std::sqrt(a.gyro_bandwidth_hz * b.gyro_bandwidth_hz), 1e-9);
+  // WHEN the model runs a continuous delay (no matching row) on a ramp
+  for (double fs : {50.0, 100.0, 200.0}) {
+    for (double delay_s : {0.0004, 0.0061, 0.0125, 0.031}) {
+      SensorParams p = ideal_sensor();
+      p.lowpass_latency.enabled = true;
+      p.lowpass_latency.delay_s = delay_s;
+      SensorModel m(p, fs, 1);
+      const double slope = 0.5;
+      const int n = static_cast<int>(5.0 * fs);
+      SensorReading r;
+      for (int k = 0; k <= n; ++k) {
+        const double t = k / fs;
+        r = m.step(truth_at(t, Eigen::Vector3d::Constant(slope * t), Eigen::Vector3d::Constant(slope * t)));
+      }
+      // THEN gyro and accelerometer lag by exactly that delay
+      EXPECT_NEAR(r.gyro_radps[0], slope * (n / fs - delay_s), 1e-10) << delay_s << " at " << fs;
+      EXPECT_NEAR(r.accel_mps2[0], slope * (n / fs - delay_s), 1e-10) << delay_s << " at " << fs;
+    }
+  }
+  // AND a given bandwidth sets the pole by impulse invariance
+  SensorParams p = ideal_sensor();
+  p.lowpass_latency.enabled = true;
+  p.lowpass_latency.delay_s = 0.02;
+  p.lowpass_latency.bandwidth_hz = 10.0;
+  EXPECT_NEAR(SensorModel(p, 100.0, 1).gyro_lowpass().pole, std::exp(-2.0 * kPi * 10.0 / 100.0), 1e-15);
+}
+
+TEST(SensorModel, SampleDelayShiftsTheTruthOnly) {
+  // GIVEN sensor samples 15 ms after the time stamp (1.5 samples at 100 Hz) and the DLPF's 4.8 ms
+  SensorParams p = ideal_sensor();
+  p.sample_delay.enabled = true;
+  p.sample_delay.delay_s = 0.015;
+  SensorModel m(p, kFs, 1);
+  SensorParams q = p;
+  q.lowpass_latency.enabled = true;
+  q.lowpass_latency.dlpf_cfg = 3;
+  SensorModel mq(q, kFs, 1);
+  // WHEN a ramp is sampled
+  const double slope = 0.3;
+  SensorReading r, rq;
+  for (int k = 0; k <= 300; ++k) {
+    const double t = k / kFs;
+    r = m.step(truth_at(t, Eigen::Vector3d::Constant(slope * t), Eigen::Vector3d::Constant(slope * t)));
+    rq = mq.step(truth_at(t, Eigen::Vector3d::Constant(slope * t), Eigen::Vector3d::Constant(slope * t)));
+  }
+  // THEN the output is the truth of 15 ms ago (gyro and accelerometer), and the delays add
+  EXPECT_NEAR(r.gyro_radps[2], slope * (3.0 - 0.015), 1e-12);
+  EXPECT_NEAR(r.accel_mps2[1], slope * (3.0 - 0.015), 1e-12);
+  EXPECT_NEAR(rq.gyro_radps[0], slope * (3.0 - 0.015 - mpu6050_dlpf(3).gyro_delay_s), 1e-10);
+  // AND a constant input is untouched from the first sample on (the delay line starts full)
+  SensorModel c(p, kFs, 1);
+  EXPECT_NEAR(c.step(truth_at(0.0, dps(3, 2, 1))).gyro_radps[1], 2.0 * kRadPerDeg, 1e-15);
+}
+
 TEST(SensorModel, DlpfMagnitudeFollowsItsDesign) {
   // GIVEN cfg 6 (5 Hz, 18.6 ms) at 1 kHz: the pole carries the whole delay (first order,
   // a = D/(1+D) with D = 18.6 samples), so |H(f)| = (1-a) / |1 - a e^{-j 2 pi f / fs}|

@@ -53,7 +53,7 @@ TEST(SensorParams, EffectIdsAreTheContract) {
       "misalignment", "g_sensitivity", "temperature", "quantization", "saturation",
       "adc_missing_codes", "adc_nonlinearity", "lowpass_latency", "sample_jitter",
       "mounting_misalignment", "accel_bias", "accel_white_noise", "accel_scale_factor",
-      "accel_quantization"};
+      "accel_quantization", "sample_delay"};
   EXPECT_EQ(effect_ids(), want);
   SensorParams p = ideal_sensor();
   set_effect_enabled(p, "white_noise", true);
@@ -71,6 +71,10 @@ TEST(SensorParams, EmitThenParseGivesBackTheSameParams) {
   p.sample_jitter.enabled = true;
   p.temperature.profile_file = "/tmp/profile.csv";
   p.bias_instability.stationary_start = false;
+  p.lowpass_latency.delay_s = 0.0123;
+  p.lowpass_latency.bandwidth_hz = 17.5;
+  p.sample_delay.enabled = true;
+  p.sample_delay.delay_s = 0.015;
   const std::string text = emit(p);
   const SensorParams q = parse_block(text, ideal_sensor(), "");
   EXPECT_TRUE(q == p) << text;
@@ -98,6 +102,24 @@ effects:
   EXPECT_NEAR((p.bias_instability.sigma_dps - want.bias_instability.sigma_dps).norm(), 0.0, 1e-15);
   want.bias_instability.sigma_dps = p.bias_instability.sigma_dps;
   EXPECT_TRUE(p == want);
+}
+
+TEST(SensorParams, SignalChainKeysTakeTheirUnits) {
+  // GIVEN a continuous DLPF delay in ms, a bandwidth in Hz and a sample delay in ms
+  const SensorParams p = parse(R"(
+preset: mpu6050
+effects:
+  lowpass_latency: {delay_ms: 8.3, bandwidth_hz: 20}
+  sample_delay: {enabled: true, delay_ms: 15}
+)");
+  // THEN they are stored in s and Hz, and the model runs exactly that filter and delay
+  EXPECT_NEAR(p.lowpass_latency.delay_s, 0.0083, 1e-15);
+  EXPECT_EQ(p.lowpass_latency.bandwidth_hz, 20.0);
+  EXPECT_TRUE(p.sample_delay.enabled);
+  EXPECT_NEAR(p.sample_delay.delay_s, 0.015, 1e-15);
+  const DlpfSetting d = lowpass_setting(p.lowpass_latency);
+  EXPECT_EQ(d.gyro_bandwidth_hz, 20.0);
+  EXPECT_NEAR(d.gyro_delay_s, 0.0083, 1e-15);
 }
 
 TEST(SensorParams, PresetIdealThenEnableOneEffect) {
@@ -188,6 +210,9 @@ TEST(SensorParams, ValidateRejectsBadValues) {
   rejects([](SensorParams& p) { p.scale_factor.value_pct[0] = -150.0; }, "scale_factor.value_pct");
   rejects([](SensorParams& p) { p.temperature.warmup_tau_s = 0.0; }, "temperature.warmup_tau_s");
   rejects([](SensorParams& p) { p.sample_jitter.sigma_s = -1e-3; }, "sample_jitter.sigma_s");
+  rejects([](SensorParams& p) { p.sample_delay.delay_s = -0.001; }, "sample_delay.delay_s");
+  rejects([](SensorParams& p) { p.lowpass_latency.delay_s = 2.0; }, "lowpass_latency.delay_s");
+  rejects([](SensorParams& p) { p.lowpass_latency.bandwidth_hz = -1.0; }, "lowpass_latency.bandwidth_hz");
   rejects([](SensorParams& p) { p.mounting_misalignment.angles_deg[0] = 90.0; }, "angles_deg");
   rejects([](SensorParams& p) { p.accel_quantization.full_scale_g = 16.0; }, "accel_quantization.full_scale_g");
   EXPECT_THROW(SensorModel(mpu6050_defaults(), 0.0, 1), std::invalid_argument);

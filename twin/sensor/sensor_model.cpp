@@ -21,7 +21,7 @@ enum Stream : std::uint64_t {
   kConstantBias = 1, kBiasInstability, kRateRandomWalk, kWhiteNoise, kScaleFactor, kMisalignment,
   kGSensitivity, kTemperature, kQuantization, kSaturation, kAdcMissingCodes, kAdcNonlinearity,
   kLowpassLatency, kSampleJitter, kMountingMisalignment, kAccelBias, kAccelWhiteNoise,
-  kAccelScaleFactor, kAccelQuantization
+  kAccelScaleFactor, kAccelQuantization, kSampleDelay
 };
 std::uint64_t init_stream(Stream s) { return 2 * static_cast<std::uint64_t>(s); }
 std::uint64_t step_stream(Stream s) { return 2 * static_cast<std::uint64_t>(s) + 1; }
@@ -122,6 +122,37 @@ DlpfSetting mpu6050_dlpf(int cfg) {
   if (cfg < 0 || cfg > 6)
     throw std::invalid_argument("MPU6050 dlpf_cfg must be 0..6, got " + std::to_string(cfg));
   return table[cfg];
+}
+
+double mpu6050_gyro_bandwidth_for_delay_hz(double delay_s) {
+  if (!(delay_s > 0.0) || !std::isfinite(delay_s))
+    throw std::invalid_argument("mpu6050_gyro_bandwidth_for_delay_hz: delay must be > 0 s");
+  // the gyro columns of DLPF_CFG 0..6: bandwidth falls as the delay grows (a straight line in
+  // log-log per segment); below cfg 0 and above cfg 6 the end segments are extended
+  constexpr int kRows = 7;
+  const double x = std::log(delay_s);
+  int i = 0;
+  while (i + 2 < kRows && x > std::log(mpu6050_dlpf(i + 1).gyro_delay_s)) ++i;
+  const DlpfSetting a = mpu6050_dlpf(i), b = mpu6050_dlpf(i + 1);
+  const double xa = std::log(a.gyro_delay_s), xb = std::log(b.gyro_delay_s);
+  const double u = (x - xa) / (xb - xa);
+  return std::exp(std::log(a.gyro_bandwidth_hz) + u * (std::log(b.gyro_bandwidth_hz) - std::log(a.gyro_bandwidth_hz)));
+}
+
+DlpfSetting lowpass_setting(const LowpassLatencyParams& p) {
+  if (!(p.delay_s > 0.0)) return mpu6050_dlpf(p.dlpf_cfg);
+  const double bw = p.bandwidth_hz > 0.0 ? p.bandwidth_hz : mpu6050_gyro_bandwidth_for_delay_hz(p.delay_s);
+  return {bw, p.delay_s, bw, p.delay_s};
+}
+
+LowpassDesign pure_delay(double delay_s, double fs) {
+  if (!(fs > 0.0) || !(delay_s >= 0.0))
+    throw std::invalid_argument("pure_delay: need sample rate > 0, delay >= 0");
+  LowpassDesign d;
+  const double want = delay_s * fs;  // samples
+  d.delay_whole_samples = static_cast<int>(std::floor(want));
+  d.delay_frac = want - d.delay_whole_samples;
+  return d;
 }
 
 double LowpassDesign::dc_group_delay_s(double fs) const {
@@ -385,9 +416,13 @@ SensorModel::SensorModel(const SensorParams& params, double sample_rate_hz, std:
     throw std::invalid_argument("SensorModel: sample_rate_hz must be > 0");
   const auto& p = params_;
   if (p.lowpass_latency.enabled) {
-    const DlpfSetting d = mpu6050_dlpf(p.lowpass_latency.dlpf_cfg);
+    const DlpfSetting d = lowpass_setting(p.lowpass_latency);
     gyro_filter_ = LowpassFilter(design_lowpass(d.gyro_bandwidth_hz, d.gyro_delay_s, fs_hz_));
     accel_filter_ = LowpassFilter(design_lowpass(d.accel_bandwidth_hz, d.accel_delay_s, fs_hz_));
+  }
+  if (p.sample_delay.enabled) {
+    delay_w_ = LowpassFilter(pure_delay(p.sample_delay.delay_s, fs_hz_));
+    delay_f_ = LowpassFilter(pure_delay(p.sample_delay.delay_s, fs_hz_));
   }
   if (p.adc_missing_codes.enabled) {
     missing_lut_.assign(65536, 0);
@@ -413,7 +448,7 @@ SensorModel::SensorModel(const SensorParams& params, double sample_rate_hz, std:
   // otherwise it is added before the filter, which colours it (long-tau density stays N)
   double gyro_noise_bw_hz = 0.5 * fs_hz_, accel_noise_bw_hz = 0.5 * fs_hz_;
   if (p.lowpass_latency.enabled) {
-    const DlpfSetting d = mpu6050_dlpf(p.lowpass_latency.dlpf_cfg);
+    const DlpfSetting d = lowpass_setting(p.lowpass_latency);
     gyro_white_after_filter_ = 2.0 * d.gyro_bandwidth_hz >= fs_hz_;
     accel_white_after_filter_ = 2.0 * d.accel_bandwidth_hz >= fs_hz_;
     if (gyro_white_after_filter_) gyro_noise_bw_hz = d.gyro_bandwidth_hz;
@@ -431,18 +466,21 @@ SensorReading SensorModel::step(const SensorTruth& truth) {
   const double temp_c = temp_.at(truth.t_s);
   const double dT = temp_c - p.temperature.reference_degc;
 
+  // 13: sampled late, the sensor reads the truth of delay_s ago
+  const Eigen::Vector3d w_in = p.sample_delay.enabled ? delay_w_.apply(truth.w_radps) : truth.w_radps;
+  const Eigen::Vector3d f_in = p.sample_delay.enabled ? delay_f_.apply(truth.f_mps2) : truth.f_mps2;
   // 11b: the sample is taken at t + dt_j; first-order in the truth's backward difference
-  Eigen::Vector3d w = truth.w_radps;
-  Eigen::Vector3d f = truth.f_mps2;
+  Eigen::Vector3d w = w_in;
+  Eigen::Vector3d f = f_in;
   if (p.sample_jitter.enabled) {
     const double dtj = p.sample_jitter.sigma_s * rng_jitter_();
     const double span = truth.t_s - t_prev_;
     if (have_prev_ && span > 0.0) {
-      w += (truth.w_radps - w_prev_) * (dtj / span);
-      f += (truth.f_mps2 - f_prev_) * (dtj / span);
+      w += (w_in - w_prev_) * (dtj / span);
+      f += (f_in - f_prev_) * (dtj / span);
     }
-    w_prev_ = truth.w_radps;
-    f_prev_ = truth.f_mps2;
+    w_prev_ = w_in;
+    f_prev_ = f_in;
     t_prev_ = truth.t_s;
     have_prev_ = true;
   }

@@ -140,10 +140,13 @@ struct AdcNonlinearityParams {
   bool operator==(const AdcNonlinearityParams&) const = default;
 };
 
-/// 11a lowpass_latency: the MPU6050 DLPF_CFG setting (0..6) as a discrete filter at the output rate.
+/// 11a lowpass_latency: the DLPF as a discrete filter at the output rate: the MPU6050 DLPF_CFG
+/// row (0..6), or a continuous group delay (`delay_s` > 0) with its bandwidth. Off = no filter.
 struct LowpassLatencyParams {
   bool enabled = true;
   int dlpf_cfg = 3;
+  double delay_s = 0.0;       // s, group delay at 0 Hz; > 0 replaces the dlpf_cfg row
+  double bandwidth_hz = 0.0;  // Hz, with delay_s > 0: the bandwidth (0 = the datasheet's for that delay)
   bool operator==(const LowpassLatencyParams&) const = default;
 };
 
@@ -152,6 +155,14 @@ struct SampleJitterParams {
   bool enabled = false;
   double sigma_s = 0.0;
   bool operator==(const SampleJitterParams&) const = default;
+};
+
+/// 13 sample_delay: the sensor samples `delay_s` after the log's time stamp: it reads the truth of
+/// that long ago (linear interpolation between output samples), gyro and accelerometer alike.
+struct SampleDelayParams {
+  bool enabled = false;
+  double delay_s = 0.0;  // s, >= 0
+  bool operator==(const SampleDelayParams&) const = default;
 };
 
 /// 12 mounting_misalignment: small rotation of the chip on its platform, rotation vector.
@@ -215,6 +226,7 @@ struct SensorParams {
   AccelWhiteNoiseParams accel_white_noise;
   AccelScaleFactorParams accel_scale_factor;
   AccelQuantizationParams accel_quantization;
+  SampleDelayParams sample_delay;
 
   /// Throws std::invalid_argument naming the effect and key of the first bad value.
   void validate() const;
@@ -269,6 +281,13 @@ struct DlpfSetting {
 /// The DLPF table row for cfg 0..6; throws std::invalid_argument otherwise.
 DlpfSetting mpu6050_dlpf(int dlpf_cfg);
 
+/// Gyro bandwidth, Hz, that the MPU6050 datasheet pairs with a DLPF group delay `delay_s` (> 0):
+/// log-log interpolation between the DLPF_CFG rows, their end segments extended beyond them.
+double mpu6050_gyro_bandwidth_for_delay_hz(double delay_s);
+/// The filter the model runs for `p` (bandwidths and delays of gyro and accelerometer): the
+/// DLPF_CFG row, or with `delay_s` > 0 that delay and bandwidth for both (docs/effects.md, 11a).
+DlpfSetting lowpass_setting(const LowpassLatencyParams& p);
+
 /// A discrete low-pass at the output rate: first-order IIR then a (fractional) sample delay.
 struct LowpassDesign {
   double pole = 0.0;            // u_k = pole u_{k-1} + (1 - pole) x_k
@@ -279,6 +298,8 @@ struct LowpassDesign {
 };
 /// Designs the filter: pole from the bandwidth (impulse invariance), delay topped up to delay_s.
 LowpassDesign design_lowpass(double bandwidth_hz, double delay_s, double sample_rate_hz);
+/// A pure (fractional) delay of `delay_s` at the output rate: no pole (13 sample_delay).
+LowpassDesign pure_delay(double delay_s, double sample_rate_hz);
 
 /// Runs a LowpassDesign on a 3-vector, one call per sample; starts in steady state at its first input.
 class LowpassFilter {
@@ -372,6 +393,7 @@ class SensorModel {
   SensorInstance inst_;
   TemperatureModel temp_;
   LowpassFilter gyro_filter_, accel_filter_;
+  LowpassFilter delay_w_, delay_f_;  // 13: the truth delayed by sample_delay.delay_s
   std::vector<std::uint8_t> missing_lut_;  // 65536 flags, code + 32768
 
   // per-step noise streams, one per effect

@@ -88,7 +88,9 @@ const std::vector<Effect>& effects() {
                 num("cubic_pct_fs", "", &AdcNonlinearityParams::cubic_pct_fs)),
       DL_EFFECT(lowpass_latency,
                 fields::integer<LowpassLatencyParams>("dlpf_cfg", &LowpassLatencyParams::dlpf_cfg, -2000000000,
-                                                      2000000000)),
+                                                      2000000000),
+                num("delay", "s", &LowpassLatencyParams::delay_s),
+                num("bandwidth", "hz", &LowpassLatencyParams::bandwidth_hz)),
       DL_EFFECT(sample_jitter, num("sigma", "s", &SampleJitterParams::sigma_s)),
       DL_EFFECT(mounting_misalignment, v3("angles", "deg", &MountingMisalignmentParams::angles_deg),
                 v3("sigma", "deg", &MountingMisalignmentParams::sigma_deg)),
@@ -100,6 +102,7 @@ const std::vector<Effect>& effects() {
       DL_EFFECT(accel_quantization,
                 num("sensitivity", "lsb_per_g", &AccelQuantizationParams::sensitivity_lsb_per_g),
                 num("full_scale", "g", &AccelQuantizationParams::full_scale_g)),
+      DL_EFFECT(sample_delay, num("delay", "s", &SampleDelayParams::delay_s)),
   };
   return e;
 }
@@ -268,6 +271,11 @@ void SensorParams::validate() const {
   if (lowpass_latency.dlpf_cfg < 0 || lowpass_latency.dlpf_cfg > 6)
     bad("lowpass_latency.dlpf_cfg",
         "must be 0..6 (MPU6050 register 26), got " + std::to_string(lowpass_latency.dlpf_cfg));
+  non_negative("lowpass_latency.delay_s", lowpass_latency.delay_s);
+  if (lowpass_latency.delay_s > 1.0) bad("lowpass_latency.delay_s", "must be <= 1 s");
+  non_negative("lowpass_latency.bandwidth_hz", lowpass_latency.bandwidth_hz);
+  non_negative("sample_delay.delay_s", sample_delay.delay_s);
+  if (sample_delay.delay_s > 1.0) bad("sample_delay.delay_s", "must be <= 1 s");
   non_negative("sample_jitter.sigma_s", sample_jitter.sigma_s);
   if (sample_jitter.sigma_s > 0.1) bad("sample_jitter.sigma_s", "must be <= 0.1 s");
   each(mounting_misalignment.angles_deg, [](double v) {
