@@ -15,10 +15,12 @@
 #include <fmt/os.h>
 
 #include "cli/command.hpp"
-#include "cli/plot.hpp"
 #include "estimator/allan.hpp"
 #include "estimator/filter.hpp"
 #include "estimator/log.hpp"
+#include "report/gnuplot.hpp"
+#include "report/json.hpp"
+#include "report/plot_table.hpp"
 
 namespace driftless::cli {
 namespace {
@@ -235,8 +237,6 @@ std::vector<Channel> read_log(const AllanArgs& a, double& rate_hz, std::vector<s
   return ch;
 }
 
-std::string json_num(double v) { return std::isfinite(v) ? fmt::format("{:.9g}", v) : "null"; }
-
 int run_allan(const AllanArgs& a) {
   if (a.log.empty() == a.csv.empty()) throw std::invalid_argument("give exactly one of --log or --csv");
   std::vector<std::string> notes;
@@ -249,14 +249,14 @@ int run_allan(const AllanArgs& a) {
   opt.sample_rate_hz = rate_hz;
   opt.overlapping = !a.non_overlapping;
   opt.spacing = a.all_tau ? est::TauSpacing::kAll : est::TauSpacing::kOctave;
-  std::vector<AllanTableColumn> table;
+  std::vector<report::AllanTableColumn> table;
   std::vector<est::NoiseFit> fits;
   Progress progress("allan");
   for (std::size_t c = 0; c < channels.size(); ++c) {
     progress.update(double(c) / double(channels.size()), channels[c].name);
     const auto curve = est::allan_deviation(channels[c].x, opt);
     fits.push_back(est::fit_noise_parameters(curve));
-    AllanTableColumn col;
+    report::AllanTableColumn col;
     col.name = channels[c].name;
     for (const auto& p : curve.points) {
       col.tau_s.push_back(p.tau_s);
@@ -267,13 +267,13 @@ int run_allan(const AllanArgs& a) {
     table.push_back(std::move(col));
   }
   progress.done();
-  write_allan_table(dir / "allan.csv", table);
+  report::write_allan_table(dir / "allan.csv", table);
 
   // fits: N in deg/s/sqrt(Hz) (= deg/sqrt(s)), B in deg/s, K in deg/s/sqrt(s)
   {
     auto o = fmt::output_file((dir / "allan_fit.json").string());
     o.print("{{\n  \"source\": \"{}\",\n  \"sample_rate_hz\": {},\n  \"samples\": {},\n  \"overlapping\": {},\n",
-            a.csv.empty() ? a.log : a.csv, json_num(rate_hz), channels.empty() ? 0 : channels[0].x.size(),
+            a.csv.empty() ? a.log : a.csv, report::json_number(rate_hz), channels.empty() ? 0 : channels[0].x.size(),
             opt.overlapping ? "true" : "false");
     o.print("  \"units\": {{\"N\": \"deg/s/sqrt(Hz)\", \"B\": \"deg/s\", \"K\": \"deg/s/sqrt(s)\", "
             "\"tau\": \"s\"}},\n  \"channels\": {{\n");
@@ -281,7 +281,7 @@ int run_allan(const AllanArgs& a) {
       const auto& f = fits[c];
       auto par = [&](const est::NoiseParameter& p) {
         return fmt::format("{{\"value\": {}, \"sigma\": {}, \"tau_s\": {}, \"valid\": {}, \"note\": \"{}\"}}",
-                           json_num(p.value), json_num(p.sigma), json_num(p.tau_s), p.valid ? "true" : "false",
+                           report::json_number(p.value), report::json_number(p.sigma), report::json_number(p.tau_s), p.valid ? "true" : "false",
                            p.note);
       };
       o.print("    \"{}\": {{\"N\": {}, \"B\": {}, \"K\": {}}}{}\n", channels[c].name, par(f.N), par(f.B), par(f.K),
@@ -333,7 +333,8 @@ int run_allan(const AllanArgs& a) {
           "'allan.csv' using 1:{0}:{1}:{2} with yerrorlines dt {3} title '{4}'{5}", 2 + 3 * c, 3 + 3 * c,
           4 + 3 * c, corr ? 2 : 1, table[c].name, c + 1 < table.size() ? ", " : "\n");
     }
-    if (auto w = render_gnuplot(dir, "allan", body); !w.empty()) fmt::print(stderr, "driftless allan: warning: {}\n", w);
+    if (const auto st = report::render(dir, report::Figure("allan", body)); !st.ok)
+      fmt::print(stderr, "driftless allan: warning: {}\n", st.message);
   }
   return 0;
 }

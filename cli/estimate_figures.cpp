@@ -4,7 +4,8 @@
 
 #include <fmt/core.h>
 
-#include "cli/plot.hpp"
+#include "report/gnuplot.hpp"
+#include "report/plot_table.hpp"
 #include "estimator/allan.hpp"
 
 namespace driftless::cli {
@@ -49,13 +50,13 @@ std::string fig4_bias(const fs::path& dir, bool truth) {
     body += "\n";
   }
   body += "  unset multiplot\n";
-  return render_gnuplot(dir, "fig4_bias", body);
+  return report::render(dir, report::Figure("fig4_bias", body)).message;
 }
 
 // Fig. 5: Allan deviation raw against corrected: sensor 1's axes on a static run (the paper's
 // Fig. 5); when the platforms flip, the sensor outputs carry the flips, so the fused body rate
 std::string fig5_allan(const fs::path& dir, const FigureSeries& sr, double rate_hz) {
-  std::vector<AllanTableColumn> cols;
+  std::vector<report::AllanTableColumn> cols;
   est::AllanOptions opt;
   opt.sample_rate_hz = rate_hz;
   const bool fused = sr.platforms_moved;
@@ -64,7 +65,7 @@ std::string fig5_allan(const fs::path& dir, const FigureSeries& sr, double rate_
       const auto& src = fused ? (pass == 0 ? sr.raw_rate[a] : sr.cor_rate[a]) : (pass == 0 ? sr.raw1[a] : sr.cor1[a]);
       std::vector<double> x(src.begin(), src.end());
       const auto curve = est::allan_deviation(x, opt);
-      AllanTableColumn c;
+      report::AllanTableColumn c;
       c.name = fmt::format("{}{}_{}", pass == 0 ? "raw_" : "corrected_", fused ? "rate" : "gyro1", "xyz"[a]);
       for (const auto& p : curve.points) {
         c.tau_s.push_back(p.tau_s);
@@ -75,7 +76,7 @@ std::string fig5_allan(const fs::path& dir, const FigureSeries& sr, double rate_
       cols.push_back(std::move(c));
     }
   }
-  write_allan_table(dir / "allan_fig5.csv", cols);
+  report::write_allan_table(dir / "allan_fig5.csv", cols);
   std::string body = fmt::format(
       "  set logscale xy; set xlabel 'tau [s]'; set ylabel 'Allan deviation [deg/s]'\n"
       "  set title 'Fig. 5: Allan deviation of {}, raw (red) and DriftLess-corrected (black)'\n"
@@ -85,7 +86,7 @@ std::string fig5_allan(const fs::path& dir, const FigureSeries& sr, double rate_
     body += fmt::format("'allan_fig5.csv' using 1:{} with linespoints lc rgb '{}' dt {} title columnhead({}){}",
                         2 + 3 * i, i < 3 ? "red" : "black", 1 + i % 3, 2 + 3 * i, i < 5 ? ", " : "\n");
   }
-  return render_gnuplot(dir, "fig5_allan", body);
+  return report::render(dir, report::Figure("fig5_allan", body)).message;
 }
 
 // Fig. 9: attitude error with and without DriftLess
@@ -99,7 +100,7 @@ std::string fig9_attitude(const fs::path& dir) {
       "'' using 1:2 with lines lc rgb 'blue' dt 1 title 'roll', "
       "'' using 1:3 with lines lc rgb 'blue' dt 2 title 'pitch', "
       "'' using 1:4 with lines lc rgb 'blue' dt 3 title 'heading'\n";
-  return render_gnuplot(dir, "fig9_attitude", body);
+  return report::render(dir, report::Figure("fig9_attitude", body)).message;
 }
 
 }  // namespace
