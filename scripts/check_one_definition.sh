@@ -33,5 +33,11 @@ check '\{"dps_rthz"|\{"dph", |"deg/s\^2", "deg/s2"' 'estimator/units\.cpp' 'a se
 check 'class [A-Za-z]+ *: *public std::(runtime_error|invalid_argument)' 'estimator/input_error\.hpp|renders/gl_context\.hpp' \
   'a new exception type for user input (use driftless::InputError)'
 
+# report plumbing (report/): one gnuplot runner, one JSON escaper and number, one HTML escaper
+check "gnuplot '|gnuplot \"" 'report/gnuplot\.cpp' 'a second gnuplot runner (use report::render)'
+check 'std::string (esc_json|json_string|json_num|json_number|esc_html|html_escape|base64)\(' \
+  'report/(json|html)\.(cpp|hpp)' 'a second JSON/HTML escaper or JSON number (use report/json.hpp, report/html.hpp)'
+check '\{:\.9g\}|%\.9g|%\.17g' 'estimator/numbers\.cpp' 'a second machine-number formatter (use exact_number / json_number)'
+
 if [[ $fail -ne 0 ]]; then exit 1; fi
 echo "ok: each checked helper is defined once"

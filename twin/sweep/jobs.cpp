@@ -10,6 +10,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "estimator/numbers.hpp"
 #include "estimator/attitude.hpp"
 #include "twin/simulator.hpp"
 #include "twin/sweep/fast_box.hpp"
@@ -44,11 +45,7 @@ void set_path(YAML::Node root, const std::string& path, const YAML::Node& value)
   chain.back()[parts.back()] = value;
 }
 
-std::string number_text(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
+std::string number_text(double v) { return exact_number(v); }
 
 struct Override {
   std::string path;
