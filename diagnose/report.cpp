@@ -160,7 +160,7 @@ void write_report(const CompareResult& r, const std::filesystem::path& dir, cons
       s += fmt::format("set title 'sensor {}: block-mean residual after the nuisance fit (points) and smoothed bias (lines)'\nplot ", sn + 1);
       for (int a = 0; a < 3; ++a) {
         const int c = sn * 3 + a;
-        s += fmt::format("'{}' u 1:{} w d t '{}', '' u 1:{} w l lw 2 t 'bias {}'{}", (plot_dir / "residual.dat").string(), 2 + 2 * c,
+        s += fmt::format("'{}' u 1:{} w d t '{}', '' u 1:{} w l lw 2 t 'bias {}'{}", "residual.dat", 2 + 2 * c,
                          channel_name(c), 3 + 2 * c, channel_name(c), a < 2 ? ", " : "\n");
       }
     }
@@ -178,7 +178,7 @@ void write_report(const CompareResult& r, const std::filesystem::path& dir, cons
     d.close();
     std::string s = "set xlabel 't (s)'\nset ylabel 'rms (deg/s)'\nset key outside right\nset title 'windowed residual rms'\nplot ";
     for (int c = 0; c < 6; ++c)
-      s += fmt::format("'{}' u 1:{} w lp t '{}'{}", (plot_dir / "windows.dat").string(), 2 + c, channel_name(c), c < 5 ? ", " : "\n");
+      s += fmt::format("'{}' u 1:{} w lp t '{}'{}", "windows.dat", 2 + c, channel_name(c), c < 5 ? ", " : "\n");
     plots.push_back({"Windowed residual RMS", gnuplot_png(plot_dir, "windows", s)});
   }
   // 3: ADEV of the residual vs the model
@@ -197,7 +197,7 @@ void write_report(const CompareResult& r, const std::filesystem::path& dir, cons
     d.close();
     std::string s = "set logscale xy\nset xlabel 'tau (s)'\nset ylabel 'ADEV (deg/s)'\nset key outside right\nset datafile missing 'null'\nset title 'Allan deviation of the residual (points) and of the model noise (lines)'\nplot ";
     for (int c = 0; c < 6; ++c)
-      s += fmt::format("'{0}' u {1}:{2} w p t '{3}', '' u {1}:{4} w l dt 2 t '{3} model'{5}", (plot_dir / "adev.dat").string(), 1 + 3 * c,
+      s += fmt::format("'{0}' u {1}:{2} w p t '{3}', '' u {1}:{4} w l dt 2 t '{3} model'{5}", "adev.dat", 1 + 3 * c,
                        2 + 3 * c, channel_name(c), 3 + 3 * c, c < 5 ? ", " : "\n");
     plots.push_back({"Allan deviation", gnuplot_png(plot_dir, "adev", s)});
   }
@@ -212,7 +212,7 @@ void write_report(const CompareResult& r, const std::filesystem::path& dir, cons
     d.close();
     std::string s = "set style data histograms\nset style fill solid 0.8\nset xtics rotate by -30\nset ylabel 'rms (deg/s)'\nset key outside right\nset title 'residual rms by regime'\nplot ";
     for (int c = 0; c < 6; ++c)
-      s += fmt::format("'{}' u {}:xtic(1) t '{}'{}", (plot_dir / "regimes.dat").string(), 2 + c, channel_name(c), c < 5 ? ", " : "\n");
+      s += fmt::format("'{}' u {}:xtic(1) t '{}'{}", "regimes.dat", 2 + c, channel_name(c), c < 5 ? ", " : "\n");
     plots.push_back({"Residual by regime", gnuplot_png(plot_dir, "regimes", s)});
   }
 
