@@ -9,7 +9,7 @@
 #include <fmt/os.h>
 
 #include "cli/allan_result.hpp"
-#include "cli/plot.hpp"
+#include "report/gnuplot.hpp"
 
 namespace driftless::cli::allan {
 namespace {
@@ -130,12 +130,12 @@ std::vector<std::string> write_plots(const std::filesystem::path& dir, const Res
     body += fmt::format("'{}' using 1:{}:{}:{} with yerrorlines title '{}'{}", table, 2 + 3 * c, 3 + 3 * c, 4 + 3 * c,
                         r.channels[c].name, c + 1 < r.channels.size() ? ", " : "\n");
   }
-  if (auto w = render_gnuplot(dir, "allan", body); !w.empty()) warnings.push_back(w);
+  if (const auto st = report::render(dir, report::Figure("allan", body)); !st.ok) warnings.push_back(st.message);
   for (const auto& c : r.channels) {
     const std::string stem = "allan_" + safe(c.name);
     write_model(dir / (stem + "_model.csv"), c, r.datasheet);
     write_points(dir / (stem + "_points.csv"), c);
-    if (auto w = render_gnuplot(dir, stem, channel_body(c, stem, r.datasheet)); !w.empty()) warnings.push_back(w);
+    if (const auto st = report::render(dir, report::Figure(stem, channel_body(c, stem, r.datasheet))); !st.ok) warnings.push_back(st.message);
   }
   return warnings;
 }

@@ -7,22 +7,15 @@
 #include <fmt/os.h>
 
 #include "cli/allan_result.hpp"
-#include "cli/plot.hpp"
+#include "estimator/numbers.hpp"
+#include "report/json.hpp"
+#include "report/plot_table.hpp"
 
 namespace driftless::cli::allan {
 namespace {
 
-std::string num(double v) { return std::isfinite(v) ? fmt::format("{:.9g}", v) : "null"; }
-
-std::string str(const std::string& s) {
-  std::string out = "\"";
-  for (const char c : s) {
-    if (c == '"' || c == '\\') out += '\\', out += c;
-    else if (static_cast<unsigned char>(c) < 0x20) out += fmt::format("\\u{:04x}", static_cast<int>(c));
-    else out += c;
-  }
-  return out + "\"";
-}
+std::string num(double v) { return report::json_number(v); }
+std::string str(const std::string& s) { return report::json_string(s); }
 
 std::string str_list(const std::vector<std::string>& v) {
   std::string out = "[";
@@ -74,16 +67,16 @@ std::string channel_json(const ChannelResult& c) {
 }
 
 void write_wide(const std::filesystem::path& path, const Result& r, std::size_t dev) {
-  std::vector<AllanTableColumn> cols;
+  std::vector<report::AllanTableColumn> cols;
   for (const auto& ch : r.channels) {
-    AllanTableColumn col;
+    report::AllanTableColumn col;
     col.name = ch.name;
     for (const auto& p : ch.curves[dev].points) {
       col.tau_s.push_back(p.tau_s), col.adev.push_back(p.adev), col.lo.push_back(p.adev_lo), col.hi.push_back(p.adev_hi);
     }
     cols.push_back(std::move(col));
   }
-  write_allan_table(path, cols);
+  report::write_allan_table(path, cols);
 }
 
 std::string cell(const est::NoiseParameter& p) {
@@ -126,8 +119,8 @@ void write_tables(const std::filesystem::path& dir, const Result& r) {
   for (const auto& ch : r.channels) {
     for (const auto& c : ch.curves) {
       for (const auto& p : c.points) {
-        o.print("{},{},{:.9g},{},{:.9e},{:.9e},{:.9e},{:.6g},{},{},{},{}\n", ch.name, est::to_string(c.deviation), p.tau_s, p.m,
-                p.adev, p.adev_lo, p.adev_hi, p.edf, est::to_string(p.noise), p.noise_inherited ? 1 : 0, p.phase_scale_m, p.terms);
+        o.print("{},{},{},{},{},{},{},{},{},{},{},{}\n", ch.name, est::to_string(c.deviation), exact_number(p.tau_s), p.m,
+                exact_number(p.adev), exact_number(p.adev_lo), exact_number(p.adev_hi), exact_number(p.edf), est::to_string(p.noise), p.noise_inherited ? 1 : 0, p.phase_scale_m, p.terms);
       }
     }
   }

@@ -9,8 +9,10 @@
 #include <mujoco/mujoco.h>
 
 #include "estimator/geometry.hpp"
+#include "estimator/input_error.hpp"
 #include "twin/motion.hpp"
 #include "twin/world.hpp"
+#include "twin/yaml_doc.hpp"
 
 namespace driftless::diagnose {
 
@@ -56,24 +58,16 @@ CompareModel default_compare_model() {
 CompareModel load_compare_model(const std::filesystem::path& path) {
   // a file holding only `model:` is a model config; anything else is a scenario. Both go
   // through twin-core's parser, so every key a user can write is honoured (or refused there).
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path.string());
-  } catch (const YAML::BadFile&) {
-    throw std::runtime_error(fmt::format("{}: cannot read the model file", path.string()));
-  } catch (const YAML::Exception& e) {
-    throw std::runtime_error(fmt::format("{}:{}: {}", path.string(), e.mark.line + 1, e.msg));
-  }
-  if (!root.IsMap() || !root["model"]) {
-    throw std::runtime_error(fmt::format(
-        "{}: no 'model:' key (a model file is a scenario, or a file holding only 'model: {{box: ..., "
-        "sensor1: ..., sensor2: ...}}'; see docs/compare.md)",
-        path.string()));
+  const fields::Node root = load_yaml_file(path);
+  if (!root.is_map() || root.find("model") == nullptr) {
+    throw InputError(path.string(), 0, "model",
+                     "missing (a model file is a scenario, or a file holding only 'model: {box: ..., "
+                     "sensor1: ..., sensor2: ...}'; see docs/compare.md)");
   }
   CompareModel m;
   m.source = path.string();
   ModelConfig cfg;
-  if (root.size() == 1) {
+  if (root.entries.size() == 1) {
     cfg = load_model_config(path, ModelConfig{});
   } else {
     m.scenario = load_scenario(path.string());
@@ -96,11 +90,9 @@ void save_compare_model(const CompareModel& m, const std::filesystem::path& path
   std::string text = emit_scenario(sc);
   if (!m.is_scenario) {
     // a model-only file stays one: only the `model:` block
-    YAML::Node full = YAML::Load(text);
-    YAML::Emitter out;
-    out.SetDoublePrecision(10);
-    out << YAML::BeginMap << YAML::Key << "model" << YAML::Value << full["model"] << YAML::EndMap;
-    text = out.c_str();
+    fields::Node top = fields::Node::map();
+    top.add("model", model_node(sc.model));
+    text = to_yaml(top);
   }
   std::ofstream f(path);
   if (!f) throw std::runtime_error(fmt::format("cannot write {}", path.string()));

@@ -12,13 +12,16 @@
 #include <string>
 #include <vector>
 
+#include "estimator/input_error.hpp"
+
 namespace driftless::importers {
 
 /// A file that cannot be read as asked; the message names the file (and line or message) and what
-/// was expected.
-class ImportError : public std::runtime_error {
+/// was expected. The house's one input-error type (driftless::InputError), so the CLI reports it
+/// like every other bad input; the message carries its own location.
+class ImportError : public InputError {
  public:
-  using std::runtime_error::runtime_error;
+  explicit ImportError(const std::string& message) : InputError("", 0, "", message) {}
 };
 
 /// The input formats (`--format`).

@@ -1,5 +1,7 @@
 #include "importers/text_layout.hpp"
 
+#include "estimator/mpu6050.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cctype>
@@ -398,7 +400,7 @@ Unit rate_unit(const TextLayout& L, const ImportOptions& opt, const std::vector<
   const auto g = triad(L, Quantity::kRate);
   if (complete(g)) {
     const Stats s = triad_stats(rows, g);
-    if (s.integers && s.max_abs > 20.0) return {1.0 / 131.0, "lsb:131"};
+    if (s.integers && s.max_abs > 20.0) return {1.0 / mpu6050::gyro_lsb_per_dps(0), "lsb:131"};
   }
   if (accel_in_si) return {57.295779513082320876798, "rad/s"};
   return {1.0, "deg/s"};
@@ -414,7 +416,7 @@ Unit accel_unit(const TextLayout& L, const ImportOptions& opt, const std::vector
   const auto a = triad(L, Quantity::kAccel);
   if (complete(a)) {
     const Stats s = triad_stats(rows, a);
-    if (s.integers && s.max_abs > 100.0) return {kG / 16384.0, "lsb:16384"};
+    if (s.integers && s.max_abs > 100.0) return {kG / mpu6050::accel_lsb_per_g(0), "lsb:16384"};
     if (std::fabs(s.mean_norm - 1.0) < 0.15) return {kG, "g"};
   }
   return {1.0, "m/s^2"};

@@ -15,13 +15,13 @@
 
 #include <fmt/core.h>
 
+#include "estimator/log_metadata.hpp"
+
 namespace driftless::twin {
 namespace {
 
 // platforms settle on their stops for this long before t = 0, s
 constexpr double kWarmupS = 1.0;
-
-std::string vec_text(const Eigen::Vector3d& v) { return fmt::format("{} {} {}", v.x(), v.y(), v.z()); }
 
 }  // namespace
 
@@ -77,24 +77,26 @@ std::uint32_t Simulator::fields() {
 }
 
 log::Metadata Simulator::metadata() const {
+  log::LogInfo info;
+  info.sample_rate_hz = scenario_.sample_rate_hz;
+  info.latitude_deg = scenario_.latitude_deg;
+  info.hinge1_axis = scenario_.model.box.hinge_axis(1);
+  info.hinge2_axis = scenario_.model.box.hinge_axis(2);
+  info.source = "twin";
+  info.scenario = scenario_.name;
+  info.seed = scenario_.seed;
+  info.duration_s = scenario_.duration_s;
+  info.motion = motion_type_name(scenario_.motion.type);
+  info.carrier = carrier_name(motion_->carrier());
+  info.platform_readback = readback_name(scenario_.platform_readback);
+  info.flip_angle_deg = scenario_.flip_schedule.flip_angle_deg;
+  info.standstill_s = scenario_.flip_schedule.standstill_s;
+  if (flips_.external_control()) info.flip_control = "external";
+  info.end_stop_deg = scenario_.model.box.end_stop_deg;
+  info.sensor1_preset = scenario_.model.sensor1.preset;
+  info.sensor2_preset = scenario_.model.sensor2.preset;
   log::Metadata m;
-  m.set("sample_rate_hz", fmt::format("{}", scenario_.sample_rate_hz));
-  m.set("latitude_deg", fmt::format("{}", scenario_.latitude_deg));
-  m.set("hinge1_axis", vec_text(scenario_.model.box.hinge_axis(1)));
-  m.set("hinge2_axis", vec_text(scenario_.model.box.hinge_axis(2)));
-  m.set("source", "twin");
-  m.set("scenario", scenario_.name);
-  m.set("seed", std::to_string(scenario_.seed));
-  m.set("duration_s", fmt::format("{}", scenario_.duration_s));
-  m.set("motion", motion_type_name(scenario_.motion.type));
-  m.set("carrier", carrier_name(motion_->carrier()));
-  m.set("platform_readback", readback_name(scenario_.platform_readback));
-  m.set("flip_angle_deg", fmt::format("{}", scenario_.flip_schedule.flip_angle_deg));
-  m.set("standstill_s", fmt::format("{}", scenario_.flip_schedule.standstill_s));
-  if (flips_.external_control()) m.set("flip_control", "external");
-  m.set("end_stop_deg", fmt::format("{}", scenario_.model.box.end_stop_deg));
-  m.set("sensor1_preset", scenario_.model.sensor1.preset);
-  m.set("sensor2_preset", scenario_.model.sensor2.preset);
+  log::write_log_info(m, info);
   return m;
 }
 

@@ -8,6 +8,7 @@
 
 #include <fmt/core.h>
 
+#include "estimator/numbers.hpp"
 #include "estimator/sample.hpp"
 #include "twin/embedded.hpp"
 #include "twin/motion.hpp"
@@ -19,7 +20,7 @@ void require(bool ok, const std::string& what) {
   if (!ok) throw std::invalid_argument(what);
 }
 
-std::string num(double v) { return fmt::format("{:.17g}", v); }
+std::string num(double v) { return exact_number(v); }  // MuJoCo reads back the same double
 std::string vec3(const Eigen::Vector3d& v) { return num(v.x()) + " " + num(v.y()) + " " + num(v.z()); }
 
 // sets attribute `attr` of the element named `name` (the one tag holding name="...") in `xml`
