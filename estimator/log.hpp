@@ -15,6 +15,7 @@
 #include <utility>
 #include <vector>
 
+#include "estimator/input_error.hpp"
 #include "estimator/output_file.hpp"
 #include "estimator/sample.hpp"
 
@@ -33,11 +34,8 @@ inline constexpr double kFullScaleMargin = 1.1;
 inline constexpr double kGapMinS = 1.0;
 inline constexpr double kGapIntervals = 10.0;
 
-/// A malformed or unreadable log; the message names the file and, where a line is at fault, the line.
-class LogError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
+/// A malformed or unreadable log: the one input-error type, naming the file, line and key.
+using LogError = InputError;
 
 /// Ordered '# key: value' metadata. Keys are unique; values are kept as text, with the line they
 /// came from (0 when set by a program).

@@ -52,13 +52,13 @@ std::string time_text(double t_s) {
 
 LogReader::LogReader(const std::filesystem::path& path, ReaderOptions opts) : path_(path), opts_(opts) {
   std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) throw LogError(path.string() + ": no such file");
+  if (!std::filesystem::exists(path, ec)) throw LogError(path.string(), 0, "", "no such file");
   if (std::filesystem::is_directory(path, ec)) {
-    throw LogError(path.string() + ": is a directory, expected a driftless log (CSV)");
+    throw LogError(path.string(), 0, "", "is a directory, expected a driftless log (CSV)");
   }
   errno = 0;
   file_.reset(std::fopen(path.c_str(), "rb"));
-  if (!file_) throw LogError(path.string() + ": cannot open: " + std::strerror(errno));
+  if (!file_) throw LogError(path.string(), 0, "", std::string("cannot open: ") + std::strerror(errno));
   // chunks of 1 MiB, or the whole file when it is smaller
   const auto size = std::filesystem::file_size(path, ec);
   chunk_bytes_ = ec ? kChunkBytes : static_cast<std::size_t>(std::min<std::uintmax_t>(kChunkBytes, size + 1));
@@ -67,8 +67,8 @@ LogReader::LogReader(const std::filesystem::path& path, ReaderOptions opts) : pa
   map_columns();
   validate_metadata(meta_, path_.string());
   if (sensors() == 1 && !opts_.accept_single_sensor) {
-    throw LogError(path_.string() + ":" + std::to_string(meta_.line_of("sensors")) +
-                   ": a single-sensor log ('sensors: 1'); this command needs both gyro triads "
+    throw LogError(path_.string(), meta_.line_of("sensors"), "sensors",
+                   "a single-sensor log ('sensors: 1'); this command needs both gyro triads "
                    "(gyro1_*, gyro2_*; docs/log-format.md)");
   }
   const double rate = meta_.sample_rate_hz();
@@ -82,7 +82,7 @@ LogReader::~LogReader() = default;
 
 std::string LogReader::where() const { return path_.string() + ":" + std::to_string(line_no_); }
 
-void LogReader::fail(std::string_view what) const { throw LogError(where() + ": " + std::string(what)); }
+void LogReader::fail(std::string_view what) const { throw LogError(path_.string(), line_no_, "", std::string(what)); }
 
 int LogReader::column_index(std::string_view name) const {
   for (std::size_t i = 0; i < columns_.size(); ++i) {
@@ -114,7 +114,7 @@ void LogReader::read_header() {
     return;
   }
   if (!saw_any) {
-    throw LogError(path_.string() + ": empty file; expected '# format: driftless-log 1' metadata "
+    throw LogError(path_.string(), 0, "", "empty file; expected '# format: driftless-log 1' metadata "
                    "and a header row (see docs/log-format.md)");
   }
   fail("no header row; expected a CSV header naming the columns (t, gyro1_x, ...)");

@@ -7,6 +7,7 @@ packages=(
   libpng-dev libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev libfmt-dev libfast-float-dev
   ffmpeg gnuplot-nox openmpi-bin libopenmpi-dev
   clang libclang-rt-14-dev  # libFuzzer harnesses (tests/fuzz, CI)
+  librosbag-dev libsensor-msgs-dev
   chromium  # the look test (tests/cli/look.sh) opens the report and the figures headless
 )
 missing=()
