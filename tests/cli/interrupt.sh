@@ -71,6 +71,27 @@ pid=$!; pids+=("$pid")
 sleep 2
 stop "$pid" TERM 143 r
 no_partials "$t/r" render
+# sweep of long runs: SIGINT -> 130 within seconds (the run in progress stops too), the table is
+# written with the unfinished runs marked failed
+cat > "$t/sweep.yaml" <<YAML
+name: interrupt_test
+runner: fast
+scenario: static
+duration_s: 200000
+monte_carlo: 2
+seed: 3
+grid:
+  flip_angle_deg: {set: flip_schedule.flip_angle_deg, values: [90]}
+YAML
+"$bin" sweep --config "$t/sweep.yaml" --out "$t/sw" --jobs 1 --no-plots > /dev/null 2> "$t/sw.err" &
+pid=$!; pids+=("$pid")
+sleep 2
+started=$SECONDS
+stop "$pid" INT 130 sw
+(( SECONDS - started <= 5 )) || fail "sweep: took $(( SECONDS - started )) s to stop"
+[[ $(grep -c ",failed: stopped" "$t/sw/runs.csv") -eq 2 ]] || { cat "$t/sw/runs.csv"; fail "sweep: runs.csv does not mark the stopped runs"; }
+no_partials "$t/sw" sweep
+
 # demo: SIGTERM while it simulates -> 143, the log says complete: false
 "$bin" demo --out "$t/demo" --duration 100000 --no-video > /dev/null 2> "$t/demo.err" &
 pid=$!; pids+=("$pid")
