@@ -147,6 +147,12 @@ Solution fit_columns(const FitData& d, const std::vector<NoiseTerm>& columns, co
   s.free_coef = coef;
   s.free_var = Eigen::VectorXd::Zero(p);
   auto sub_cov = [&](const std::vector<int>& cols, Eigen::VectorXd* step) {
+    // no active column (every coefficient at zero): nothing to invert (Eigen's QR of a 0 x 0
+    // matrix reads past its end)
+    if (cols.empty()) {
+      if (step != nullptr) step->resize(0);
+      return Eigen::MatrixXd(0, 0);
+    }
     Eigen::MatrixXd Js(n, static_cast<Eigen::Index>(cols.size()));
     for (std::size_t k = 0; k < cols.size(); ++k) Js.col(static_cast<Eigen::Index>(k)) = J.col(cols[k]);
     const Eigen::MatrixXd C = (Js.transpose() * Js).completeOrthogonalDecomposition().pseudoInverse();
