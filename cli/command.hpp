@@ -22,12 +22,6 @@ enum ExitCode : int {
   kExitSigterm = 143,  // interrupted by SIGTERM
 };
 
-/// A usage error found after parsing (e.g. two options that exclude each other): exit 2.
-class UsageError : public std::invalid_argument {
- public:
-  using std::invalid_argument::invalid_argument;
-};
-
 /// Adds a subcommand to `app`; the returned callback runs it after parsing and gives the exit code.
 using CommandSetup = std::function<std::function<int()>(CLI::App& app)>;
 

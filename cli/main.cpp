@@ -155,9 +155,6 @@ int run_command(const Runner& r) {
     const int code = r.run();
     const int stopped = interrupted_exit_code();
     return stopped != 0 && r.interrupt == Interrupt::kPolls ? stopped : code;
-  } catch (const UsageError& e) {
-    fmt::print(stderr, "driftless {}: {} (driftless {} --help)\n", r.app->get_name(), e.what(), r.app->get_name());
-    return kExitUsage;
   } catch (const std::exception& e) {
     fmt::print(stderr, "driftless {}: error: {}\n", r.app->get_name(), e.what());
     const int stopped = interrupted_exit_code();

@@ -346,7 +346,7 @@ TEST(LogSingleSensor, RoundTripAndRefusalByTwoSensorReaders) {
   EXPECT_EQ(n, 3);
   EXPECT_EQ(r.rows_with_missing_gyro(), 0u);
   EXPECT_NE(message_of([&] { LogReader two(path); })
-                .find(path.string() + ":3: a single-sensor log ('sensors: 1'); this command needs both gyro triads"),
+                .find(path.string() + ":3: sensors: a single-sensor log ('sensors: 1'); this command needs both gyro triads"),
             std::string::npos);
 }
 
