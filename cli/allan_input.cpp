@@ -1,10 +1,12 @@
 #include "cli/allan_input.hpp"
+#include "cli/command.hpp"
 
 #include <algorithm>
 #include <fstream>
 #include <memory>
 #include <thread>
 
+#include <CLI/CLI.hpp>
 #include <fmt/core.h>
 
 #include "estimator/allan_stream.hpp"
@@ -81,10 +83,14 @@ std::unique_ptr<est::DriftlessFilter> make_filter(const InputArgs& a, const log:
 }
 
 Loaded load_log(const InputArgs& a) {
-  log::LogReader reader(a.log);
+  // the single-sensor form is read too; --corrected runs the filter, which needs both triads
+  log::ReaderOptions ro;
+  ro.accept_single_sensor = !a.corrected;
+  log::LogReader reader(a.log, ro);
   Loaded out;
   out.format = "log";
-  const auto names = split_list(a.columns.empty() ? "gyro1_x,gyro1_y,gyro1_z,gyro2_x,gyro2_y,gyro2_z" : a.columns);
+  const char* all_gyros = reader.sensors() == 1 ? "gyro1_x,gyro1_y,gyro1_z" : "gyro1_x,gyro1_y,gyro1_z,gyro2_x,gyro2_y,gyro2_z";
+  const auto names = split_list(a.columns.empty() ? all_gyros : a.columns);
   std::vector<int> idx;
   for (const auto& n : names) {
     const int i = reader.column_index(n);
@@ -169,6 +175,21 @@ bool is_imported(const InputArgs& a) {
   const auto f = importers::parse_format(a.format);
   return f != importers::Format::kDriftlessLog &&
          (f != importers::Format::kAuto || importers::detect_format(a.in) != importers::Format::kDriftlessLog);
+}
+
+void add_import_options(CLI::App* cmd, InputArgs& in) {
+  cmd->add_option("--format", in.format, "Input format: auto, text, euroc, npy, bag")
+      ->check(CLI::IsMember({"auto", "text", "euroc", "npy", "bag", "log"}));
+  cmd->add_option("--columns", in.columns, "Rate channels: names or 1-based indices, comma-separated (log default: gyro1_x..gyro2_z)");
+  cmd->add_option("--accel-columns", in.accel_columns, "Accelerometer channels (x,y,z), names or 1-based indices");
+  cmd->add_option("--time-column", in.import.time_column, "Time column: name, 1-based index or none (default: detected)");
+  cmd->add_option("--units", in.import.units, "Rate units: deg/s, rad/s or lsb:<LSB per deg/s> (MPU6050 +-250: lsb:131)");
+  cmd->add_option("--accel-units", in.import.accel_units, "Acceleration units: m/s^2, g or lsb:<LSB per g>");
+  cmd->add_option("--time-units", in.import.time_units, "Time units: s, ms, us, ns (default: detected)");
+  cmd->add_option("--separator", in.import.separator, "Text separator: one character, tab or space (default: detected)");
+  cmd->add_flag("--no-header", in.import.no_header, "Text: the first row is data");
+  cmd->add_option("--topic", in.import.topic, "Bag: the sensor_msgs/Imu topic (default: the only one)");
+  cmd->add_option("--rate", in.rate_hz, "Sample rate in Hz (overrides the file's and the stamps')")->check(positive_number("Hz"));
 }
 
 }  // namespace driftless::cli::allan

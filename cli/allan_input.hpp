@@ -11,6 +11,10 @@
 #include "importers/imu_reader.hpp"
 #include "importers/stamps.hpp"
 
+namespace CLI {
+class App;
+}  // namespace CLI
+
 namespace driftless::cli::allan {
 
 /// The input options of `driftless allan` (and the reader options of `convert`).
@@ -59,6 +63,10 @@ struct Streamed {
 /// memory: exact up to `exact_up_to_m` samples per cluster. Two threads share the channels.
 Streamed stream_octaves(const InputArgs& a, const std::vector<est::Deviation>& devs, double confidence,
                         std::size_t exact_up_to_m);
+
+/// The importer options shared by `allan --in` and `convert`: --format, --columns, --accel-columns,
+/// --time-column, --units, --accel-units, --time-units, --separator, --no-header, --topic, --rate.
+void add_import_options(CLI::App* cmd, InputArgs& in);
 
 /// True when the input is read by the importers (not a driftless log).
 bool is_imported(const InputArgs& a);

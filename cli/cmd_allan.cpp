@@ -164,18 +164,7 @@ void add_input_options(CLI::App* cmd, AllanArgs& a) {
   auto* csv_opt = cmd->add_option("--csv", in.csv, "Same as --in FILE --format text")->check(CLI::ExistingFile);
   log_opt->excludes(in_opt)->excludes(csv_opt);
   in_opt->excludes(csv_opt);
-  cmd->add_option("--format", in.format, "Input format: auto, text, euroc, npy, bag")
-      ->check(CLI::IsMember({"auto", "text", "euroc", "npy", "bag", "log"}));
-  cmd->add_option("--columns", in.columns, "Rate channels: names or 1-based indices, comma-separated (log default: gyro1_x..gyro2_z)");
-  cmd->add_option("--accel-columns", in.accel_columns, "Accelerometer channels (x,y,z), names or 1-based indices");
-  cmd->add_option("--time-column", in.import.time_column, "Time column: name, 1-based index or none (default: detected)");
-  cmd->add_option("--units", in.import.units, "Rate units: deg/s, rad/s or lsb:<LSB per deg/s> (MPU6050 +-250: lsb:131)");
-  cmd->add_option("--accel-units", in.import.accel_units, "Acceleration units: m/s^2, g or lsb:<LSB per g>");
-  cmd->add_option("--time-units", in.import.time_units, "Time units: s, ms, us, ns (default: detected)");
-  cmd->add_option("--separator", in.import.separator, "Text separator: one character, tab or space (default: detected)");
-  cmd->add_flag("--no-header", in.import.no_header, "Text: the first row is data");
-  cmd->add_option("--topic", in.import.topic, "Bag: the sensor_msgs/Imu topic (default: the only one)");
-  cmd->add_option("--rate", in.rate_hz, "Sample rate in Hz (overrides the file's and the stamps')")->check(positive_number("Hz"));
+  allan::add_import_options(cmd, in);
   cmd->add_option("--gaps", a.gaps, "At gaps in the stamps or missing values: split (gap-aware, default) or ignore")
       ->check(CLI::IsMember({"split", "ignore"}));
 }

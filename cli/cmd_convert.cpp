@@ -1,0 +1,224 @@
+// driftless convert: any IMU recording the importers read (delimited text, EuRoC/TUM-VI, .npy,
+// ROS 1 bags) into the documented measurement log, single-sensor form (docs/import.md, "convert").
+// The log then goes to check, allan and (with a reference attitude) compare/diagnose.
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <fmt/core.h>
+#include <fmt/format.h>
+
+#include "cli/allan_input.hpp"
+#include "cli/command.hpp"
+#include "estimator/input_error.hpp"
+#include "estimator/log.hpp"
+#include "estimator/log_metadata.hpp"
+#include "importers/imu_reader.hpp"
+#include "importers/stamps.hpp"
+
+namespace driftless::cli {
+namespace {
+
+using importers::Quantity;
+
+enum class TimeBase { kAuto, kStamps, kUniform };
+
+struct ConvertArgs {
+  allan::InputArgs input;
+  std::string out;
+  std::string time = "auto";       // auto | stamps | uniform
+  double full_scale_dps = 0.0;     // deg/s, the gyro's range for the log's plausibility check
+  std::string source_name;         // free text for the log's 'source' key
+};
+
+/// Where each log column comes from in the importer's channels (-1: absent).
+struct ChannelMap {
+  int gyro[3] = {-1, -1, -1};
+  int accel[3] = {-1, -1, -1};
+  int temp = -1;
+  bool has_accel() const { return accel[0] >= 0 && accel[1] >= 0 && accel[2] >= 0; }
+};
+
+ChannelMap map_channels(const importers::StreamInfo& info) {
+  ChannelMap m;
+  int rates = 0;
+  for (std::size_t c = 0; c < info.channels.size(); ++c) {
+    const auto& ch = info.channels[c];
+    const int i = static_cast<int>(c);
+    if (ch.quantity == Quantity::kRate) {
+      ++rates;
+      if (ch.axis >= 0 && ch.axis < 3 && m.gyro[ch.axis] < 0) m.gyro[ch.axis] = i;
+    } else if (ch.quantity == Quantity::kAccel) {
+      if (ch.axis >= 0 && ch.axis < 3 && m.accel[ch.axis] < 0) m.accel[ch.axis] = i;
+    } else if (ch.quantity == Quantity::kTemperature && m.temp < 0) {
+      m.temp = i;
+    }
+  }
+  std::string names;
+  for (const auto& ch : info.channels) names += (names.empty() ? "" : ", ") + ch.name;
+  if (m.gyro[0] < 0 || m.gyro[1] < 0 || m.gyro[2] < 0) {
+    throw InputError(info.source, 0, "",
+                     fmt::format("convert needs one gyro triad (x, y, z); the channels read are [{}]: name them "
+                                 "with --columns GX,GY,GZ (names or 1-based indices)", names));
+  }
+  if (rates > 3) {
+    throw InputError(info.source, 0, "",
+                     fmt::format("{} rate channels [{}]: the log holds one sensor (the single-sensor form); "
+                                 "pick its triad with --columns GX,GY,GZ", rates, names));
+  }
+  return m;
+}
+
+TimeBase parse_time_base(const std::string& s) {
+  if (s == "stamps") return TimeBase::kStamps;
+  if (s == "uniform") return TimeBase::kUniform;
+  return TimeBase::kAuto;
+}
+
+/// First pass over a stamped input: what its stamps do (gaps, bursts, steps back).
+importers::StampReport survey_stamps(const std::filesystem::path& in, const importers::ImportOptions& opt) {
+  auto reader = importers::open_imu(in, opt);
+  importers::StampMonitor mon;
+  importers::ImuBlock block;
+  bool learned = false;
+  while (reader->read(block, 65536)) {
+    if (!learned) {
+      mon.learn(block.t_s);
+      learned = true;
+    }
+    for (std::size_t r = 0; r < block.rows(); ++r) mon.push(block.t_s[r], block.loc[r]);
+    if (stop_requested()) break;
+  }
+  return mon.report();
+}
+
+/// How rows get their time: the stamps (strictly increasing, regular or with gaps), or k / rate.
+struct TimePlan {
+  bool uniform = false;
+  double rate_hz = kNaN;  // Hz, the log's sample_rate_hz
+  double t0_s = 0.0;      // s, the first row's time on the uniform base
+  std::vector<std::string> notes;
+};
+
+TimePlan plan_time(const ConvertArgs& a, const importers::StreamInfo& info, const importers::StampReport& st) {
+  TimePlan p;
+  const TimeBase want = parse_time_base(a.time);
+  if (!info.has_time && want == TimeBase::kStamps) {
+    throw InputError(info.source, 0, "--time", "stamps asked for, but the rows carry no time");
+  }
+  p.rate_hz = allan::resolve_rate(a.input.rate_hz, info.nominal_rate_hz, st, p.notes, info.source);
+  const bool stamps_usable = info.has_time && st.backwards == 0 && st.repeated == 0 && !st.bursty;
+  p.uniform = want == TimeBase::kUniform || !info.has_time || (want == TimeBase::kAuto && !stamps_usable);
+  if (!p.uniform && !stamps_usable) {
+    throw InputError(info.source, 0, "--time",
+                     fmt::format("the stamps cannot be the log's time (it must increase strictly): {}; "
+                                 "give --time uniform to write t = t0 + k / rate",
+                                 fmt::join(st.describe("line"), "; ")));
+  }
+  if (info.has_time) p.t0_s = st.first_t_s;
+  if (p.uniform) {
+    p.notes.push_back(info.has_time ? fmt::format("t = first stamp + k / {:.6g} Hz (the stamps are {})", p.rate_hz,
+                                                  st.bursty ? "bursty arrival times" : "not strictly increasing")
+                                    : fmt::format("t = k / {:.6g} Hz (the rows carry no time)", p.rate_hz));
+    if (want == TimeBase::kUniform) p.notes.back() = fmt::format("t = first stamp + k / {:.6g} Hz (--time uniform)", p.rate_hz);
+  } else {
+    p.notes.push_back("t = the stamps");
+  }
+  return p;
+}
+
+log::Metadata convert_metadata(const ConvertArgs& a, const importers::StreamInfo& info, const TimePlan& tp) {
+  log::LogInfo li;
+  li.sample_rate_hz = tp.rate_hz;
+  li.source = !a.source_name.empty()
+                  ? a.source_name
+                  : fmt::format("driftless convert from {} ({})", info.source, importers::to_string(info.format));
+  log::Metadata meta;
+  log::write_log_info(meta, li);
+  if (a.full_scale_dps > 0.0) log::set_number(meta, "gyro_full_scale_dps", a.full_scale_dps);
+  return meta;
+}
+
+Sample sample_of(const importers::ImuBlock& b, std::size_t r, const ChannelMap& m, double t_s) {
+  Sample s;
+  s.t_s = t_s;
+  for (int k = 0; k < 3; ++k) s.gyro1_dps[k] = b.values[static_cast<std::size_t>(m.gyro[k])][r];
+  if (m.has_accel()) {
+    for (int k = 0; k < 3; ++k) s.accel1_mps2[k] = b.values[static_cast<std::size_t>(m.accel[k])][r];
+  }
+  if (m.temp >= 0) s.temp1_c = b.values[static_cast<std::size_t>(m.temp)][r];
+  s.plat1_deg = 0.0;  // the sensor is fixed to the box
+  return s;
+}
+
+int run_convert(const ConvertArgs& a) {
+  const auto opt = a.input.import_options();
+  auto reader = importers::open_imu(a.input.in, opt);
+  const importers::StreamInfo info = reader->info();
+  const ChannelMap map = map_channels(info);
+  const importers::StampReport st = info.has_time ? survey_stamps(a.input.in, opt) : importers::StampReport{};
+  const TimePlan tp = plan_time(a, info, st);
+  std::uint32_t fields = kLayoutSingleSensor;
+  if (map.has_accel()) fields |= kFieldAccel;
+  if (map.temp >= 0) fields |= kFieldTemp;
+  const std::filesystem::path out(a.out);
+  if (out.has_parent_path()) std::filesystem::create_directories(out.parent_path());
+  const double rows_estimate = st.rows > 0 ? static_cast<double>(st.rows) : 0.0;
+  warn_if_disk_too_small("convert", out.has_parent_path() ? out.parent_path() : ".",
+                         rows_estimate * log::estimated_row_bytes(fields), "the log");
+  log::LogWriter writer(out, convert_metadata(a, info, tp), fields);
+  for (const auto& s : info.assumptions) writer.event(tp.t0_s, "assumed: " + s);
+  for (const auto& s : tp.notes) writer.event(tp.t0_s, "time: " + s);
+  importers::ImuBlock block;
+  std::uint64_t k = 0;
+  Progress progress("convert");
+  while (!stop_requested() && reader->read(block, 65536)) {
+    for (std::size_t r = 0; r < block.rows(); ++r, ++k) {
+      const double t = tp.uniform ? tp.t0_s + static_cast<double>(k) / tp.rate_hz : block.t_s[r];
+      writer.write(sample_of(block, r, map, t));
+    }
+    if (st.rows > 0) progress.update(static_cast<double>(k) / static_cast<double>(st.rows));
+  }
+  if (stop_requested()) {
+    writer.finish(false, fmt::format("interrupted after {} rows", k));
+    fmt::print(stderr, "driftless convert: interrupted; {} holds {} rows and says complete: false\n", a.out, k);
+    return interrupted_exit_code();
+  }
+  writer.finish(true);
+  progress.done();
+  fmt::print("{} ({}): {} rows, gyro{}{} -> {} (single-sensor log, {:.6g} Hz)\n", info.source,
+             importers::to_string(info.format), k, map.has_accel() ? ", accel" : "", map.temp >= 0 ? ", temperature" : "",
+             a.out, tp.rate_hz);
+  for (const auto& s : info.assumptions) fmt::print("  assumed: {}\n", s);
+  for (const auto& s : tp.notes) fmt::print("  time: {}\n", s);
+  for (const auto& s : st.describe("line")) fmt::print("  stamps: {}\n", s);
+  return kExitOk;
+}
+
+const bool registered = register_command(
+    45,
+    [](CLI::App& app) {
+      auto* cmd = app.add_subcommand("convert",
+                                     "An IMU recording (delimited text, EuRoC/TUM-VI imu0/data.csv, .npy, ROS 1 bag) into a "
+                                     "measurement log in the single-sensor form (deg/s, m/s^2, degC, s)");
+      auto a = std::make_shared<ConvertArgs>();
+      cmd->add_option("--in", a->input.in, "The recording (docs/import.md)")->required()->check(CLI::ExistingFile);
+      allan::add_import_options(cmd, a->input);
+      cmd->add_option("--temp-column", a->input.import.temp_column, "Temperature column (degC): name or 1-based index");
+      cmd->add_option("--out", a->out, "The log to write (driftless-log 1, 'sensors: 1')")->required();
+      cmd->add_option("--time", a->time, "Row times: auto (the stamps when they increase regularly, else k / rate), "
+                                         "stamps, or uniform")
+          ->check(CLI::IsMember({"auto", "stamps", "uniform"}));
+      cmd->add_option("--full-scale", a->full_scale_dps, "The gyro's range +-FS in deg/s, written as gyro_full_scale_dps "
+                                                         "(MPU6050 default: 250)")
+          ->check(positive_number("deg/s"));
+      cmd->add_option("--source", a->source_name, "Text for the log's 'source' key (default: the file and its format)");
+      return [a] { return run_convert(*a); };
+    },
+    Interrupt::kPolls);
+
+}  // namespace
+}  // namespace driftless::cli

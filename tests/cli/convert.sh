@@ -1,0 +1,63 @@
+#!/usr/bin/env bash
+# driftless convert: other people's recordings into the single-sensor log, which check and allan
+# then read. Real MPU6050 files (bursty stamps; raw counts without time), a regular-stamp EuRoC
+# file, and the refusals: two triads without --columns, stamps that step back with --time stamps.
+set -euo pipefail
+bin=$1; src=$2
+real=$src/../shared/realdata/mpu6050-sunsided/unmoved-with-x-pointing-forward/mpu6050.csv
+raw=$src/../shared/realdata/mpu6050-tomisuarez2/imu_90_x_rot.csv
+[[ -f $real && -f $raw ]] || { echo "no real data under $src/../shared/realdata: skipped"; exit 77; }
+t=$(mktemp -d); trap 'rm -rf "$t"' EXIT
+fail() { echo "FAIL: $*"; exit 1; }
+meta() { grep -m1 "^# $2:" "$1" | sed "s/^# $2: *//; s/ *$//"; }
+
+# 1. bursty arrival stamps (median step 2 ms, mean 10 ms): t = first stamp + k / mean rate
+"$bin" convert --in "$real" --columns gyro_x,gyro_y,gyro_z --accel-columns acc_x,acc_y,acc_z --temp-column temp \
+  --out "$t/static.csv" > "$t/static.txt" || { cat "$t/static.txt"; fail "convert of the sunsided file"; }
+grep -q "bursty" "$t/static.txt" || fail "the bursty stamps are not said: $(cat "$t/static.txt")"
+[[ $(meta "$t/static.csv" sensors) == 1 ]] || fail "not the single-sensor form"
+[[ $(meta "$t/static.csv" complete) == true ]] || fail "not complete"
+grep -q "^t,gyro1_x,gyro1_y,gyro1_z,plat1_deg,accel1_x,accel1_y,accel1_z,temp1" "$t/static.csv" ||
+  fail "columns: $(grep -m1 '^t,' "$t/static.csv")"
+rows_in=$(($(wc -l < "$real") - 1))
+rows_out=$(grep -vc '^#\|^t,' "$t/static.csv")
+[[ $rows_in == "$rows_out" ]] || fail "rows: $rows_in in, $rows_out out"
+# values: deg/s kept, g converted to m/s^2 (first row: gyro_x 4.557252 deg/s, acc_z -1.029541 g)
+row=$(awk '!/^#/ && !/^t,/ { print; exit }' "$t/static.csv")
+awk -F, -v r="$row" 'BEGIN { split(r, c, ","); exit !(c[2] - 4.557252 < 1e-6 && 4.557252 - c[2] < 1e-6 &&
+  c[8] + 1.029541 * 9.80665 < 1e-4 && -1.029541 * 9.80665 - c[8] < 1e-4) }' || fail "values of the first row: $row"
+"$bin" check --log "$t/static.csv" > "$t/check.txt" || { cat "$t/check.txt"; fail "check refuses the converted log"; }
+"$bin" allan --log "$t/static.csv" --columns gyro1_x,gyro1_y,gyro1_z --out "$t/allan" > /dev/null || fail "allan on the converted log"
+# the same white-noise density as allan on the original file (same samples, same rate)
+"$bin" allan --in "$real" --columns gyro_x,gyro_y,gyro_z --out "$t/allan_in" > /dev/null
+a=$(jq -r '.channels["gyro1_x"].N.value' "$t/allan/allan_fit.json"); b=$(jq -r '.channels["gyro_x"].N.value' "$t/allan_in/allan_fit.json")
+awk -v a="$a" -v b="$b" 'BEGIN { d = (a - b) / b; if (d < 0) d = -d; exit !(d < 1e-6) }' || fail "N: converted $a, original $b"
+# estimate needs two triads: refused, naming the file
+out=$("$bin" estimate --log "$t/static.csv" --out "$t/est" 2>&1) && fail "estimate accepted a single-sensor log"
+echo "$out" | grep -q "static.csv" || fail "estimate's refusal does not name the file: $out"
+
+# 2. raw counts, no time column, 'Fs,100' line: t = k / 100 Hz, counts at 131 LSB per deg/s
+"$bin" convert --in "$raw" --out "$t/raw.csv" > "$t/raw.txt" || { cat "$t/raw.txt"; fail "convert of raw counts"; }
+[[ $(meta "$t/raw.csv" sample_rate_hz) == 100 ]] || fail "rate of the raw file: $(meta "$t/raw.csv" sample_rate_hz)"
+row=$(awk '!/^#/ && !/^t,/ && ++n == 2 { print; exit }' "$t/raw.csv")
+awk -F, -v r="$row" 'BEGIN { split(r, c, ","); exit !(c[1] == 0.01 && c[2] + 408 / 131 < 1e-6 && -408 / 131 - c[2] < 1e-6) }' ||
+  fail "second row of the raw file: $row"
+
+# 3. EuRoC: regular ns stamps are the log's time
+awk -F, 'NR == 1 { print "#timestamp [ns],w_RS_S_x [rad s^-1],w_RS_S_y [rad s^-1],w_RS_S_z [rad s^-1],a_RS_S_x [m s^-2],a_RS_S_y [m s^-2],a_RS_S_z [m s^-2]"; next }
+  NR < 2000 { printf "%.0f,%.17g,%.17g,%.17g,0,0,9.81\n", 1403636579758555392 + (NR - 2) * 5000000, $5 / 57.29577951308232, $6 / 57.29577951308232, $7 / 57.29577951308232 }' \
+  "$real" > "$t/data.csv"
+"$bin" convert --in "$t/data.csv" --out "$t/euroc.csv" > "$t/euroc.txt" || { cat "$t/euroc.txt"; fail "EuRoC"; }
+grep -q "t = the stamps" "$t/euroc.txt" || fail "EuRoC stamps not used: $(cat "$t/euroc.txt")"
+# (epoch stamps in ns held as double seconds resolve 2.4e-7 s: the median 5 ms step is good to 1e-4)
+awk -v r="$(meta "$t/euroc.csv" sample_rate_hz)" 'BEGIN { exit !(r > 199.98 && r < 200.02) }' ||
+  fail "EuRoC rate: $(meta "$t/euroc.csv" sample_rate_hz)"
+
+# 4. refusals: a stamp that steps back with --time stamps; two triads without --columns
+printf 't,gx,gy,gz\n0.00,1,2,3\n0.01,1,2,3\n0.005,1,2,3\n0.02,1,2,3\n' > "$t/back.csv"
+out=$("$bin" convert --in "$t/back.csv" --time stamps --out "$t/back.log" 2>&1) && fail "stamps stepping back accepted"
+echo "$out" | grep -q "back.csv.*--time uniform" || fail "message for stamps stepping back: $out"
+printf 't,g1x,g1y,g1z,g2x,g2y,g2z\n0.00,1,2,3,4,5,6\n0.01,1,2,3,4,5,6\n' > "$t/two.csv"
+out=$("$bin" convert --in "$t/two.csv" --out "$t/two.log" 2>&1) && fail "two triads accepted without --columns"
+echo "$out" | grep -q "two.csv.*--columns" || fail "message for two triads: $out"
+echo "convert: ok"
