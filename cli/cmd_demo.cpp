@@ -1,6 +1,6 @@
 // driftless demo: the main job. Runs a short pipeline on the built-in default scenario into
-// DIR and says where to look. Each step is one function; later steps (estimate, report, video)
-// append to the list.
+// DIR, checks that each output holds what it claims (demo_checks.hpp) and says where to look,
+// or what failed and why (non-zero exit).
 #include <cerrno>
 #include <filesystem>
 #include <stdexcept>
@@ -16,6 +16,7 @@
 #include <fmt/core.h>
 
 #include "cli/command.hpp"
+#include "cli/demo_checks.hpp"
 #include "twin/scenario.hpp"
 #include "twin/simulator.hpp"
 
@@ -32,8 +33,12 @@ struct DemoContext {
   std::filesystem::path dir;
   bool video = true;
   twin::Scenario scenario;
-  std::vector<std::string> outputs;  // "path: what it is", printed at the end
+  std::uint64_t log_rows = 0;        // rows the simulation wrote
+  std::vector<OutputCheck> checks;   // what each output holds, printed at the end
 };
+
+constexpr double kVideoSpeed = 10.0;  // x real time of the demo's time-lapse
+constexpr double kVideoFps = 30.0;
 
 // step 1: simulate the built-in default scenario (short run)
 bool step_simulate(DemoContext& c) {
@@ -50,10 +55,7 @@ bool step_simulate(DemoContext& c) {
     return !stop_requested().load();
   });
   if (r.complete) progress.done();
-  c.outputs.push_back(fmt::format("{}: simulated measurement log, {} rows at {} Hz (docs/log-format.md)",
-                                  (c.dir / "sim" / "log.csv").string(), r.rows, c.scenario.sample_rate_hz));
-  c.outputs.push_back(fmt::format("{}: the scenario with every default explicit (docs/scenario.md)",
-                                  resolved.string()));
+  c.log_rows = r.rows;
   return r.complete;
 }
 
@@ -82,34 +84,54 @@ bool run_self(const std::vector<std::string>& args) {
 // step 2: the DriftLess estimator on the log, with the paper's Fig. 4/5/9 plots
 bool step_estimate(DemoContext& c) {
   const auto out = c.dir / "estimate";
-  if (!run_self({"estimate", "--log", (c.dir / "sim" / "log.csv").string(), "--out", out.string(), "--plot"}))
-    return false;
-  c.outputs.push_back(fmt::format("{}: bias estimates, attitude drift with/without DriftLess, NEES (docs/estimator.md)",
-                                  (out / "summary.json").string()));
-  c.outputs.push_back(fmt::format("{}: Fig. 4 bias estimate vs truth (also fig5_allan.png, fig9_attitude.png)",
-                                  (out / "fig4_bias.png").string()));
-  return true;
+  return run_self({"estimate", "--log", (c.dir / "sim" / "log.csv").string(), "--out", out.string(), "--plot"});
 }
 
 // step 3: model versus measurement against the model that produced the log (docs/compare.md)
 bool step_report(DemoContext& c) {
   const auto out = c.dir / "report";
-  if (!run_self({"diagnose", "--log", (c.dir / "sim" / "log.csv").string(), "--model",
-                 (c.dir / "sim" / "scenario.resolved.yaml").string(), "--out", out.string()}))
-    return false;
-  c.outputs.push_back(fmt::format("{}: model vs measurement report, open in a browser (diagnosis.json beside it)",
-                                  (out / "report.html").string()));
-  return true;
+  return run_self({"diagnose", "--log", (c.dir / "sim" / "log.csv").string(), "--model",
+                   (c.dir / "sim" / "scenario.resolved.yaml").string(), "--out", out.string()});
 }
 
 // step 4: an off-screen rendered time-lapse of the run (docs/render.md)
 bool step_video(DemoContext& c) {
   if (!c.video) return true;
-  const auto out = c.dir / "video.mp4";
-  if (!run_self({"render", "--log", (c.dir / "sim" / "log.csv").string(), "--out", out.string(), "--speed", "10"}))
-    return false;
-  c.outputs.push_back(fmt::format("{}: 640x480 time-lapse (x10, flips shown at x1 now and then)", out.string()));
-  return true;
+  return run_self({"render", "--log", (c.dir / "sim" / "log.csv").string(), "--out", (c.dir / "video.mp4").string(),
+                   "--speed", fmt::format("{:g}", kVideoSpeed), "--fps", fmt::format("{:g}", kVideoFps)});
+}
+
+// what each output holds, in the order a user would open them
+std::vector<OutputCheck> check_outputs(const DemoContext& c) {
+  std::vector<OutputCheck> all = {check_log(c.dir / "sim" / "log.csv", c.log_rows)};
+  for (auto& x : check_estimate(c.dir / "estimate")) all.push_back(std::move(x));
+  for (auto& x : check_figures(c.dir / "estimate")) all.push_back(std::move(x));
+  all.push_back(check_report(c.dir / "report"));
+  if (c.video) {
+    // the time-lapse plays every data second at x10 and adds flips at x1: never fewer frames
+    const auto min_frames = static_cast<std::uint64_t>(std::floor(c.scenario.duration_s / kVideoSpeed * kVideoFps));
+    all.push_back(check_video(c.dir / "video.mp4", min_frames));
+  }
+  return all;
+}
+
+// prints the checks; returns the number that failed
+int report_checks(const std::vector<OutputCheck>& checks) {
+  int failed = 0;
+  fmt::print("checks (does each output hold what it claims?):\n");
+  for (const auto& k : checks) {
+    fmt::print("  {:4}  {}: {}: {}\n", k.ok ? "ok" : "FAIL", k.path.string(), k.claim, k.detail);
+    failed += k.ok ? 0 : 1;
+  }
+  if (failed == 0) {
+    fmt::print("done. Look at:\n");
+    for (const auto& k : checks) fmt::print("  {}\n", k.path.string());
+  } else {
+    std::fflush(stdout);
+    fmt::print(stderr, "driftless demo: {} of {} outputs do not hold what they claim (FAIL above)\n", failed,
+               checks.size());
+  }
+  return failed;
 }
 
 int run_demo(const DemoArgs& a) {
@@ -128,21 +150,26 @@ int run_demo(const DemoArgs& a) {
       {"report", step_report},
       {"video", step_video},
   };
+  // every step after the simulation runs even if one fails: the checks say what each left behind
+  bool all_ran = true;
   for (const auto& [name, step] : steps) {
-    if (!step(c)) {
-      fmt::print(stderr, "driftless demo: step '{}' did not finish (see its message above)\n", name);
-      return stop_requested().load() ? 130 : 1;
+    const bool ran = step(c);
+    if (stop_requested().load()) return 130;
+    if (!ran) {
+      fmt::print(stderr, "driftless demo: step '{}' failed (see its message above)\n", name);
+      if (std::string(name) == "simulate") return 1;
+      all_ran = false;
     }
   }
-  fmt::print("done. Look at:\n");
-  for (const auto& o : c.outputs) fmt::print("  {}\n", o);
-  return 0;
+  const int failed = report_checks(check_outputs(c));
+  return failed == 0 && all_ran ? 0 : 1;
 }
 
 const bool registered = register_command(0, [](CLI::App& app) {
   auto* cmd = app.add_subcommand("demo", "The main job on the built-in default scenario: simulate, estimate "
                                          "(with plots), model-vs-measurement report and a rendered video into "
-                                         "DIR, then where to look");
+                                         "DIR; then checks that each output holds what it claims and says where "
+                                         "to look (exit 1 when one does not)");
   auto args = std::make_shared<DemoArgs>();
   cmd->add_option("--out", args->out_dir, "Output directory (default out/demo)");
   cmd->add_option("--duration", args->duration_s, "Simulated duration in s (default 600)")

@@ -16,7 +16,7 @@
 #include "cli/estimate_figures.hpp"
 #include "estimator/calibration.hpp"
 #include "estimator/pipeline.hpp"
-#include "twin/calib/calib_file.hpp"
+#include "calibration/calib_file.hpp"
 
 namespace driftless::cli {
 namespace {
@@ -108,6 +108,7 @@ class FileSink : public est::EstimateSink {
     }
     b.push_back('\n');
     estimate_.print("{}", fmt::to_string(b));
+    if (keep_series_) series_.add_update(r, s);
   }
 
   void on_attitude(const est::AttitudePoint& p) override {
@@ -141,8 +142,19 @@ class FileSink : public est::EstimateSink {
   bool keep_series_;
 };
 
+// "figures": what --plot drew, and why a figure was left out
+std::string json_figures(const std::vector<FigureOutcome>& figures) {
+  std::string o = "[";
+  for (std::size_t i = 0; i < figures.size(); ++i) {
+    const auto& f = figures[i];
+    o += fmt::format("{}{{\"name\": {}, \"written\": {}, \"reason\": {}}}", i ? ", " : "", json_string(f.stem),
+                     f.written ? "true" : "false", f.written ? "null" : json_string(f.reason));
+  }
+  return o + "]";
+}
+
 void write_summary(const fs::path& path, const EstimateArgs& a, const est::EstimatorConfig& cfg,
-                   const est::EstimateSummary& s) {
+                   const est::EstimateSummary& s, const std::vector<FigureOutcome>& figures) {
   auto o = fmt::output_file(path.string());
   o.print("{{\n");
   o.print("  \"log\": {},\n", json_string(a.log));
@@ -186,6 +198,7 @@ void write_summary(const fs::path& path, const EstimateArgs& a, const est::Estim
     o.print("  }},\n");
   }
   o.print("  \"bias_error_rms_dps\": {},\n", json_number(s.truth.bias_error_rms_dps));
+  o.print("  \"figures\": {},\n", json_figures(figures));
   o.print("  \"warnings\": [");
   for (std::size_t i = 0; i < s.warnings.size(); ++i) o.print("{}{}", i ? ", " : "", json_string(s.warnings[i]));
   o.print("]\n}}\n");
@@ -206,7 +219,7 @@ int run_estimate_cmd(const EstimateArgs& a) {
   log::LogReader reader(a.log);
   // --calib: the calibrated matrices M replace R in eq. (1)-(2) (docs/calibration.md)
   if (!a.calib.empty()) {
-    const twin::calib::CalibFile c = twin::calib::load_calib(a.calib);
+    const calib::CalibFile c = calib::load_calib(a.calib);
     const auto& meta = reader.metadata();
     if ((c.hinge1_axis.normalized() - meta.hinge1_axis().normalized()).norm() > 1e-6 ||
         (c.hinge2_axis.normalized() - meta.hinge2_axis().normalized()).norm() > 1e-6) {
@@ -257,15 +270,20 @@ int run_estimate_cmd(const EstimateArgs& a) {
   progress.done(fmt::format("{} rows, {} updates", summary.rows, summary.counters.updates));
 
   auto warnings = summary.warnings;
+  std::vector<FigureOutcome> figures;
   if (a.plot) {
     double rate = reader.metadata().sample_rate_hz();
     if (!std::isfinite(rate) && summary.rows > 1) rate = double(summary.rows - 1) / (summary.t_last_s - summary.t_first_s);
-    const EstimateFigureInputs fig{&sink.series(), truth, attitude, rate};
-    for (auto& w : write_estimate_figures(dir, fig)) warnings.push_back(w);
+    EstimateFigureInputs fig{&sink.series(), truth, attitude, rate, summary.attitude_start_s,
+                             a.attitude_start_sigma_dps};
+    figures = write_estimate_figures(dir, fig);
+    for (const auto& f : figures) {
+      if (!f.written) warnings.push_back(fmt::format("{} not drawn: {}", f.stem, f.reason));
+    }
   }
   auto final_summary = summary;
   final_summary.warnings = warnings;
-  write_summary(dir / "summary.json", a, cfg, final_summary);
+  write_summary(dir / "summary.json", a, cfg, final_summary, figures);
 
   for (const auto& w : warnings) fmt::print(stderr, "driftless estimate: warning: {}\n", w);
   const auto& b = summary.bias_dps;

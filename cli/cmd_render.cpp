@@ -1,6 +1,8 @@
 // driftless render: an off-screen video (OSMesa, no display or GPU) of a log replay or a
 // simulated scenario, with an overlay of time, platform state, residual and attitude error.
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <memory>
 #include <string>
 
@@ -21,6 +23,9 @@ struct RenderArgs {
   double from = kNaN, to = kNaN;
   double realtime_flip_every = kNaN;
   std::string camera;
+  double azimuth_deg = render::ViewAngles{}.azimuth_deg;
+  double elevation_deg = render::ViewAngles{}.elevation_deg;
+  bool no_close_ups = false;
   std::string preset = "ultrafast";
   int crf = 23;
   bool no_overlay = false;
@@ -36,11 +41,29 @@ ModelPtr load_mjcf(const std::string& path) {
   return m;
 }
 
+// video.json beside video.mp4: what the renderer wrote, for checks (driftless demo) and users
+void write_sidecar(const RenderArgs& a, const render::RenderParams& p, const render::RenderStats& st, bool complete) {
+  const std::filesystem::path path = std::filesystem::path(a.out).replace_extension(".json");
+  auto num = [](double v) { return std::isfinite(v) ? fmt::format("{}", v) : std::string("null"); };
+  std::ofstream f(path);
+  f << fmt::format(
+      "{{\n  \"format\": \"driftless-video 1\",\n  \"output\": \"{}\",\n  \"png_fallback\": {},\n"
+      "  \"complete\": {},\n  \"frames\": {},\n  \"width\": {},\n  \"height\": {},\n  \"fps\": {},\n"
+      "  \"speed\": {},\n  \"first_frame_s\": {},\n  \"last_frame_s\": {},\n  \"realtime_flip_frames\": {},\n"
+      "  \"camera\": \"{}\",\n  \"wall_s\": {:.3f}\n}}\n",
+      st.output, st.png_fallback, complete, st.frames, p.scene.width_px, p.scene.height_px, p.timeline.fps,
+      p.timeline.speed, num(st.first_frame_s), num(st.last_frame_s), st.realtime_flip_frames,
+      p.scene.camera.empty() ? "auto" : p.scene.camera, st.wall_s);
+  if (!f.flush()) throw std::runtime_error("cannot write " + path.string());
+}
+
 int run_render(const RenderArgs& a) {
   render::RenderParams p;
   p.scene.width_px = a.width;
   p.scene.height_px = a.height;
   p.scene.camera = a.camera;
+  p.scene.view = {a.azimuth_deg, a.elevation_deg};
+  p.scene.close_ups = !a.no_close_ups;
   p.timeline.fps = a.fps;
   p.timeline.speed = a.speed;
   p.timeline.from_s = a.from;
@@ -100,6 +123,7 @@ int run_render(const RenderArgs& a) {
              static_cast<double>(stats.frames) / a.fps, stats.first_frame_s, stats.last_frame_s,
              stats.realtime_flip_frames, stats.wall_s,
              stats.wall_s > 0 ? static_cast<double>(stats.frames) / stats.wall_s : 0.0);
+  write_sidecar(a, p, stats, !stop_requested().load());
   if (stop_requested().load()) {
     fmt::print(stderr, "driftless render: stopped early (Ctrl-C); the video ends at t = {:.2f} s\n",
                stats.last_frame_s);
@@ -135,8 +159,18 @@ const bool registered = register_command(60, [](CLI::App& app) {
   cmd->add_option("--height", a->height, "Frame height, px (even)")->capture_default_str();
   cmd->add_option("--fps", a->fps, "Video frame rate, frames/s")->capture_default_str();
   cmd->add_option("--camera", a->camera,
-                  "MJCF camera name, or 'free' (orbit camera tracking the box); default: the "
-                  "tracking camera if the model has one");
+                  "auto (default): a camera that frames the box large, follows it and closes in "
+                  "on a flipping platform; 'free': an orbit camera tracking the box; or an MJCF "
+                  "camera name");
+  cmd->add_option("--azimuth", a->azimuth_deg,
+                  "Direction the auto camera looks towards, deg from East towards North (ENU)")
+      ->capture_default_str();
+  cmd->add_option("--elevation", a->elevation_deg,
+                  "Elevation of the auto camera's line of sight, deg (negative: looking down)")
+      ->capture_default_str()
+      ->check(CLI::Range(-89.0, 89.0));
+  cmd->add_flag("--no-close-ups", a->no_close_ups,
+                "Auto camera: keep the whole box in view during flips (no close-up of the platform)");
   auto* from = cmd->add_option("--from", a->from, "First data time shown, s (default: start)");
   auto* to = cmd->add_option("--to", a->to, "Data time where the video ends, s (default: end)");
   (void)from;

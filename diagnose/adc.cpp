@@ -5,6 +5,7 @@
 #include <limits>
 #include <map>
 
+#include "estimator/mpu6050.hpp"
 #include "estimator/sample.hpp"
 
 namespace driftless::diagnose {
@@ -40,7 +41,7 @@ double lattice(const std::vector<double>& y, double step) {
 double data_lsb(const std::vector<double>& y, const twin::SensorParams& p, double* strength) {
   std::vector<double> steps;
   if (p.quantization.enabled) steps.push_back(1.0 / p.quantization.sensitivity_lsb_per_dps);
-  for (double sens : {131.0, 65.5, 32.8, 16.4}) steps.push_back(1.0 / sens);
+  for (int fs_sel = 0; fs_sel < 4; ++fs_sel) steps.push_back(1.0 / mpu6050::gyro_lsb_per_dps(fs_sel));
   std::vector<double> u(y.begin(), y.begin() + static_cast<std::ptrdiff_t>(std::min<std::size_t>(y.size(), 20000)));
   std::sort(u.begin(), u.end());
   u.erase(std::unique(u.begin(), u.end(), [](double a, double b) { return std::abs(a - b) < 2e-7; }), u.end());
@@ -84,14 +85,28 @@ std::vector<long> missing_codes(const std::vector<double>& y, double lsb, double
   return out;
 }
 
-// saturation: repeated extreme outputs where the model predicts beyond them
+// median of the finite entries of x (0 when none)
+double finite_median(const std::vector<double>& x) {
+  std::vector<double> v;
+  v.reserve(x.size());
+  for (double e : x)
+    if (std::isfinite(e)) v.push_back(e);
+  if (v.empty()) return 0.0;
+  auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+// saturation: repeated extreme outputs where the model, with the channel's turn-on bias (the
+// residual's median; a bias of 20 deg/s is normal), predicts beyond them
 double saturation_evidence(const Replay& r, const Residual& res, int c, double ymax, double tol, double floor_dps) {
   const int s = c / 3, j = c % 3;
+  const double bias_dps = finite_median(res.e_dps[c]);
   double dj = 0.0;
   std::size_t plateau = 0;
   for (std::size_t k = 0; k < res.n; ++k) {
     if (!r.usable[k]) continue;
-    const double v = r.gyro_dps[s][k][j], pv = res.pred[s].gyro_dps[k][j];
+    const double v = r.gyro_dps[s][k][j], pv = res.pred[s].gyro_dps[k][j] + bias_dps;
     if (std::abs(std::abs(v) - ymax) <= tol && std::abs(pv) > ymax + 5.0 * floor_dps) {
       ++plateau;
       dj += std::pow((std::abs(pv) - ymax) / std::max(floor_dps, 1e-3), 2);

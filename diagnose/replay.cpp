@@ -1,5 +1,7 @@
 #include "diagnose/replay.hpp"
 
+#include "estimator/geometry.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -84,15 +86,6 @@ double median_dt(const std::vector<Raw>& raw) {
   auto mid = dt.begin() + static_cast<std::ptrdiff_t>(dt.size() / 2);
   std::nth_element(dt.begin(), mid, dt.end());
   return *mid;
-}
-
-// rotation vector (rad) of a unit quaternion
-Eigen::Vector3d rotation_vector(Eigen::Quaterniond q) {
-  if (q.w() < 0) q.coeffs() = -q.coeffs();
-  const Eigen::Vector3d v = q.vec();
-  const double s = v.norm();
-  if (s < 1e-12) return 2.0 * v;
-  return v * (2.0 * std::atan2(s, q.w()) / s);
 }
 
 // largest swing of a sensor's output inside rest intervals of both platforms, deg/s
@@ -271,7 +264,7 @@ void body_rate(const std::vector<Raw>& raw, const Eigen::Vector3d& earth_enu, co
   // kinks from the interval mean rates (their second differences)
   std::vector<Eigen::Vector3d> mean_rate(n - 1);
   for (std::size_t k = 0; k + 1 < n; ++k) {
-    mean_rate[k] = rotation_vector(quat(raw[k]).conjugate() * quat(raw[k + 1])) / (out.t_s[k + 1] - out.t_s[k]);
+    mean_rate[k] = geo::rotvec_rad(quat(raw[k]).conjugate() * quat(raw[k + 1])) / (out.t_s[k + 1] - out.t_s[k]);
   }
   mark_kinks(mean_rate, M, opt, out);
   // the first and last M samples have no full differentiator stencil: left out like a kink
@@ -384,7 +377,7 @@ void sensor_truth(const std::vector<Raw>& raw, const Eigen::Vector3d& dearth_dla
         out.usable[k] = 0;
         continue;
       }
-      const Eigen::Matrix3d Rt = platform_rotation(axis, ang).transpose();
+      const Eigen::Matrix3d Rt = geo::rot_about_axis_deg(axis, ang).transpose();
       const double rate = out.plat_rate_dps[s][k];
       out.w_radps[s][k] = Rt * out.w_body_radps[k] + (std::isfinite(rate) ? rate : 0.0) * kRadPerDeg * axis;
       out.f_mps2[s][k] = out.has_accel && raw[k].a[s].allFinite() ? raw[k].a[s] : Eigen::Vector3d(Rt * out.f_body_mps2[k]);
@@ -417,9 +410,8 @@ Replay build(std::vector<Raw> raw, const log::Metadata& meta, std::uint32_t fiel
   }
   out.latitude_deg = lat;
   check_attitude(raw, opt, out);
-  const double lat_rad = lat * kRadPerDeg;
-  const Eigen::Vector3d earth_enu = kEarthRateRadps * Eigen::Vector3d(0, std::cos(lat_rad), std::sin(lat_rad));
-  const Eigen::Vector3d dearth_dlat_enu = kEarthRateRadps * Eigen::Vector3d(0, -std::sin(lat_rad), std::cos(lat_rad));
+  const Eigen::Vector3d earth_enu = geo::earth_rate_enu_radps(lat);
+  const Eigen::Vector3d dearth_dlat_enu = geo::earth_rate_enu_dlat_radps_per_rad(lat);
   body_rate(raw, earth_enu, opt, out);
   specific_force(raw, out);
   flip_history(raw, platform_motion(raw, opt, out), out);
@@ -445,10 +437,6 @@ void ReplayOptions::validate() const {
   if (!(std::abs(default_latitude_deg) <= 90)) {
     throw std::invalid_argument("ReplayOptions.default_latitude_deg must be within [-90, 90] deg");
   }
-}
-
-Eigen::Matrix3d platform_rotation(const Eigen::Vector3d& axis, double angle_deg) {
-  return Eigen::AngleAxisd(angle_deg * kRadPerDeg, axis.normalized()).toRotationMatrix();
 }
 
 Replay replay_samples(const std::vector<Sample>& samples, const log::Metadata& meta,

@@ -11,72 +11,6 @@
 namespace driftless::est {
 namespace {
 
-// the three attitude integrations of docs/estimator.md section 4, each with its unwrapped error
-// (updated every sample with a ref_q) and that error at the comparison points
-class AttitudeComparison {
- public:
-  explicit AttitudeComparison(double latitude_deg)
-      : tracks_{Track{AttitudeIntegrator(latitude_deg), {}, {}}, Track{AttitudeIntegrator(latitude_deg), {}, {}},
-                Track{AttitudeIntegrator(latitude_deg), {}, {}}} {}
-
-  bool started() const { return tracks_[kCorrected].att.initialized(); }
-
-  // the three integrations start together at `s`: the bias estimate then is what a box
-  // calibrated once would keep, and the `fixed` integration holds it
-  void start(const Sample& s, DriftlessFilter& filter, EstimateSummary& sum, double interval_s) {
-    filter.set_fixed_bias_dps(filter.bias_dps());  // the next sample's fixed rate uses it
-    sum.fixed_bias_dps = filter.bias_dps();
-    sum.attitude_start_s = s.t_s;
-    for (Track& tr : tracks_) tr.att.reset(s.q_enu_from_body(), s.t_s);
-    next_t_ = s.t_s;
-    interval_s_ = interval_s;
-  }
-
-  void step(const Sample& s, const SampleOutput& out) {
-    tracks_[kCorrected].att.step(s.t_s, out.rate_body_dps);
-    tracks_[kRaw].att.step(s.t_s, out.rate_body_raw_dps);
-    tracks_[kFixed].att.step(s.t_s, out.rate_body_fixed_dps);
-  }
-
-  // compares with the reference; returns true (and fills `ap`) at a comparison point
-  bool compare(const Sample& s, AttitudePoint& ap) {
-    for (Track& tr : tracks_) tr.acc.add(tr.att.q_enu_from_body(), s.q_enu_from_body());
-    if (!(s.t_s >= next_t_)) return false;
-    ap.t_s = s.t_s;
-    ap.corrected = attitude_error(tracks_[kCorrected].att.q_enu_from_body(), s.q_enu_from_body());
-    ap.raw = attitude_error(tracks_[kRaw].att.q_enu_from_body(), s.q_enu_from_body());
-    ap.fixed = attitude_error(tracks_[kFixed].att.q_enu_from_body(), s.q_enu_from_body());
-    ap.corrected_accumulated_deg = tracks_[kCorrected].acc.angle_deg();
-    ap.raw_accumulated_deg = tracks_[kRaw].acc.angle_deg();
-    ap.fixed_accumulated_deg = tracks_[kFixed].acc.angle_deg();
-    t_.push_back(ap.t_s);
-    // the drift is fitted to the unwrapped error: a raw gyro's error angle folds at 180 deg
-    for (Track& tr : tracks_) tr.err_deg.push_back(tr.acc.angle_deg());
-    next_t_ += interval_s_;
-    return true;
-  }
-
-  void drifts(EstimateSummary& sum) const {
-    if (t_.size() < 2) return;
-    sum.drift_corrected_deg_per_h = drift_deg_per_h(t_, tracks_[kCorrected].err_deg);
-    sum.drift_raw_deg_per_h = drift_deg_per_h(t_, tracks_[kRaw].err_deg);
-    sum.drift_fixed_deg_per_h = drift_deg_per_h(t_, tracks_[kFixed].err_deg);
-  }
-  std::size_t points() const { return t_.size(); }
-
- private:
-  struct Track {
-    AttitudeIntegrator att;
-    ErrorAccumulator acc;
-    std::vector<double> err_deg;
-  };
-  enum { kCorrected, kRaw, kFixed };
-  std::array<Track, 3> tracks_;
-  std::vector<double> t_;
-  double next_t_ = kNaN;
-  double interval_s_ = 1.0;
-};
-
 // NEES and error statistics of the accepted updates against the log's true_bias columns
 class TruthScore {
  public:
@@ -174,7 +108,7 @@ EstimateSummary run_estimate(log::LogReader& reader, const EstimatorConfig& cfg,
   const bool have_ref = (reader.fields() & kFieldRefQ) != 0;
   sum.attitude_available = have_ref;
   sum.truth.available = have_truth;
-  AttitudeComparison att(meta.latitude_deg());
+  AttitudeComparison att(meta.latitude_deg(), opt.attitude_start_sigma_dps, opt.attitude_interval_s);
   TruthScore score(sum.truth, opt.nees_band_probability);
 
   // an update (accepted or rejected) reaches the sink, the truth score and the re-lock list
@@ -201,16 +135,8 @@ EstimateSummary run_estimate(log::LogReader& reader, const EstimatorConfig& cfg,
 
     // attitude: the comparison starts at the first finite ref_q once the filter has locked on
     // (every bias sigma below attitude_start_sigma_dps)
-    const bool ref_ok = have_ref && s.ref_q_wxyz.allFinite();
-    if (ref_ok && !att.started()) {
-      const bool locked = opt.attitude_start_sigma_dps <= 0.0 ||
-                          (filter.has_update() && filter.sigma_dps().maxCoeff() < opt.attitude_start_sigma_dps);
-      if (locked) att.start(s, filter, sum, opt.attitude_interval_s);
-    } else if (att.started() && std::isfinite(s.t_s)) {
-      att.step(s, out);
-    }
     AttitudePoint ap;
-    if (ref_ok && att.started() && att.compare(s, ap)) {
+    if (att.push(s, filter, ap)) {
       sum.final_corrected = ap.corrected;
       sum.final_raw = ap.raw;
       sum.final_fixed = ap.fixed;
@@ -225,7 +151,12 @@ EstimateSummary run_estimate(log::LogReader& reader, const EstimatorConfig& cfg,
   add_filter_warnings(filter, sum);
   sum.bias_dps = filter.bias_dps();
   sum.sigma_dps = filter.sigma_dps();
-  att.drifts(sum);
+  sum.attitude_start_s = att.start_s();
+  if (att.started()) sum.fixed_bias_dps = att.fixed_bias_dps();
+  const AttitudeDrifts drift = att.drifts();
+  sum.drift_corrected_deg_per_h = drift.corrected_deg_per_h;
+  sum.drift_raw_deg_per_h = drift.raw_deg_per_h;
+  sum.drift_fixed_deg_per_h = drift.fixed_deg_per_h;
   if (att.points() < 2 && have_ref && !att.started() && sum.rows > 0) {
     sum.warnings.push_back(
         "no attitude comparison: the filter never locked on (every bias sigma below " +

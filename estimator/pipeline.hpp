@@ -8,21 +8,11 @@
 #include <vector>
 
 #include "estimator/attitude.hpp"
+#include "estimator/attitude_comparison.hpp"
 #include "estimator/filter.hpp"
 #include "estimator/log.hpp"
 
 namespace driftless::est {
-
-/// One attitude comparison point (deg), with and without the DriftLess correction.
-struct AttitudePoint {
-  double t_s = kNaN;
-  AttitudeError corrected;  // with DriftLess: the filter's running bias estimate
-  AttitudeError raw;        // no bias correction at all
-  AttitudeError fixed;      // the bias estimate at the comparison's start, never updated again
-  double corrected_accumulated_deg = kNaN;  // deg, unwrapped errors (ErrorAccumulator)
-  double raw_accumulated_deg = kNaN;
-  double fixed_accumulated_deg = kNaN;
-};
 
 /// Receives the pass's outputs as they happen (all optional).
 class EstimateSink {

@@ -1,5 +1,7 @@
 #include "renders/overlay.hpp"
 
+#include "estimator/geometry.hpp"
+
 #include <cmath>
 
 #include <Eigen/Geometry>
@@ -12,67 +14,101 @@ OverlayState overlay_state(const PlatformTracker& tracker) {
   for (int i = 0; i < 2; ++i) {
     st.plat_deg[i] = tracker.angle_deg(i);
     st.moving[i] = tracker.moving(i);
+    st.flip_from_deg[i] = tracker.flip_from_deg(i);
   }
   st.next_flip_s = tracker.predicted_next_flip_s();
   st.next_platform = tracker.predicted_next_platform();
   return st;
 }
 
-OverlayText overlay_text(const std::string& title, double t_s, double speed, bool realtime_flip,
-                         const OverlayState& st) {
-  OverlayText o;
-  o.top_left_titles = fmt::format("{}\ntime\nplay\nplatform 1\nplatform 2\nnext flip\nattitude err",
-                                  title);
-  std::string play;
-  if (realtime_flip) {
-    play = "x1 (flip shown in real time)";
-  } else if (speed == 1.0) {
-    play = "x1 real time";
-  } else {
-    play = fmt::format("x{:g} {}", speed, speed > 1.0 ? "time-lapse" : "slow motion");
+namespace {
+
+// the axis colours of every chart: x red, y green, z blue
+constexpr float kAxisRgb[3][3] = {{0.95f, 0.3f, 0.3f}, {0.3f, 0.85f, 0.3f}, {0.4f, 0.6f, 1.0f}};
+
+std::vector<LegendEntry> axis_legend(bool with_truth) {
+  std::vector<LegendEntry> l;
+  for (int k = 0; k < 3; ++k) l.push_back({std::string(1, "xyz"[k]), {kAxisRgb[k][0], kAxisRgb[k][1], kAxisRgb[k][2]}});
+  if (with_truth) l.push_back({"true", {0.85f, 0.85f, 0.85f}, true});
+  return l;
+}
+
+// three axis lines, then the same three dashed: the reference
+std::vector<ChartLine> axis_lines(const char* name, const char* ref) {
+  std::vector<ChartLine> lines;
+  for (int pass = 0; pass < 2; ++pass) {
+    for (int k = 0; k < 3; ++k) {
+      lines.push_back({fmt::format("{} {}", pass == 0 ? name : ref, "xyz"[k]),
+                       {kAxisRgb[k][0], kAxisRgb[k][1], kAxisRgb[k][2]}, pass == 1});
+    }
   }
-  auto plat = [&](int i) {
-    if (std::isnan(st.plat_deg[i])) return std::string(st.moving[i] ? "moving" : "unknown");
-    return fmt::format("{:+7.2f} deg  {}", st.plat_deg[i], st.moving[i] ? "moving" : "at rest");
-  };
-  std::string next = "unknown (fewer than 2 flips seen)";
-  if (!std::isnan(st.next_flip_s)) {
-    next = fmt::format("~{:.1f} s, platform {}", st.next_flip_s, st.next_platform + 1);
-  }
-  const std::string att = std::isnan(st.attitude_error_deg)
-                              ? std::string("n/a (needs ref_q and the estimator)")
-                              : fmt::format("{:.4f} deg (DriftLess-corrected)",
-                                            st.attitude_error_deg);
+  return lines;
+}
+
+std::string clock_text(double t_s) {
   const int h = static_cast<int>(t_s / 3600.0);
   const int mi = static_cast<int>((t_s - 3600.0 * h) / 60.0);
   const double sec = t_s - 3600.0 * h - 60.0 * mi;
-  o.top_left_values = fmt::format(" \n{:.2f} s  ({}:{:02d}:{:05.2f})\n{}\n{}\n{}\n{}\n{}", t_s, h,
-                                  mi, sec, play, plat(0), plat(1), next, att);
-  return o;
+  return fmt::format("{:.2f} s  ({}:{:02d}:{:04.1f})", t_s, h, mi, sec);
 }
 
-Eigen::Vector3d residual_dps(const Sample& s, const Eigen::Vector3d& a1,
-                             const Eigen::Vector3d& a2) {
-  const Eigen::Matrix3d R1 =
-      Eigen::AngleAxisd(s.plat1_deg * kRadPerDeg, a1.normalized()).toRotationMatrix();
-  const Eigen::Matrix3d R2 =
-      Eigen::AngleAxisd(s.plat2_deg * kRadPerDeg, a2.normalized()).toRotationMatrix();
+std::string play_text(const PlayState& p) {
+  if (p.realtime_flip) return "x1 (flip in real time)";
+  if (p.speed == 1.0) return "x1 real time";
+  return fmt::format("x{:g} {}", p.speed, p.speed > 1.0 ? "time-lapse" : "slow motion");
+}
+
+std::string next_flip_text(const PlayState& p, const OverlayState& st) {
+  if (std::isnan(st.next_flip_s)) return "unknown (fewer than 2 flips seen)";
+  if (std::isfinite(p.end_s) && st.next_flip_s > p.end_s) return fmt::format("none before the end ({:.0f} s)", p.end_s);
+  return fmt::format("~{:.1f} s, platform {}", st.next_flip_s, st.next_platform + 1);
+}
+
+std::string attitude_text(const AttitudeNow& a) {
+  if (!a.available) return "n/a (needs ref_q and the estimator)";
+  if (!a.started) return "-  (starts when the filter has locked on)";
+  return fmt::format("{:.2f} deg since lock at {:.1f} s", a.corrected_deg, a.start_s);
+}
+
+}  // namespace
+
+std::string platform_text(const OverlayState& st, int i) {
+  const double now = st.plat_deg[i], from = st.flip_from_deg[i];
+  if (!st.moving[i]) {
+    return std::isnan(now) ? std::string("unknown") : fmt::format("{:+.0f} deg, at rest", now);
+  }
+  // a flip runs from one end stop to the other: say where it comes from and where it goes
+  if (std::isfinite(from) && std::abs(from) >= 1.0) {
+    const std::string where = std::isnan(now) ? std::string() : fmt::format(" (now {:+.0f})", now);
+    return fmt::format("{:+.0f} -> {:+.0f} deg, moving{}", from, -from, where);
+  }
+  return std::isnan(now) ? std::string("moving") : fmt::format("moving, now {:+.0f} deg", now);
+}
+
+std::vector<TextRow> overlay_rows(const PlayState& p, const OverlayState& st) {
+  std::vector<TextRow> rows;
+  rows.push_back({"time", clock_text(p.t_s) + "  " + play_text(p)});
+  for (int i = 0; i < 2; ++i) {
+    rows.push_back({fmt::format("platform {}", i + 1), platform_text(st, i) + (p.close_up == i ? "  [close-up]" : "")});
+  }
+  rows.push_back({"next flip", next_flip_text(p, st)});
+  rows.push_back({"attitude error", attitude_text(st.attitude)});
+  return rows;
+}
+
+Eigen::Vector3d residual_dps(const Sample& s, const Eigen::Vector3d& a1, const Eigen::Vector3d& a2) {
+  const Eigen::Matrix3d R1 = geo::rot_about_axis_deg(a1, s.plat1_deg);
+  const Eigen::Matrix3d R2 = geo::rot_about_axis_deg(a2, s.plat2_deg);
   return R1 * s.gyro1_dps - R2 * s.gyro2_dps;
 }
 
-ResidualChart::ResidualChart(const Eigen::Vector3d& a1, const Eigen::Vector3d& a2,
-                             double window_s, int points)
+ResidualChart::ResidualChart(const Eigen::Vector3d& a1, const Eigen::Vector3d& a2, double window_s, int points)
     : a1_(a1),
       a2_(a2),
-      chart_("residual R1y1-R2y2 xyz, pale: true (deg/s)",
-             {{"r x", {0.95f, 0.25f, 0.25f}},
-              {"r y", {0.25f, 0.85f, 0.25f}},
-              {"r z", {0.35f, 0.5f, 1.0f}},
-              {"true x", {1.0f, 0.7f, 0.7f}},
-              {"true y", {0.7f, 1.0f, 0.7f}},
-              {"true z", {0.75f, 0.8f, 1.0f}}},
-             window_s),
-      bucket_s_(window_s / points) {}
+      chart_("residual R1 y1 - R2 y2, deg/s", axis_lines("r", "true"), axis_legend(true), window_s, 0.02),
+      bucket_s_(window_s / points) {
+  chart_.empty_text = "waiting for both platforms at rest";
+}
 
 void ResidualChart::flush_bucket() {
   std::vector<double> v(6, kNaN);
@@ -110,20 +146,31 @@ void ResidualChart::push(const Sample& s, bool at_rest) {
 }
 
 BiasChart::BiasChart(int sensor, double window_s, int points)
-    : chart_(fmt::format("bias {} estimate xyz, pale: true (deg/s)", sensor),
-             {{"est x", {0.95f, 0.25f, 0.25f}},
-              {"est y", {0.25f, 0.85f, 0.25f}},
-              {"est z", {0.35f, 0.5f, 1.0f}},
-              {"true x", {1.0f, 0.7f, 0.7f}},
-              {"true y", {0.7f, 1.0f, 0.7f}},
-              {"true z", {0.75f, 0.8f, 1.0f}}},
-             window_s),
-      bucket_s_(window_s / points) {}
+    : chart_(fmt::format("sensor {} bias estimate, deg/s", sensor), axis_lines("est", "true"), axis_legend(true),
+             window_s, 0.02),
+      bucket_s_(window_s / points) {
+  chart_.empty_text = "waiting for the first filter update";
+}
 
 void BiasChart::push(double t_s, const Eigen::Vector3d& est, const Eigen::Vector3d& truth) {
   if (!std::isnan(last_push_s_) && t_s - last_push_s_ < bucket_s_) return;
   last_push_s_ = t_s;
   chart_.push(t_s, {est[0], est[1], est[2], truth[0], truth[1], truth[2]});
+}
+
+AttitudeChart::AttitudeChart(double window_s, int points)
+    : chart_("attitude error since lock, deg",
+             {{"DriftLess", {0.4f, 0.6f, 1.0f}}, {"bias fixed at lock", {0.95f, 0.35f, 0.3f}}},
+             {{"DriftLess", {0.4f, 0.6f, 1.0f}}, {"bias fixed", {0.95f, 0.35f, 0.3f}}}, window_s, 0.1),
+      bucket_s_(window_s / points) {
+  chart_.empty_text = "waiting for the filter to lock";
+}
+
+void AttitudeChart::push(double t_s, const AttitudeNow& a) {
+  if (!a.started) return;
+  if (!std::isnan(last_push_s_) && t_s - last_push_s_ < bucket_s_) return;
+  last_push_s_ = t_s;
+  chart_.push(t_s, {a.corrected_deg, a.fixed_deg});
 }
 
 }  // namespace driftless::render

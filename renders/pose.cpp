@@ -41,6 +41,7 @@ BoxPoser::BoxPoser(const mjModel* m, const std::string& base_body, const std::st
     }
     plat_adr_[i] = m->jnt_qposadr[j];
   }
+  bodies_ = find_framed_bodies(m, base_body.c_str(), plat1_joint.c_str(), plat2_joint.c_str());
   d_.reset(mj_makeData(m));
   kinematics_for_drawing(m, d_.get());
 }

@@ -8,6 +8,7 @@
 #include <mujoco/mujoco.h>
 
 #include "estimator/sample.hpp"
+#include "renders/framing.hpp"
 
 namespace driftless::render {
 
@@ -19,6 +20,8 @@ class WorldPoser {
   virtual mjData* data() = 0;
   /// Poses the world for `s` (angles in deg as logged; NaN parts keep their previous pose).
   virtual void pose(const Sample& s) = 0;
+  /// The box and platform bodies (for the framing camera).
+  virtual FramedBodies bodies() const = 0;
 };
 
 /// Poses a model whose base body carries either a free joint or slide joints plus a ball joint
@@ -35,9 +38,11 @@ class BoxPoser final : public WorldPoser {
   const mjModel* model() const override { return m_; }
   mjData* data() override { return d_.get(); }
   void pose(const Sample& s) override;
+  FramedBodies bodies() const override { return bodies_; }
 
  private:
   const mjModel* m_;
+  FramedBodies bodies_;
   std::unique_ptr<mjData, decltype(&mj_deleteData)> d_;
   int free_adr_ = -1;                        // qpos address of the base's free joint
   std::vector<std::pair<int, int>> slides_;  // (qpos address, joint id) of base slides

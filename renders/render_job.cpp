@@ -192,7 +192,80 @@ constexpr double kSettleS = 0.3;
 struct Held {
   Sample posed;
   OverlayState overlay;
+  double rest_s = 0.0;          // s, both platforms at rest this long (0 while one moves)
+  int last_flip_platform = -1;  // 0/1, the platform of the latest flip
 };
+
+// the platform a frame shows in close-up: the flip a time-lapse plays at x1, or at x1 and
+// slower the platform that moves (until the flip's tail has passed), else none
+int close_up_platform(const FrameInfo& f, const Held& held, double speed, int realtime_platform,
+                      double tail_s) {
+  if (f.realtime_flip) return realtime_platform;
+  if (speed > 1.0) return -1;
+  for (int i = 0; i < 2; ++i) {
+    if (held.overlay.moving[i]) return i;
+  }
+  return held.rest_s < tail_s ? held.last_flip_platform : -1;
+}
+
+// draws the frames the planner emits and hands them to the sink
+class FrameDrawer {
+ public:
+  FrameDrawer(const RenderParams& p, const StreamInfo& info, WorldPoser& poser, SceneRenderer& scene,
+              const Telemetry& telemetry, AsyncSink& out, RenderStats& stats)
+      : p_(p), info_(info), poser_(poser), scene_(scene), telemetry_(telemetry), out_(out), stats_(stats) {
+    end_s_ = info.end_s;
+    if (!std::isnan(p.timeline.to_s) && !(p.timeline.to_s >= end_s_)) end_s_ = p.timeline.to_s;
+  }
+  int realtime_platform = -1;  // the flip a time-lapse is playing at x1
+
+  void draw(const FrameInfo& f, const Held& held) {
+    const double t0 = now_s();
+    poser_.pose(held.posed);
+    mjData* data = poser_.data();
+    data->time = f.t_s;
+    auto buf = out_.take_buffer();
+    const double t1 = now_s();
+    PlayState play{f.t_s, p_.timeline.speed, f.realtime_flip, end_s_, -1};
+    play.close_up = close_up_platform(f, held, p_.timeline.speed, realtime_platform, p_.timeline.flip_tail_s);
+    if (p_.overlay) {
+      FrameOverlay o{info_.title, overlay_rows(play, held.overlay), telemetry_.charts(), held.posed.t_s};
+      scene_.render(data, &o, play.close_up, buf);
+    } else {
+      scene_.render(data, nullptr, play.close_up, buf);
+    }
+    const double t2 = now_s();
+    out_.submit(std::move(buf));
+    stats_.draw_s += t2 - t1;
+    stats_.sink_s += (t1 - t0) + (now_s() - t2);
+    if (std::isnan(stats_.first_frame_s)) stats_.first_frame_s = f.t_s;
+    stats_.last_frame_s = f.t_s;
+    ++stats_.frames;
+    if (f.realtime_flip) ++stats_.realtime_flip_frames;
+  }
+
+ private:
+  const RenderParams& p_;
+  const StreamInfo& info_;
+  WorldPoser& poser_;
+  SceneRenderer& scene_;
+  const Telemetry& telemetry_;
+  AsyncSink& out_;
+  RenderStats& stats_;
+  double end_s_ = kNaN;
+};
+
+std::unique_ptr<VideoSink> open_sink(const RenderParams& params, RenderStats& stats) {
+  const int w = params.scene.width_px, h = params.scene.height_px;
+  const auto ffmpeg = find_ffmpeg();
+  if (ffmpeg.empty()) {
+    stats.png_fallback = true;
+    return make_png_sink(png_fallback_dir(params.out), w, h);
+  }
+  std::error_code ec;
+  if (params.out.has_parent_path()) std::filesystem::create_directories(params.out.parent_path(), ec);
+  return make_ffmpeg_sink(ffmpeg, params.out, w, h, params.timeline.fps, params.encoder);
+}
 
 }  // namespace
 
@@ -205,71 +278,39 @@ RenderStats render_video(FrameSource& source, const RenderParams& params,
   GlContext gl;
   stats.gl_renderer = gl.renderer();
   WorldPoser& poser = source.poser();
-  SceneRenderer scene(poser.model(), params.scene);
-
+  SceneParams sp = params.scene;
+  sp.fps = params.timeline.fps;
+  SceneRenderer scene(poser.model(), sp, poser.bodies());
   const int w = params.scene.width_px, h = params.scene.height_px;
-  std::unique_ptr<VideoSink> sink;
-  const auto ffmpeg = find_ffmpeg();
-  if (ffmpeg.empty()) {
-    sink = make_png_sink(png_fallback_dir(params.out), w, h);
-    stats.png_fallback = true;
-  } else {
-    std::error_code ec;
-    if (params.out.has_parent_path()) std::filesystem::create_directories(params.out.parent_path(), ec);
-    sink = make_ffmpeg_sink(ffmpeg, params.out, w, h, params.timeline.fps, params.encoder);
-  }
-  AsyncSink out(std::move(sink), static_cast<std::size_t>(w) * h * 3);
+  AsyncSink out(open_sink(params, stats), static_cast<std::size_t>(w) * h * 3);
   stats.output = out.sink().description();
 
   const auto& info = source.info();
-  const double speed = params.timeline.speed;
-  const double window_s =
-      std::isnan(params.chart_window_s) ? std::max(30.0, 20.0 * speed) : params.chart_window_s;
   TelemetryParams tp;
   tp.run_estimator = params.run_estimator;
-  tp.window_s = window_s;
+  tp.window_s = std::isnan(params.chart_window_s) ? std::max(30.0, 20.0 * params.timeline.speed) : params.chart_window_s;
   tp.settle_s = kSettleS;
   Telemetry telemetry(tp, info.metadata);
-  const auto charts = telemetry.charts();
   PlatformTracker tracker;
   FramePlanner<Held> planner(params.timeline);
-
+  FrameDrawer drawer(params, info, poser, scene, telemetry, out, stats);
   bool keep_going = true;
   auto emit = [&](const FrameInfo& f, const Held& held) {
     if (!keep_going) return;
-    const double t0 = now_s();
-    poser.pose(held.posed);
-    mjData* data = poser.data();
-    data->time = f.t_s;
-    auto buf = out.take_buffer();
-    const double t1 = now_s();
-    if (params.overlay) {
-      const auto text = overlay_text(info.title, f.t_s, speed, f.realtime_flip, held.overlay);
-      scene.render(data, text, charts, held.posed.t_s, buf);
-    } else {
-      scene.render(data, OverlayText{}, {}, f.t_s, buf);
-    }
-    const double t2 = now_s();
-    out.submit(std::move(buf));
-    stats.draw_s += t2 - t1;
-    stats.sink_s += (t1 - t0) + (now_s() - t2);
-    if (std::isnan(stats.first_frame_s)) stats.first_frame_s = f.t_s;
-    stats.last_frame_s = f.t_s;
-    ++stats.frames;
-    if (f.realtime_flip) ++stats.realtime_flip_frames;
+    drawer.draw(f, held);
     if (progress && !progress(f.t_s, stats.frames)) keep_going = false;
   };
-
   Sample sample;
   Held cur;
   while (keep_going && source.next(sample, cur.posed)) {
     ++stats.samples;
     const bool flip_starts = tracker.update(sample.t_s, sample.plat1_deg, sample.plat2_deg);
     cur.overlay = overlay_state(tracker);
-    if (params.overlay) telemetry.push(sample, tracker.rest_duration_s(sample.t_s), cur.overlay);
-    if (!planner.push(sample.t_s, flip_starts, tracker.rest_duration_s(sample.t_s), cur, emit)) {
-      break;
-    }
+    cur.rest_s = tracker.rest_duration_s(sample.t_s);
+    cur.last_flip_platform = tracker.last_flip_platform();
+    if (params.overlay) telemetry.push(sample, cur.rest_s, cur.overlay);
+    if (flip_starts && !planner.in_realtime_flip()) drawer.realtime_platform = tracker.last_flip_platform();
+    if (!planner.push(sample.t_s, flip_starts, cur.rest_s, cur, emit)) break;
   }
   if (keep_going) planner.finish(emit);
   out.close();

@@ -6,9 +6,15 @@
 #include <limits>
 #include <stdexcept>
 
+#include <Eigen/Core>
 #include <fmt/core.h>
 
 namespace driftless::render {
+
+namespace {
+constexpr double kMinNearM = 0.005;  // m, the closest near plane (depth buffer precision)
+constexpr double kCameraMoveS = 0.3;  // s of video the auto camera takes to close in or back out
+}  // namespace
 
 void SceneParams::validate() const {
   if (width_px < 16 || width_px > 4096 || height_px < 16 || height_px > 4096) {
@@ -27,108 +33,47 @@ void SceneParams::validate() const {
   }
 }
 
-// ---- strip chart ----
-
-StripChart::StripChart(std::string title, std::vector<Line> lines, double window_s)
-    : title_(std::move(title)), lines_(std::move(lines)), window_s_(window_s),
-      data_(lines_.size()) {
-  if (lines_.empty() || lines_.size() > 8) {
-    throw std::invalid_argument("a strip chart holds 1..8 lines");
-  }
-  if (!(window_s > 0.0)) throw std::invalid_argument("strip chart window must be > 0 s");
-}
-
-void StripChart::push(double t_s, const std::vector<double>& values) {
-  for (std::size_t i = 0; i < lines_.size() && i < values.size(); ++i) {
-    if (!std::isfinite(values[i])) continue;
-    auto& d = data_[i];
-    d.emplace_back(t_s, values[i]);
-    // drop what slid out of the window (kept bounded: at most a few thousand points)
-    std::size_t drop = 0;
-    while (drop < d.size() && d[drop].first < t_s - window_s_) ++drop;
-    if (drop > 0 && (drop > 256 || drop == d.size())) d.erase(d.begin(), d.begin() + drop);
-    ++points_;
-  }
-}
-
-void StripChart::clear() {
-  for (auto& d : data_) d.clear();
-  points_ = 0;
-}
-
-std::vector<std::pair<double, double>> StripChart::points(std::size_t i, double t_now_s) const {
-  std::vector<std::pair<double, double>> out;
-  for (const auto& p : data_.at(i)) {
-    if (p.first >= t_now_s - window_s_ && p.first <= t_now_s) out.push_back(p);
-  }
-  return out;
-}
-
 // ---- renderer ----
 
-SceneRenderer::SceneRenderer(const mjModel* model, const SceneParams& params)
-    : params_(params),
-      live_model_(model),
-      model_(nullptr, &mj_deleteModel),
-      figure_(std::make_unique<mjvFigure>()) {
-  params_.validate();
-  if (model == nullptr) throw std::invalid_argument("SceneRenderer needs a model");
-  model_.reset(mj_copyModel(nullptr, model));
-  mjModel* m = model_.get();
-  // the off-screen framebuffer is sized from the model's visual settings
-  m->vis.global.offwidth = params_.width_px;
-  m->vis.global.offheight = params_.height_px;
-  m->vis.quality.offsamples = params_.msaa_samples;
-  if (!params_.shadows) m->vis.quality.shadowsize = 0;
-
-  // camera: an MJCF camera by name, "free" (tracks the first body), or the default choice
+void SceneRenderer::choose_camera(const mjModel* m, const FramedBodies& bodies) {
   mjv_defaultCamera(&camera_);
-  std::string name = params_.camera;
-  if (name.empty()) {
-    if (mj_name2id(m, mjOBJ_CAMERA, "track") >= 0) {
-      name = "track";
-    } else if (mj_name2id(m, mjOBJ_CAMERA, "cam_track") >= 0) {
-      name = "cam_track";
-    } else if (m->ncam > 0) {
-      const char* n0 = mj_id2name(m, mjOBJ_CAMERA, 0);
-      name = n0 != nullptr ? n0 : "";
-      if (name.empty()) {
-        camera_.type = mjCAMERA_FIXED;
-        camera_.fixedcamid = 0;
-        camera_name_ = "camera 0";
-      }
-    } else {
-      name = "free";
-    }
+  const std::string& name = params_.camera;
+  if (name.empty() || name == "auto") {
+    CameraDirector::Params dp;
+    dp.view = params_.view;
+    dp.blend_frames = std::max(1, static_cast<int>(std::lround(kCameraMoveS * params_.fps)));
+    director_ = std::make_unique<CameraDirector>(m, bodies, dp);
+    camera_name_ = "auto";
+    return;
   }
-  if (camera_name_.empty()) {
-    if (name == "free") {
-      mjv_defaultFreeCamera(m, &camera_);
-      if (m->nbody > 1) {
-        camera_.type = mjCAMERA_TRACKING;
-        camera_.trackbodyid = 1;
-      }
-      camera_.distance = 2.5 * m->stat.extent;
-      camera_.elevation = -25;
-      camera_.azimuth = 135;
-    } else {
-      const int id = mj_name2id(m, mjOBJ_CAMERA, name.c_str());
-      if (id < 0) {
-        std::string known;
-        for (int i = 0; i < m->ncam; ++i) {
-          const char* n = mj_id2name(m, mjOBJ_CAMERA, i);
-          known += fmt::format("{}{}", known.empty() ? "" : ", ", n != nullptr ? n : "(unnamed)");
-        }
-        throw std::invalid_argument(fmt::format("camera '{}' is not in the model (cameras: {}{})",
-                                                name, known.empty() ? "none" : known,
-                                                known.empty() ? "; use free" : ", free"));
-      }
-      camera_.type = mjCAMERA_FIXED;
-      camera_.fixedcamid = id;
+  camera_name_ = name;
+  if (name == "free") {
+    // an orbit camera tracking the box (or the first body)
+    mjv_defaultFreeCamera(m, &camera_);
+    if (m->nbody > 1) {
+      camera_.type = mjCAMERA_TRACKING;
+      camera_.trackbodyid = bodies.box > 0 ? bodies.box : 1;
     }
-    camera_name_ = name;
+    camera_.distance = 2.5 * m->stat.extent;
+    camera_.elevation = -25;
+    camera_.azimuth = 135;
+    return;
   }
+  const int id = mj_name2id(m, mjOBJ_CAMERA, name.c_str());
+  if (id < 0) {
+    std::string known;
+    for (int i = 0; i < m->ncam; ++i) {
+      const char* n = mj_id2name(m, mjOBJ_CAMERA, i);
+      known += fmt::format("{}{}", known.empty() ? "" : ", ", n != nullptr ? n : "(unnamed)");
+    }
+    throw std::invalid_argument(fmt::format("camera '{}' is not in the model (cameras: {}{}auto, free)", name, known,
+                                            known.empty() ? "" : ", "));
+  }
+  camera_.type = mjCAMERA_FIXED;
+  camera_.fixedcamid = id;
+}
 
+void SceneRenderer::find_triads(const mjModel* m) {
   // the sensors' axis triads sit at the sites of the gyro sensors
   for (int i = 0; i < m->nsensor; ++i) {
     if (m->sensor_type[i] == mjSENS_GYRO && m->sensor_objtype[i] == mjOBJ_SITE) {
@@ -143,13 +88,27 @@ SceneRenderer::SceneRenderer(const mjModel* model, const SceneParams& params)
   if (triad_length_m_ <= 0 && triad_sites_.size() >= 2) {
     mjData* d0 = mj_makeData(m);
     mj_kinematics(m, d0);
-    const mjtNum* a = d0->site_xpos + 3 * triad_sites_[0];
-    const mjtNum* b = d0->site_xpos + 3 * triad_sites_[1];
-    triad_length_m_ = 0.7 * std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
-                                      (a[2] - b[2]) * (a[2] - b[2]));
+    const Eigen::Map<const Eigen::Vector3d> a(d0->site_xpos + 3 * triad_sites_[0]);
+    const Eigen::Map<const Eigen::Vector3d> b(d0->site_xpos + 3 * triad_sites_[1]);
+    triad_length_m_ = 0.7 * (a - b).norm();
     mj_deleteData(d0);
   }
   if (triad_length_m_ <= 0) triad_length_m_ = m->stat.extent / 10.0;
+}
+
+SceneRenderer::SceneRenderer(const mjModel* model, const SceneParams& params, const FramedBodies& bodies)
+    : params_(params), live_model_(model), model_(nullptr, &mj_deleteModel), bodies_(bodies) {
+  params_.validate();
+  if (model == nullptr) throw std::invalid_argument("SceneRenderer needs a model");
+  model_.reset(mj_copyModel(nullptr, model));
+  mjModel* m = model_.get();
+  // the off-screen framebuffer is sized from the model's visual settings
+  m->vis.global.offwidth = params_.width_px;
+  m->vis.global.offheight = params_.height_px;
+  m->vis.quality.offsamples = params_.msaa_samples;
+  if (!params_.shadows) m->vis.quality.shadowsize = 0;
+  choose_camera(m, bodies);
+  find_triads(m);
 
   mjv_defaultOption(&option_);
   mjv_defaultScene(&scene_);
@@ -205,75 +164,91 @@ void SceneRenderer::add_triads(const mjData* d) {
   }
 }
 
-void SceneRenderer::draw_chart(const StripChart& chart, double t_now_s, int slot) {
-  mjvFigure& f = *figure_;
-  mjv_defaultFigure(&f);
-  f.flg_legend = 0;  // the title names the lines; a legend would hide the data
-  f.flg_extend = 1;
-  f.flg_ticklabel[0] = 1;
-  f.flg_ticklabel[1] = 1;
-  f.gridsize[0] = 3;
-  f.gridsize[1] = 3;
-  f.figurergba[3] = 0.55f;
-  f.panergba[3] = 0.6f;
-  f.legendrgba[3] = 0.0f;
-  std::snprintf(f.title, sizeof f.title, "%s", chart.title().c_str());
-  std::snprintf(f.xformat, sizeof f.xformat, "%%.0f");
-  std::snprintf(f.yformat, sizeof f.yformat, "%%.2g");
-  std::snprintf(f.minwidth, sizeof f.minwidth, "-0.000");
-  f.range[0][0] = static_cast<float>(t_now_s - chart.window_s());
-  f.range[0][1] = static_cast<float>(t_now_s);
-  f.range[1][0] = 0.0f;  // y automatic
-  f.range[1][1] = 0.0f;
-  for (std::size_t i = 0; i < chart.lines().size(); ++i) {
-    const auto& line = chart.lines()[i];
-    std::snprintf(f.linename[i], sizeof f.linename[i], "%s", line.name.c_str());
-    std::copy(line.rgb, line.rgb + 3, f.linergb[i]);
-    auto pts = chart.points(i, t_now_s);
-    // thin to the figure's capacity, keeping the newest point
-    const std::size_t n = pts.size();
-    const std::size_t step = n > mjMAXLINEPNT ? (n + mjMAXLINEPNT - 1) / mjMAXLINEPNT : 1;
-    int k = 0;
-    for (std::size_t j = (n - 1) % step; j < n && k < mjMAXLINEPNT; j += step, ++k) {
-      f.linedata[i][2 * k] = static_cast<float>(pts[j].first);
-      f.linedata[i][2 * k + 1] = static_cast<float>(pts[j].second);
-    }
-    f.linepnt[i] = k;
+FrameLayout frame_layout(int w, int h, int text_rows, int row_px, int charts) {
+  FrameLayout l;
+  l.scene = {0, 0, w, h};
+  // parts that would not be readable, or would leave the view too little room, are left out
+  if (w * 36 / 100 < kMinChartWidthPx || (h - row_px - 8) / std::max(charts, 2) < kMinChartHeightPx) charts = 0;
+  if (text_rows * row_px + 12 > h * 45 / 100) text_rows = 0;
+  if (charts > 0) {
+    // a column of charts on the right, each at most half the height
+    const int cw = w * 36 / 100;
+    l.column = {w - cw, 0, cw, h};
+    l.scene.width = w - cw;
+    l.title = {w - cw, h - row_px - 8, cw, row_px + 8};
+    const int chh = l.title.bottom / std::max(charts, 2);
+    for (int i = 0; i < charts; ++i) l.charts.push_back({w - cw, l.title.bottom - (i + 1) * chh, cw, chh});
   }
-  const int w = params_.width_px * 40 / 100;
-  const int h = params_.height_px * 25 / 100;
-  mjrRect rect{params_.width_px - w, slot * h, w, h};
-  mjr_figure(rect, &f, &context_);
+  if (text_rows > 0) {
+    const int band = text_rows * row_px + 12;
+    l.text = {0, h - band, l.scene.width, band};
+    l.scene.height = h - band;
+  }
+  return l;
 }
 
-void SceneRenderer::render(mjData* data, const OverlayText& text,
-                           const std::vector<const StripChart*>& charts, double t_now_s,
-                           std::vector<std::uint8_t>& rgb_top_down) {
+// MuJoCo puts the near plane at znear x the model's extent (0.5 m for the twin, whose ship is
+// 12 m long), which would cut a camera close to the box: bring it to half the way to the box
+void SceneRenderer::fit_near_plane(const mjData* data) {
+  const auto corners = body_corners_world(live_model_, data, bodies_.box, option_);
+  if (corners.empty()) return;
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (const auto& c : corners) centre += c;
+  centre /= static_cast<double>(corners.size());
+  double radius = 0.0;
+  for (const auto& c : corners) radius = std::max(radius, (c - centre).norm());
+  for (auto& cam : scene_.camera) {
+    const Eigen::Vector3d pos(cam.pos[0], cam.pos[1], cam.pos[2]);
+    const float near = static_cast<float>(std::max(kMinNearM, 0.5 * ((pos - centre).norm() - radius)));
+    if (cam.frustum_near <= near) continue;
+    const float k = near / cam.frustum_near;
+    cam.frustum_near = near;
+    cam.frustum_center *= k;
+    cam.frustum_bottom *= k;
+    cam.frustum_top *= k;
+  }
+}
+
+// the 3D view into `view`
+void SceneRenderer::draw_world(mjData* data, const PixelRect& view, int close_up) {
+  if (director_) {
+    director_->update(data, option_, params_.close_ups ? close_up : -1,
+                      static_cast<double>(view.width) / view.height, &camera_);
+  }
   mjv_updateScene(live_model_, data, &option_, nullptr, &camera_, mjCAT_ALL, &scene_);
+  fit_near_plane(data);
   add_triads(data);
-  const mjrRect viewport{0, 0, params_.width_px, params_.height_px};
   mjr_setBuffer(mjFB_OFFSCREEN, &context_);
-  mjr_render(viewport, &scene_, &context_);
-  if (!text.top_left_titles.empty()) {
-    mjr_overlay(mjFONT_NORMAL, mjGRID_TOPLEFT, viewport, text.top_left_titles.c_str(),
-                text.top_left_values.c_str(), &context_);
+  mjr_render(mjrRect{view.left, view.bottom, view.width, view.height}, &scene_, &context_);
+}
+
+void SceneRenderer::render(mjData* data, const FrameOverlay* overlay, int close_up,
+                           std::vector<std::uint8_t>& rgb_top_down) {
+  const int w = params_.width_px, h = params_.height_px;
+  layout_ = overlay == nullptr ? frame_layout(w, h, 0, 0, 0)
+                               : frame_layout(w, h, static_cast<int>(overlay->rows.size()), text_row_px(),
+                                              static_cast<int>(overlay->charts.size()));
+  draw_world(data, layout_.scene, close_up);
+  if (overlay != nullptr) {
+    if (layout_.text.height > 0) {
+      fill_rect(layout_.text, 0.1f, 0.11f, 0.13f, 1.0f, w, h);
+      draw_text_rows(overlay->rows, layout_.text, context_, w, h);
+    }
+    if (layout_.column.width > 0) {
+      fill_rect(layout_.column, 0.1f, 0.11f, 0.13f, 1.0f, w, h);
+      draw_text_rows({{"", overlay->title}}, layout_.title, context_, w, h);
+    }
+    for (std::size_t i = 0; i < overlay->charts.size() && i < layout_.charts.size(); ++i) {
+      if (overlay->charts[i] != nullptr) draw_chart(*overlay->charts[i], layout_.charts[i], overlay->t_now_s, context_, w, h);
+    }
   }
-  if (!text.bottom_left_titles.empty()) {
-    mjr_overlay(mjFONT_NORMAL, mjGRID_BOTTOMLEFT, viewport, text.bottom_left_titles.c_str(),
-                text.bottom_left_values.c_str(), &context_);
-  }
-  int slot = 0;
-  for (const StripChart* chart : charts) {
-    if (chart != nullptr && !chart->empty()) draw_chart(*chart, t_now_s, slot++);
-  }
-  mjr_readPixels(bottom_up_.data(), nullptr, viewport, &context_);
+  mjr_readPixels(bottom_up_.data(), nullptr, mjrRect{0, 0, w, h}, &context_);
   // OpenGL rows run bottom-up; video rows run top-down
-  const std::size_t row = static_cast<std::size_t>(params_.width_px) * 3;
+  const std::size_t row = static_cast<std::size_t>(w) * 3;
   rgb_top_down.resize(bottom_up_.size());
-  for (int y = 0; y < params_.height_px; ++y) {
+  for (int y = 0; y < h; ++y) {
     std::memcpy(rgb_top_down.data() + row * static_cast<std::size_t>(y),
-                bottom_up_.data() + row * static_cast<std::size_t>(params_.height_px - 1 - y),
-                row);
+                bottom_up_.data() + row * static_cast<std::size_t>(h - 1 - y), row);
   }
 }
 

@@ -5,6 +5,10 @@
 
 namespace driftless::render {
 
+namespace {
+constexpr double kAttitudeIntervalS = 0.1;  // s of data between attitude comparisons (overlay, chart)
+}  // namespace
+
 void TelemetryParams::validate() const {
   if (!(window_s > 0.0)) throw std::invalid_argument("chart window must be > 0 s");
   if (!(settle_s >= 0.0)) throw std::invalid_argument("settle time must be >= 0 s");
@@ -17,8 +21,9 @@ Telemetry::Telemetry(const TelemetryParams& p, const log::Metadata& meta)
     filter_ = std::make_unique<est::DriftlessFilter>(est::EstimatorConfig{}, est::box_geometry_from_metadata(meta));
     bias1_.emplace(1, p_.window_s);
     bias2_.emplace(2, p_.window_s);
-    const double lat = meta.latitude_deg();
-    attitude_.emplace(std::isfinite(lat) ? lat : 0.0);
+    attitude_chart_.emplace(p_.window_s);
+    // the comparison `driftless estimate` makes, from the same lock level, more often
+    attitude_.emplace(meta.latitude_deg(), est::EstimateRunOptions{}.attitude_start_sigma_dps, kAttitudeIntervalS);
   }
 }
 
@@ -32,25 +37,22 @@ void Telemetry::push(const Sample& s, double rest_s, OverlayState& st) {
       bias1_->push(s.t_s, filter_->bias1_dps(), s.true_bias1_dps);
       bias2_->push(s.t_s, filter_->bias2_dps(), s.true_bias2_dps);
     }
-    // strapdown attitude from the bias-corrected fused rate (paper section 4), started at the
-    // first reference attitude and compared with ref_q
-    const bool has_ref = s.ref_q_wxyz.allFinite();
-    if (has_ref && !attitude_->initialized()) {
-      attitude_->reset(s.q_enu_from_body().normalized(), s.t_s);
-    } else if (attitude_->initialized()) {
-      attitude_->step(s.t_s, filter_->output().rate_body_dps);
-      if (has_ref) {
-        attitude_error_deg_ = est::attitude_error(attitude_->q_enu_from_body(),
-                                                  s.q_enu_from_body().normalized())
-                                  .angle_deg;
-      }
+    // the attitude comparison of docs/estimator.md section 4: from lock on, against ref_q
+    attitude_now_.available = attitude_now_.available || s.ref_q_wxyz.allFinite();
+    est::AttitudePoint ap;
+    if (attitude_->push(s, *filter_, ap)) {
+      attitude_now_.started = true;
+      attitude_now_.start_s = attitude_->start_s();
+      attitude_now_.corrected_deg = ap.corrected.angle_deg;
+      attitude_now_.fixed_deg = ap.fixed.angle_deg;
     }
+    attitude_chart_->push(s.t_s, attitude_now_);
   }
-  st.attitude_error_deg = attitude_error_deg_;
+  st.attitude = attitude_now_;
 }
 
 std::vector<const StripChart*> Telemetry::charts() const {
-  if (filter_) return {&bias2_->chart(), &bias1_->chart()};
+  if (filter_) return {&bias1_->chart(), &bias2_->chart(), &attitude_chart_->chart()};
   return {&residual_.chart()};
 }
 

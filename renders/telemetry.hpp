@@ -1,13 +1,14 @@
 // The numbers behind the overlay, computed from the sample stream as it is read: the DriftLess
 // filter's bias estimate (when enabled) against the true biases, the residual of eq. (2), and
-// the attitude error of a strapdown attitude against ref_q.
+// the attitude error from lock on (est::AttitudeComparison: what `driftless estimate` reports).
 #pragma once
 
 #include <memory>
 #include <optional>
 #include <vector>
 
-#include "estimator/attitude.hpp"
+#include "estimator/attitude_comparison.hpp"
+#include "estimator/pipeline.hpp"
 #include "estimator/filter.hpp"
 #include "estimator/log.hpp"
 #include "renders/overlay.hpp"
@@ -33,7 +34,8 @@ class Telemetry {
   /// Adds one sample; `rest_s`: how long both platforms have been at rest (0 while moving).
   /// Fills the estimator-derived parts of `st` (attitude error).
   void push(const Sample& s, double rest_s, OverlayState& st);
-  /// The charts to draw, bottom first: bias 1 and 2 estimates with the filter, else the residual.
+  /// The charts to draw, top first: bias 1 and 2 estimates and the attitude error with the
+  /// filter, else the residual.
   std::vector<const StripChart*> charts() const;
   /// The filter, when it runs (for tests and summaries).
   const est::DriftlessFilter* filter() const { return filter_.get(); }
@@ -43,8 +45,9 @@ class Telemetry {
   ResidualChart residual_;
   std::unique_ptr<est::DriftlessFilter> filter_;
   std::optional<BiasChart> bias1_, bias2_;
-  std::optional<est::AttitudeIntegrator> attitude_;  // from the filter's corrected body rate
-  double attitude_error_deg_ = kNaN;
+  std::optional<AttitudeChart> attitude_chart_;
+  std::optional<est::AttitudeComparison> attitude_;  // the comparison `driftless estimate` makes
+  AttitudeNow attitude_now_;
 };
 
 }  // namespace driftless::render

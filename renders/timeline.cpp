@@ -53,6 +53,7 @@ bool PlatformTracker::update(double t_s, double plat1_deg, double plat2_deg) {
     if (now_moving && !moving_[i] && !std::isnan(last_t_s_)) {
       if (!started) starter = i;
       started = true;
+      from_deg_[i] = last_deg_[i];
     }
     moving_[i] = now_moving;
     if (!std::isnan(deg[i])) last_deg_[i] = deg[i];

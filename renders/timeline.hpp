@@ -44,6 +44,8 @@ class PlatformTracker {
   bool any_moving() const { return moving_[0] || moving_[1]; }
   /// Last known angle of platform i (0 or 1), deg (NaN before any).
   double angle_deg(int i) const { return last_deg_[i]; }
+  /// Angle of platform i when its latest flip started (at rest before it), deg (NaN before any).
+  double flip_from_deg(int i) const { return from_deg_[i]; }
   /// Start time of the latest flip of any platform, s (NaN before any).
   double last_flip_start_s() const { return last_start_s_; }
   /// Which platform (0/1) moved in the latest flip, -1 before any.
@@ -62,6 +64,7 @@ class PlatformTracker {
   double rest_rate_dps_;
   bool moving_[2] = {false, false};
   double last_deg_[2] = {kNaN, kNaN};      // last finite angle
+  double from_deg_[2] = {kNaN, kNaN};      // angle at the start of the latest flip
   double prev_raw_deg_[2] = {kNaN, kNaN};  // previous sample's value, NaN kept
   double last_t_s_ = kNaN;
   double rest_since_s_ = kNaN;

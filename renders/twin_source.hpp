@@ -24,6 +24,7 @@ class TwinPoser final : public WorldPoser {
   const mjModel* model() const override { return world_.model(); }
   mjData* data() override { return world_.data(); }
   void pose(const Sample& s) override;
+  FramedBodies bodies() const override { return find_framed_bodies(world_.model()); }
 
  private:
   twin::World world_;

@@ -2,10 +2,12 @@
 # Install everything DriftLess Twin needs from Debian 12 packages. Idempotent: skips apt when all present.
 set -euo pipefail
 packages=(
-  build-essential cmake pkg-config ccache git
+  build-essential cmake pkg-config ccache git universal-ctags
   libmujoco-dev libqhull-dev libeigen3-dev libyaml-cpp-dev libosmesa6-dev
   libpng-dev libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev libfmt-dev libfast-float-dev
   ffmpeg gnuplot-nox openmpi-bin libopenmpi-dev
+  chromium  # the look test (tests/cli/look.sh) opens the report and the figures headless
+  python3-numpy  # the independent log generator of the diagnose tests (tests/diagnose/independent_log.py)
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -15,6 +15,7 @@
 
 #include "diagnose/apply.hpp"
 #include "diagnose/compare.hpp"
+#include "tests/temp_path.hpp"
 
 namespace driftless::diagnose::indep {
 
@@ -35,7 +36,7 @@ struct Source {
 
 /// Writes the log of `src` into the temp folder (GTest fails on a generator error).
 inline std::filesystem::path generate(const Source& src, const std::string& tag) {
-  const auto path = std::filesystem::temp_directory_path() / fmt::format("driftless_indep_{}_{}.csv", tag, src.seed);
+  const auto path = test::temp_path(fmt::format("driftless_indep_{}_{}.csv", tag, src.seed));
   std::string cmd = fmt::format("/usr/bin/python3 '{}/tests/diagnose/independent_log.py' --out '{}' --seed {} --rate {} "
                                 "--duration {} --motion {} --noise-scale {} --dlpf {}",
                                 DRIFTLESS_SOURCE_DIR, path.string(), src.seed, src.rate_hz, src.duration_s, src.motion,
@@ -61,7 +62,7 @@ inline CompareResult diagnose_log(const std::filesystem::path& log, CompareModel
 inline CompareResult apply_and_compare(const std::filesystem::path& log, const CompareResult& r, const std::string& tag) {
   CompareModel m = default_compare_model();
   apply_result(m, r);
-  const auto yaml = std::filesystem::temp_directory_path() / fmt::format("driftless_indep_{}.yaml", tag);
+  const auto yaml = test::temp_path(fmt::format("driftless_indep_{}.yaml", tag));
   save_compare_model(m, yaml);
   const CompareModel back = load_compare_model(yaml);
   std::filesystem::remove(yaml);

@@ -68,8 +68,8 @@ TEST(CompareEffects, LowpassLatency) {
   const auto r = run(c, 32);
   expect_top(r, "lowpass_latency");
   // both sensors run the same filter: one shared delay, the new value near cfg 5's 13.4 ms
-  const double want = mpu6050_dlpf(5).gyro_delay_s;
-  EXPECT_NEAR(param(check::top(r), "delay_s"), want, 0.2 * (want - mpu6050_dlpf(3).gyro_delay_s));
+  const double want = mpu6050::dlpf_setting(5).gyro_delay_s;
+  EXPECT_NEAR(param(check::top(r), "delay_s"), want, 0.2 * (want - mpu6050::dlpf_setting(3).gyro_delay_s));
   CompareModel m = default_compare_model();
   m.sensor = {c.model1, c.model2};
   apply_candidate(m, check::top(r));

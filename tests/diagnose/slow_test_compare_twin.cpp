@@ -50,7 +50,7 @@ Outcome run(const Case& c) {
   if (o.before.verdict == Verdict::kMissingEffect || !o.before.noise_model.empty()) {
     CompareModel upd = m;
     apply_result(upd, o.before);
-    const auto yaml = std::filesystem::temp_directory_path() / (std::string("driftless_twin_") + effect_id(c.effect) + ".yaml");
+    const auto yaml = test::temp_path(std::string("driftless_twin_") + effect_id(c.effect) + ".yaml");
     save_compare_model(upd, yaml);
     o.after = compare(rp, load_compare_model(yaml), CompareOptions{});
     std::filesystem::remove(yaml);
@@ -204,7 +204,7 @@ TEST(CompareTwinEffects, LowpassLatency) {
   };
   c.effect = Effect::kLowpass;
   c.param = "delay_s";  // both sensors run the same filter: one shared delay
-  c.truth = mpu6050_dlpf(5).gyro_delay_s - mpu6050_dlpf(3).gyro_delay_s;
+  c.truth = mpu6050::dlpf_setting(5).gyro_delay_s - mpu6050::dlpf_setting(3).gyro_delay_s;
   check(c);
 }
 
