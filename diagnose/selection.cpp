@@ -263,8 +263,11 @@ Eval Selector::evaluate(const ParamRef& x, const Terms& S, double base) const {
   const auto i = static_cast<Eigen::Index>(it - spec.free.begin());
   e.value = fit.value[i];
   e.sigma = fit.sigma[i];
-  // a sample delay cannot be negative (the sensor cannot sample before the time stamp)
+  // a sample delay cannot be negative (the sensor cannot sample before the time stamp), nor can
+  // the box's time offset (simulate models offsets >= 0; a negative one is the model's low-pass
+  // delay the log does not have, which at a rate where the filter is a pure delay reads the same)
   if (x.param == Param::kSampleDelayS && model_sample_delay_[static_cast<std::size_t>(x.sensor)] + e.value < 0.0) return e;
+  if (x.param == Param::kTimeOffsetS && in_.model.time_offset_s + e.value < 0.0) return e;
   if (!std::isfinite(e.sigma)) return e;  // not identified given the selection
   e.ev = t - base - log_m_;
   return e;

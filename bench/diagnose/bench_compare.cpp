@@ -1,6 +1,6 @@
-// compare + diagnose on a 1 h, 100 Hz MuJoCo twin log (pan/tilt, a hidden scale error): CSV
-// parsing, replay, fits, ranking, --apply and the comparison with the new model, report JSON.
-// Target (issue 5): at most 10 s. The log is simulated once and kept in the temp folder.
+// diagnose on a 1 h, 100 Hz MuJoCo twin log (pan/tilt, a hidden scale error): CSV parsing,
+// replay, fits, the forward selection, the noise model, summaries, report JSON. Target (issue
+// 12): at most 2 s and 150 MB peak. The log is simulated once and kept in the temp folder.
 #include <benchmark/benchmark.h>
 
 #include <filesystem>
