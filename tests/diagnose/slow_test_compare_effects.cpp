@@ -114,8 +114,16 @@ TEST(CompareEffects, RateRandomWalk) {
   c.duration_s = 600.0;
   const auto r = run(c, 37);
   ASSERT_TRUE(r.verdict == Verdict::kMissingEffect || !r.noise_model.empty()) << r.statement;
-  const std::string e = check::top_effect(r);
-  EXPECT_TRUE(e == "rate_random_walk" || e == "bias_instability") << r.statement;
+  // the drift is a noise-model change, reported after the effects (the selection may also take
+  // small slow effects that this strong drift mimics: docs/compare.md "Known limits")
+  const Candidate* drift = nullptr;
+  for (const auto& c : r.noise_model)
+    if (!drift && (c.effect == Effect::kRateRandomWalk || c.effect == Effect::kBiasInstability)) drift = &c;
+  ASSERT_NE(drift, nullptr) << r.statement;
+  if (drift->effect == Effect::kRateRandomWalk) {
+    EXPECT_NEAR(check::param(*drift, "s1.x.k_dps_rts"), 0.01, 0.003) << r.statement;
+  }
+  for (const auto& c : r.selected) EXPECT_FALSE(c.absurd) << r.statement;
 }
 
 TEST(CompareEffects, QuantizationStep) {
