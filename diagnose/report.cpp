@@ -10,11 +10,12 @@
 
 #include "diagnose/report_plots.hpp"
 #include "diagnose/report_text.hpp"
+#include "report/html.hpp"
 
 namespace driftless::diagnose {
 namespace {
 
-using report_text::html_escape;
+using report::html_escape;
 
 const char* kStyle =
     "body{font-family:sans-serif;max-width:1150px;margin:auto;padding:1em}table{border-collapse:collapse;margin:0.5em 0}"
@@ -152,7 +153,7 @@ std::string html(const CompareResult& r, const ReportExtras& x, const std::vecto
   for (const auto& p : plots) {
     if (p.png.empty()) h << "<p>" << html_escape(p.title) << ": no plot (gnuplot missing or no data; data and messages in plots/)</p>\n";
     else h << "<h3>" << html_escape(p.title) << "</h3><img alt='" << html_escape(p.title) << "' src='data:image/png;base64,"
-           << report_text::base64(p.png) << "'>\n";
+           << report::base64(p.png) << "'>\n";
   }
   h << "</body></html>\n";
   return h.str();

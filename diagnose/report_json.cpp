@@ -2,14 +2,13 @@
 #include <sstream>
 
 #include "diagnose/report.hpp"
-#include "diagnose/report_text.hpp"
+#include "report/json.hpp"
 
 namespace driftless::diagnose {
 namespace {
 
-using report_text::json_escape;
-std::string n(double v) { return report_text::json_number(v); }
-std::string q(const std::string& s) { return "\"" + json_escape(s) + "\""; }
+std::string n(double v) { return report::json_number(v); }
+std::string q(const std::string& s) { return report::json_string(s); }
 
 void param_json(std::ostringstream& o, const FittedParam& p) {
   o << "{\"name\": " << q(p.name()) << ", \"value\": " << n(p.new_value()) << ", \"change\": " << n(p.value)

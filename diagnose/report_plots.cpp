@@ -5,12 +5,13 @@
 
 #include "diagnose/report_plots.hpp"
 #include "diagnose/report_text.hpp"
+#include "report/json.hpp"
 
 namespace driftless::diagnose {
 namespace {
 
 using report_text::gnuplot_png;
-std::string n(double v) { return report_text::json_number(v); }
+std::string n(double v) { return report::json_number(v); }
 
 // residual after the selected effects and the smoothed bias (points), per sensor; the smoothed
 // bias itself below (it is a nuisance, drawn so its size is visible)
@@ -31,11 +32,11 @@ Plot residual_plot(const CompareResult& r, const std::filesystem::path& dir) {
                      "smoothed bias'\nplot ", sn + 1);
     for (int a = 0; a < 3; ++a) {
       const int c = sn * 3 + a;
-      s += fmt::format("'{}' u 1:{} w p pt 7 ps 0.25 t '{}'{}", dat.string(), 2 + 2 * c, channel_name(c), a < 2 ? ", " : "\n");
+      s += fmt::format("'{}' u 1:{} w p pt 7 ps 0.25 t '{}'{}", dat.filename().string(), 2 + 2 * c, channel_name(c), a < 2 ? ", " : "\n");
     }
   }
   s += "set title 'smoothed bias (nuisance: turn-on bias and drift)'\nplot ";
-  for (int c = 0; c < 6; ++c) s += fmt::format("'{}' u 1:{} w l t '{}'{}", dat.string(), 3 + 2 * c, channel_name(c), c < 5 ? ", " : "\n");
+  for (int c = 0; c < 6; ++c) s += fmt::format("'{}' u 1:{} w l t '{}'{}", dat.filename().string(), 3 + 2 * c, channel_name(c), c < 5 ? ", " : "\n");
   s += "unset multiplot\n";
   return {"Residual over time", gnuplot_png(dir, "residual", s, 900, 720)};
 }
@@ -53,7 +54,7 @@ Plot windows_plot(const CompareResult& r, const std::filesystem::path& dir) {
   std::string s = "set termoption noenhanced\nset xlabel 't (s)'\nset ylabel 'rms (deg/s)'\nset yrange [0:*]\nset key outside right\n"
                   "set title 'windowed residual rms after the selected effects (dashed: the model noise floor)'\nplot ";
   for (int c = 0; c < 6; ++c) {
-    s += fmt::format("'{0}' u 1:{1} w lp lc {3} t '{2}', '' u 1:{4} w l dt 2 lc {3} notitle{5}", dat.string(), 2 + 2 * c,
+    s += fmt::format("'{0}' u 1:{1} w lp lc {3} t '{2}', '' u 1:{4} w l dt 2 lc {3} notitle{5}", dat.filename().string(), 2 + 2 * c,
                      channel_name(c), c + 1, 3 + 2 * c, c < 5 ? ", " : "\n");
   }
   return {"Windowed residual RMS", gnuplot_png(dir, "windows", s)};
@@ -89,7 +90,7 @@ Plot allan_plot(const CompareResult& r, const std::filesystem::path& dir) {
       const int c = sn * 3 + a, o = 7 * c;
       s += fmt::format("'{0}' u {1}:{6}:{7} w filledcurves lc {8} notitle, '' u {1}:{5} w l lc {8} dt 2 t '{9} model', "
                        "'' u {1}:{2}:{3}:{4} w yerrorbars pt 7 ps 0.5 lc {8} t '{9}'{10}",
-                       dat.string(), o + 1, o + 2, o + 3, o + 4, o + 5, o + 6, o + 7, a + 1, channel_name(c), a < 2 ? ", " : "\n");
+                       dat.filename().string(), o + 1, o + 2, o + 3, o + 4, o + 5, o + 6, o + 7, a + 1, channel_name(c), a < 2 ? ", " : "\n");
     }
   }
   s += "unset multiplot\n";
@@ -112,7 +113,7 @@ Plot regimes_plot(const CompareResult& r, const std::filesystem::path& dir) {
                   "set style fill solid 0.8\n"
                   "set yrange [0:*]\nset xtics rotate by -30\nset ylabel 'rms (deg/s)'\nset key outside right\n"
                   "set title 'residual rms by regime, after the selected effects (during flips: table only, no truth there)'\nplot ";
-  for (int c = 0; c < 6; ++c) s += fmt::format("'{}' u {}:xtic(1) t '{}'{}", dat.string(), 2 + c, channel_name(c), c < 5 ? ", " : "\n");
+  for (int c = 0; c < 6; ++c) s += fmt::format("'{}' u {}:xtic(1) t '{}'{}", dat.filename().string(), 2 + c, channel_name(c), c < 5 ? ", " : "\n");
   return {"Residual by regime", gnuplot_png(dir, "regimes", s, 900, 480)};
 }
 
