@@ -106,6 +106,11 @@ int run_from_scenario(const Options& o) {
     });
     progress.done();
   }
+  if (stop_requested().load()) {
+    // interrupted: the rig run is partial, so no fit and no calibration file that would look whole
+    fmt::print(stderr, "driftless calibrate: stopped before the rig run finished; nothing written\n");
+    return interrupted_exit_code();
+  }
   if (!o.save_log.empty()) {
     log::LogWriter w(o.save_log, run.meta,
                      kFieldAccel | kFieldTemp | kFieldRefQ | kFieldRefP | kFieldTrueBias |
@@ -186,7 +191,7 @@ const bool registered = register_command(40, [](CLI::App& app) {
       throw std::invalid_argument("calibrate: give --scenario FILE, or --log FILE --plan FILE");
     return o->scenario.empty() ? run_from_log(*o) : run_from_scenario(*o);
   };
-});
+}, Interrupt::kPolls);
 
 }  // namespace
 }  // namespace driftless::cli

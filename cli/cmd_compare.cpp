@@ -62,7 +62,7 @@ const bool registered = register_command(50, [](CLI::App& app) {
   cmd->add_option("--out", a->common.out, "Output directory (report.html, diagnosis.json, plots/)")->required();
   cmd->add_flag("--resample", a->common.resample, "Resample the log to the sample_rate_hz the model file states (default: "
                 "the model runs at the log's rate)");
-  cmd->add_option("--block", a->common.block_s, "Block length of the residual fits, s (default 0.1)")->check(CLI::PositiveNumber);
+  cmd->add_option("--block", a->common.block_s, "Block length of the residual fits, s (default 0.1)")->check(positive_number("s"));
   cmd->add_option("--threshold", a->common.threshold, "Evidence (2 ln L gain - ln(m) per parameter) above which an effect "
                   "is selected (default 10)")->check(CLI::NonNegativeNumber);
   return [a] { return run_compare(*a); };

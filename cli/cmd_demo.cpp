@@ -173,10 +173,10 @@ const bool registered = register_command(0, [](CLI::App& app) {
   auto args = std::make_shared<DemoArgs>();
   cmd->add_option("--out", args->out_dir, "Output directory (default out/demo)");
   cmd->add_option("--duration", args->duration_s, "Simulated duration in s (default 600)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number("s"));
   cmd->add_flag("!--no-video", args->video, "Skip the rendered video step");
   return [args] { return run_demo(*args); };
-});
+}, Interrupt::kPolls);
 
 }  // namespace
 }  // namespace driftless::cli

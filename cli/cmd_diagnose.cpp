@@ -85,7 +85,7 @@ const bool registered = register_command(51, [](CLI::App& app) {
                   "file, then compare again; exit 1 unless the new model is consistent with the log");
   cmd->add_flag("--resample", a->common.resample, "Resample the log to the sample_rate_hz the model file states (default: "
                 "the model runs at the log's rate)");
-  cmd->add_option("--block", a->common.block_s, "Block length of the residual fits, s (default 0.1)")->check(CLI::PositiveNumber);
+  cmd->add_option("--block", a->common.block_s, "Block length of the residual fits, s (default 0.1)")->check(positive_number("s"));
   cmd->add_option("--threshold", a->common.threshold, "Evidence above which an effect is selected (default 10)")
       ->check(CLI::NonNegativeNumber);
   return [a] { return run_diagnose(*a); };

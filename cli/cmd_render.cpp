@@ -130,9 +130,9 @@ int run_render(const RenderArgs& a) {
   if (stop_requested().load()) {
     fmt::print(stderr, "driftless render: stopped early (Ctrl-C); the video ends at t = {:.2f} s\n",
                stats.last_frame_s);
-    return 130;
+    return interrupted_exit_code();
   }
-  return 0;
+  return kExitOk;
 }
 
 const bool registered = register_command(60, [](CLI::App& app) {
@@ -201,7 +201,7 @@ const bool registered = register_command(60, [](CLI::App& app) {
     (void)cmd;
     return run_render(*a);
   };
-});
+}, Interrupt::kPolls);
 
 }  // namespace
 }  // namespace driftless::cli

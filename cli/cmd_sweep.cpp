@@ -215,7 +215,7 @@ const bool registered = register_command(60, [](CLI::App& app) {
   cmd->add_flag("--save-logs", opt->save_logs,
                 "Also write every run's samples to OUT/logs/run_<index>.csv (driftless-log 1)");
   return [opt] { return run_sweep(*opt); };
-});
+}, Interrupt::kPolls);
 
 }  // namespace
 }  // namespace driftless::cli

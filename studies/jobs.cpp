@@ -145,7 +145,6 @@ Metrics evaluate_bias(const RunSetup& setup, const log::Metadata& meta, const Sa
   // their bias zeroed once at the first sample (a perfect turn-on calibration, then drift: the
   // paper's "without DriftLess"); both start on the reference attitude
   est::AttitudeIntegrator att_dl(setup.scenario.latitude_deg), att_zero(setup.scenario.latitude_deg);
-  est::Vector6d bias_at_start = est::Vector6d::Constant(kNaN);
   Eigen::Quaterniond err_dl0 = Eigen::Quaterniond::Identity(), err_zero0 = Eigen::Quaterniond::Identity();
   bool att_window = false;
   double att_t0 = kNaN, att_t1 = kNaN;
@@ -155,23 +154,16 @@ Metrics evaluate_bias(const RunSetup& setup, const log::Metadata& meta, const Sa
     if (s.ref_q_wxyz.allFinite() && s.true_bias1_dps.allFinite() && s.true_bias2_dps.allFinite()) {
       const est::SampleOutput& out = filter.output();
       if (!att_dl.initialized()) {
+        // the true bias at the first sample, held: the filter fuses its rate with it
+        // (rate_body_fixed_dps), the same fusion as the corrected rate
+        est::Vector6d bias_at_start;
         bias_at_start << s.true_bias1_dps, s.true_bias2_dps;
+        filter.set_fixed_bias_dps(bias_at_start);
         att_dl.reset(s.q_enu_from_body(), s.t_s);
         att_zero.reset(s.q_enu_from_body(), s.t_s);
       } else {
-        // the same fusion as the filter's output: the sensors at rest, averaged
-        Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-        int k = 0;
-        if (std::isfinite(s.plat1_deg) && out.sensors_fused > 0) {
-          sum += filter.body_from_sensor(1, s.plat1_deg) * (s.gyro1_dps - bias_at_start.head<3>());
-          ++k;
-        }
-        if (std::isfinite(s.plat2_deg) && out.sensors_fused > 0) {
-          sum += filter.body_from_sensor(2, s.plat2_deg) * (s.gyro2_dps - bias_at_start.tail<3>());
-          ++k;
-        }
         att_dl.step(s.t_s, out.rate_body_dps);
-        att_zero.step(s.t_s, k > 0 ? Eigen::Vector3d(sum / k) : Eigen::Vector3d::Constant(kNaN));
+        att_zero.step(s.t_s, out.rate_body_fixed_dps);
       }
       const Eigen::Quaterniond q_ref = s.q_enu_from_body();
       const Eigen::Quaterniond e_dl = att_dl.q_enu_from_body() * q_ref.conjugate();
