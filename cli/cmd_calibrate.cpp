@@ -9,6 +9,7 @@
 #include <fmt/core.h>
 
 #include "cli/command.hpp"
+#include "estimator/output_file.hpp"
 #include "estimator/calibration.hpp"
 #include "estimator/log.hpp"
 #include "calibration/calib_file.hpp"
@@ -62,9 +63,7 @@ void print_summary(const est::CalibFit& fit, const calib::RigConditions& rig,
 void write_prior(const Options& o) {
   if (o.prior_out.empty()) return;
   const calib::CalibFile c = calib::load_calib(o.out);
-  std::ofstream f(o.prior_out);
-  f << calib::model_prior_yaml(c);
-  if (!f) throw std::runtime_error("cannot write --prior-out " + o.prior_out);
+  io::write_file(o.prior_out, calib::model_prior_yaml(c));
   fmt::print("wrote {} (model prior)\n", o.prior_out);
 }
 

@@ -16,6 +16,7 @@
 #include <fmt/core.h>
 
 #include "cli/command.hpp"
+#include "estimator/output_file.hpp"
 #include "cli/demo_checks.hpp"
 #include "twin/scenario.hpp"
 #include "twin/simulator.hpp"
@@ -44,10 +45,7 @@ constexpr double kVideoFps = 30.0;
 bool step_simulate(DemoContext& c) {
   std::filesystem::create_directories(c.dir / "sim");
   const auto resolved = c.dir / "sim" / "scenario.resolved.yaml";
-  {
-    std::ofstream y(resolved, std::ios::binary);
-    y << twin::emit_scenario(c.scenario);
-  }
+  io::write_file(resolved, twin::emit_scenario(c.scenario));
   Progress progress("demo: simulate");
   const double dur = c.scenario.duration_s;
   const auto r = twin::simulate_to_log(c.scenario, c.dir / "sim" / "log.csv", [&](double f) {

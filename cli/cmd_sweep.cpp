@@ -16,6 +16,7 @@
 #endif
 
 #include "cli/command.hpp"
+#include "estimator/output_file.hpp"
 #include "studies/jobs.hpp"
 #include "studies/sweep.hpp"
 
@@ -117,7 +118,8 @@ int run_sweep(const Options& opt) {
   }
   try {
     const SweepJob job =
-        make_job(cfg, opt.save_logs ? std::filesystem::path(opt.out) / "logs" : std::filesystem::path());
+        make_job(cfg, opt.save_logs ? std::filesystem::path(opt.out) / "logs" : std::filesystem::path(),
+                 &stop_requested());
     Progress progress(fmt::format("sweep {} (rank 0 share)", cfg.name));
     mine.results = run_parallel(
         specs, indices, job, threads,
@@ -185,11 +187,12 @@ int run_sweep(const Options& opt) {
   for (const auto& w : plot_warnings) fmt::print(stderr, "driftless sweep: warning: {}\n", w);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   {
-    std::ofstream t(std::filesystem::path(opt.out) / "timing.txt");
+    std::ostringstream t;
     t << "# wall time is not part of the table (not reproducible)\n"
       << "ranks: " << size << "\nthreads_per_rank: " << threads << "\nwall_s: " << wall
       << "\nsum_of_run_times_s: " << serial_s << "\nspeedup: " << (wall > 0 ? serial_s / wall : 0)
       << "\n";
+    io::write_file(std::filesystem::path(opt.out) / "timing.txt", t.str());
   }
   fmt::print("{} runs, {} failed; wall {:.1f} s, sum of run times {:.1f} s (speed-up {:.2f}x); "
              "table: {}/runs.csv, {}/summary.csv\n",

@@ -10,6 +10,7 @@
 
 #include "diagnose/report_plots.hpp"
 #include "diagnose/report_text.hpp"
+#include "estimator/output_file.hpp"
 #include "report/html.hpp"
 
 namespace driftless::diagnose {
@@ -159,12 +160,8 @@ std::string html(const CompareResult& r, const ReportExtras& x, const std::vecto
   return h.str();
 }
 
-void write_text(const std::filesystem::path& path, const std::string& text) {
-  std::ofstream f(path);
-  if (!f) throw std::runtime_error(fmt::format("cannot write {}", path.string()));
-  f << text;
-  if (!f) throw std::runtime_error(fmt::format("error writing {}", path.string()));
-}
+// through the one output helper (partial name, checked writes, rename)
+void write_text(const std::filesystem::path& path, const std::string& text) { io::write_file(path, text); }
 
 }  // namespace
 

@@ -1,10 +1,12 @@
 // The report's plots: gnuplot data and scripts under DIR/plots/, drawn to PNG.
-#include <fstream>
+
+#include <sstream>
 
 #include <fmt/core.h>
 
 #include "diagnose/report_plots.hpp"
 #include "diagnose/report_text.hpp"
+#include "estimator/output_file.hpp"
 #include "report/json.hpp"
 
 namespace driftless::diagnose {
@@ -18,12 +20,13 @@ std::string n(double v) { return report::json_number(v); }
 Plot residual_plot(const CompareResult& r, const std::filesystem::path& dir) {
   const auto dat = dir / "residual.dat";
   {
-    std::ofstream d(dat);
+    std::ostringstream d;
     for (std::size_t b = 0; b < r.block_t_s.size(); ++b) {
       d << fmt::format("{:.3f}", r.block_t_s[b]);
       for (int c = 0; c < 6; ++c) d << ' ' << n(r.block_residual_dps[c][b]) << ' ' << n(r.block_bias_dps[c][b]);
       d << '\n';
     }
+    io::write_file(dat, d.str());  // before gnuplot reads it
   }
   std::string s = "set termoption noenhanced\nset multiplot layout 3,1\nset xlabel 't (s)'\nset key outside right\n"
                   "set datafile missing 'null'\n";
@@ -44,12 +47,13 @@ Plot residual_plot(const CompareResult& r, const std::filesystem::path& dir) {
 Plot windows_plot(const CompareResult& r, const std::filesystem::path& dir) {
   const auto dat = dir / "windows.dat";
   {
-    std::ofstream d(dat);
+    std::ostringstream d;
     for (const auto& w : r.windows) {
       d << fmt::format("{:.3f}", 0.5 * (w.t0_s + w.t1_s));
       for (int c = 0; c < 6; ++c) d << ' ' << n(w.rms_dps[c]) << ' ' << n(r.channels[c].noise_floor_dps);
       d << '\n';
     }
+    io::write_file(dat, d.str());  // before gnuplot reads it
   }
   std::string s = "set termoption noenhanced\nset xlabel 't (s)'\nset ylabel 'rms (deg/s)'\nset yrange [0:*]\nset key outside right\n"
                   "set title 'windowed residual rms after the selected effects (dashed: the model noise floor)'\nplot ";
@@ -65,7 +69,7 @@ Plot windows_plot(const CompareResult& r, const std::filesystem::path& dir) {
 Plot allan_plot(const CompareResult& r, const std::filesystem::path& dir) {
   const auto dat = dir / "adev.dat";
   {
-    std::ofstream d(dat);
+    std::ostringstream d;
     std::size_t np = 0;
     for (const auto& ch : r.channels) np = std::max(np, ch.adev.points.size());
     for (std::size_t i = 0; i < np; ++i) {
@@ -81,6 +85,7 @@ Plot allan_plot(const CompareResult& r, const std::filesystem::path& dir) {
       }
       d << '\n';
     }
+    io::write_file(dat, d.str());  // before gnuplot reads it
   }
   std::string s = "set termoption noenhanced\nset multiplot layout 1,2\nset logscale xy\nset xlabel 'tau (s)'\nset ylabel 'ADEV (deg/s)'\n"
                   "set key bottom left\nset datafile missing 'null'\nset style fill transparent solid 0.2 noborder\n";
@@ -101,13 +106,14 @@ Plot allan_plot(const CompareResult& r, const std::filesystem::path& dir) {
 Plot regimes_plot(const CompareResult& r, const std::filesystem::path& dir) {
   const auto dat = dir / "regimes.dat";
   {
-    std::ofstream d(dat);
+    std::ostringstream d;
     for (const auto& g : r.regimes) {
       if (g.group == "flip" && g.name == "during flips") continue;  // no truth there: in the table only
       d << '"' << g.group << ": " << g.name << '"';
       for (int c = 0; c < 6; ++c) d << ' ' << n(g.rms_dps[c]);
       d << '\n';
     }
+    io::write_file(dat, d.str());  // before gnuplot reads it
   }
   std::string s = "set termoption noenhanced\nset style data histograms\nset style histogram clustered gap 1\n"
                   "set style fill solid 0.8\n"

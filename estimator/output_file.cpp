@@ -89,7 +89,8 @@ void CheckedFile::close() {
   if (!file_) return;
   std::FILE* f = file_.release();
   errno = 0;
-  const bool flushed = std::fflush(f) == 0;
+  // a write through get() (libpng) that failed earlier leaves the error flag set
+  const bool flushed = std::fflush(f) == 0 && std::ferror(f) == 0;
   const int flush_errno = errno;
   errno = 0;
   const bool closed = std::fclose(f) == 0;

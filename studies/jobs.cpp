@@ -10,6 +10,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "estimator/numbers.hpp"
+#include "estimator/output_file.hpp"
 #include "estimator/attitude.hpp"
 #include "estimator/geometry.hpp"
 #include "estimator/random.hpp"
@@ -125,12 +126,10 @@ RunSetup SetupBuilder::build(const RunSpec& spec) const {
 
 Metrics evaluate_bias(const RunSetup& setup, const log::Metadata& meta, const SampleSource& source,
                       const std::filesystem::path& attitude_csv) {
-  std::ofstream att_out;
-  if (!attitude_csv.empty()) {
-    att_out.open(attitude_csv);
-    if (!att_out) throw std::runtime_error("sweep: cannot write " + attitude_csv.string());
-    att_out << "t_s,err_driftless_deg,err_zeroed_deg\n";
-  }
+  // attitude.csv: collected here, written through the output helper when the run is done
+  const bool att_file = !attitude_csv.empty();
+  std::ostringstream att_out;
+  if (att_file) att_out << "t_s,err_driftless_deg,err_zeroed_deg\n";
   double next_att_out_s = 0.0;
   est::DriftlessFilter filter(setup.estimator, est::box_geometry_from_metadata(meta));
   const double eval_start =
@@ -178,8 +177,8 @@ Metrics evaluate_bias(const RunSetup& setup, const log::Metadata& meta, const Sa
         att_zero.reset(q_ref, s.t_s);
         err_dl0 = err_zero0 = Eigen::Quaterniond::Identity();
         next_att_out_s = s.t_s;
-        if (att_out.is_open()) att_out << s.t_s << ",nan,nan\n";  // gnuplot: break the lines
-      } else if (att_out.is_open() && s.t_s >= next_att_out_s) {
+        if (att_file) att_out << s.t_s << ",nan,nan\n";  // gnuplot: break the lines
+      } else if (att_file && s.t_s >= next_att_out_s) {
         att_out << s.t_s << ',' << geo::rotvec_rad(e_dl).norm() * kDegPerRad << ','
                 << geo::rotvec_rad(e_zero).norm() * kDegPerRad << '\n';
         next_att_out_s += 1.0;
@@ -207,6 +206,7 @@ Metrics evaluate_bias(const RunSetup& setup, const log::Metadata& meta, const Sa
     last_err = e;
     ++n;
   }
+  if (att_file) io::write_file(attitude_csv, att_out.str());
   if (n == 0) throw std::runtime_error("sweep: no samples after eval start (duration too short?)");
   Metrics m;
   m.emplace_back("bias_err_rms_dph", std::sqrt(sum2 / (6.0 * n)) * kDphPerDps);
@@ -307,11 +307,11 @@ Metrics evaluate_fdi(const RunSetup& setup, const log::Metadata& meta, const Sam
   return m;
 }
 
-SweepJob make_job(const SweepConfig& cfg, const std::filesystem::path& log_dir) {
+SweepJob make_job(const SweepConfig& cfg, const std::filesystem::path& log_dir, const std::atomic<bool>* stop) {
   auto builder = std::make_shared<SetupBuilder>(cfg);
   if (!log_dir.empty()) std::filesystem::create_directories(log_dir);
   const std::string runner = cfg.runner;
-  return [builder, runner, log_dir](const RunSpec& spec) {
+  return [builder, runner, log_dir, stop](const RunSpec& spec) {
     const RunSetup setup = builder->build(spec);
     std::unique_ptr<Simulator> sim;
     std::unique_ptr<twin::FastBox> box;
@@ -325,6 +325,13 @@ SweepJob make_job(const SweepConfig& cfg, const std::filesystem::path& log_dir) 
       box = std::make_unique<twin::FastBox>(setup.scenario);
       meta = box->metadata();
       next = [&](Sample& s) { return box->next(s); };
+    }
+    // a stop request ends the run in progress at its next sample (a 14 h run would otherwise finish first)
+    if (stop != nullptr) {
+      next = [inner = std::move(next), stop](Sample& s) {
+        if (stop->load(std::memory_order_relaxed)) throw std::runtime_error("stopped");
+        return inner(s);
+      };
     }
     std::unique_ptr<log::LogWriter> writer;
     SampleSource source = next;
