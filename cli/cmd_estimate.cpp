@@ -14,8 +14,10 @@
 
 #include "cli/command.hpp"
 #include "cli/estimate_figures.hpp"
+#include "cli/estimate_health.hpp"
 #include "estimator/calibration.hpp"
 #include "estimator/pipeline.hpp"
+#include "estimator/tune.hpp"
 #include "twin/calib/calib_file.hpp"
 
 namespace driftless::cli {
@@ -30,6 +32,8 @@ struct EstimateArgs {
   std::string config;
   std::string calib;  // calib.yaml from driftless calibrate (docs/calibration.md)
   bool plot = false;
+  bool strict = false;    // exit 1 on a degraded health verdict too (failed always exits 1)
+  std::string tune;       // "auto": noise density and bias wander from the log (docs/estimator.md section 6.2)
   double attitude_start_sigma_dps = est::EstimateRunOptions{}.attitude_start_sigma_dps;
 };
 
@@ -153,8 +157,20 @@ std::string json_figures(const std::vector<FigureOutcome>& figures) {
   return o + "]";
 }
 
+// "tune": what --tune auto measured (null without it)
+std::string json_tune(const est::TuneResult* t) {
+  if (t == nullptr) return "null";
+  return fmt::format("{{\"block_s\": {}, \"noise_block_pairs\": {}, \"noise_estimated\": {}, "
+                     "\"noise_density_dps_rthz\": {}, \"wander_pairs\": {}, \"q_estimated\": {}, "
+                     "\"q_dps2_per_s\": {}}}",
+                     json_number(t->block_s), t->noise_block_pairs, t->noise_estimated ? "true" : "false",
+                     json_number(t->noise_density_dps_rthz), t->wander_pairs, t->q_estimated ? "true" : "false",
+                     json_number(t->q_dps2_per_s));
+}
+
 void write_summary(const fs::path& path, const EstimateArgs& a, const est::EstimatorConfig& cfg,
-                   const est::EstimateSummary& s, const std::vector<FigureOutcome>& figures) {
+                   const est::EstimateSummary& s, const std::vector<FigureOutcome>& figures,
+                   const est::TuneResult* tune) {
   auto o = fmt::output_file(path.string());
   o.print("{{\n");
   o.print("  \"log\": {},\n", json_string(a.log));
@@ -198,6 +214,8 @@ void write_summary(const fs::path& path, const EstimateArgs& a, const est::Estim
     o.print("  }},\n");
   }
   o.print("  \"bias_error_rms_dps\": {},\n", json_number(s.truth.bias_error_rms_dps));
+  o.print("{},\n", health_json(s.health, cfg));
+  o.print("  \"tune\": {},\n", json_tune(tune));
   o.print("  \"figures\": {},\n", json_figures(figures));
   o.print("  \"warnings\": [");
   for (std::size_t i = 0; i < s.warnings.size(); ++i) o.print("{}{}", i ? ", " : "", json_string(s.warnings[i]));
@@ -205,6 +223,37 @@ void write_summary(const fs::path& path, const EstimateArgs& a, const est::Estim
 }
 
 bool stop_polled() { return stop_requested().load(); }
+
+// --tune auto: a first pass over the log measures N and K (docs/estimator.md section 6.2)
+est::TuneResult tune_config(const EstimateArgs& a, est::EstimatorConfig& cfg) {
+  log::LogReader first(a.log);
+  const est::TuneResult t = est::tune_from_log(first, cfg);
+  est::apply_tune(t, cfg);
+  cfg.validate();
+  fmt::print("tune auto: noise density {} ({} block pairs of {:g} s), bias random walk Q {} ({} revisits)\n",
+             t.noise_estimated ? fmt::format("{:.4g} deg/s/sqrt(Hz)", t.noise_density_dps_rthz)
+                               : "not measured, configured value kept",
+             t.noise_block_pairs, t.block_s,
+             t.q_estimated ? fmt::format("{:.4g} (deg/s)^2/s", t.q_dps2_per_s) : "not measured, configured value kept",
+             t.wander_pairs);
+  return t;
+}
+
+// the health verdict on the console; the exit code: failed always 1, degraded 1 with --strict
+int report_health(const EstimateArgs& a, const est::EstimatorConfig& cfg, const est::HealthReport& h) {
+  const auto lines = health_lines(h, cfg);
+  const bool bad = h.verdict != est::HealthVerdict::kOk;
+  for (const auto& l : lines) fmt::print(bad ? stderr : stdout, "{}{}\n", bad ? "driftless estimate: " : "  ", l);
+  if (h.verdict == est::HealthVerdict::kFailed) {
+    fmt::print(stderr, "driftless estimate: the filter never locked: the estimates are not usable (exit 1)\n");
+    return 1;
+  }
+  if (h.verdict == est::HealthVerdict::kDegraded && a.strict) {
+    fmt::print(stderr, "driftless estimate: health degraded and --strict given (exit 1)\n");
+    return 1;
+  }
+  return 0;
+}
 
 int run_estimate_cmd(const EstimateArgs& a) {
   est::EstimatorConfig cfg;
@@ -235,6 +284,8 @@ int run_estimate_cmd(const EstimateArgs& a) {
     if (c.has_g_sensitivity) cfg.calibration.G_dps_per_g = c.G_dps_per_g;
   }
   cfg.validate();
+  est::TuneResult tune;
+  if (a.tune == "auto") tune = tune_config(a, cfg);
 
   const bool truth = (reader.fields() & kFieldTrueBias) != 0;
   const bool attitude = (reader.fields() & kFieldRefQ) != 0;
@@ -283,7 +334,7 @@ int run_estimate_cmd(const EstimateArgs& a) {
   }
   auto final_summary = summary;
   final_summary.warnings = warnings;
-  write_summary(dir / "summary.json", a, cfg, final_summary, figures);
+  write_summary(dir / "summary.json", a, cfg, final_summary, figures, a.tune == "auto" ? &tune : nullptr);
 
   for (const auto& w : warnings) fmt::print(stderr, "driftless estimate: warning: {}\n", w);
   const auto& b = summary.bias_dps;
@@ -307,7 +358,8 @@ int run_estimate_cmd(const EstimateArgs& a) {
                summary.truth.nees_mean, summary.truth.nees_mean_band_lo, summary.truth.nees_mean_band_hi);
   }
   fmt::print("  wrote {}/{{estimate.csv, corrected.csv, attitude.csv, summary.json}}\n", a.out);
-  return 0;
+  std::fflush(stdout);
+  return report_health(a, cfg, summary.health);
 }
 
 const bool registered = register_command(30, [](CLI::App& app) {
@@ -336,6 +388,14 @@ const bool registered = register_command(30, [](CLI::App& app) {
   cmd->add_flag("--plot", a->plot,
                 "Also write Fig. 4 (bias vs truth, deg/s), Fig. 5 (Allan deviation, deg/s vs s) and "
                 "Fig. 9 (attitude error, deg vs s) as PNG + SVG with their gnuplot scripts");
+  cmd->add_flag("--strict", a->strict,
+                "Exit 1 when the health verdict is 'degraded' too (gate rejections, NIS outside its "
+                "band, unobservable components, re-locks); 'failed' (never locked) always exits 1");
+  cmd->add_option("--tune", a->tune,
+                  "auto: measure the noise density (deg/s/sqrt(Hz)) and the bias random walk "
+                  "((deg/s)^2/s) from the log's standstills in a first pass and use them instead of "
+                  "the configured ones; docs/estimator.md section 6.2")
+      ->check(CLI::IsMember({"auto"}));
   cmd->add_option("--attitude-start-sigma", a->attitude_start_sigma_dps,
                   "deg/s: the attitude comparison (attitude.csv, Fig. 9, drift in deg/h) starts once "
                   "every bias sigma is below this, i.e. once the filter has locked on; there the "
