@@ -11,10 +11,10 @@
 #include "cli/command.hpp"
 #include "estimator/calibration.hpp"
 #include "estimator/log.hpp"
-#include "twin/calib/calib_file.hpp"
-#include "twin/calib/prior.hpp"
-#include "twin/calib/rig_sim.hpp"
-#include "twin/calib/rig_plan.hpp"
+#include "calibration/calib_file.hpp"
+#include "calibration/prior.hpp"
+#include "calibration/rig_sim.hpp"
+#include "calibration/rig_plan.hpp"
 
 namespace driftless::cli {
 namespace {
@@ -29,8 +29,8 @@ est::CalibMethod parse_method(const std::string& m) {
   throw std::invalid_argument("--method: expected least_squares or top_to_top, got '" + m + "'");
 }
 
-void print_summary(const est::CalibFit& fit, const twin::calib::RigConditions& rig,
-                   const twin::calib::ExtractReport& rep, const est::GSensitivityFit& g) {
+void print_summary(const est::CalibFit& fit, const calib::RigConditions& rig,
+                   const calib::ExtractReport& rep, const est::GSensitivityFit& g) {
   fmt::print("calibration ({}), {} segments, Earth rate {}\n", est::method_name(fit.method),
              rig.plan.segments.size(), rep.earth_rate_removed ? "removed" : "NOT removed");
   for (const auto& n : rep.notes) fmt::print("  note: {}\n", n);
@@ -61,9 +61,9 @@ void print_summary(const est::CalibFit& fit, const twin::calib::RigConditions& r
 // --prior-out: the calibrated errors as a twin model-config file
 void write_prior(const Options& o) {
   if (o.prior_out.empty()) return;
-  const twin::calib::CalibFile c = twin::calib::load_calib(o.out);
+  const calib::CalibFile c = calib::load_calib(o.out);
   std::ofstream f(o.prior_out);
-  f << twin::calib::model_prior_yaml(c);
+  f << calib::model_prior_yaml(c);
   if (!f) throw std::runtime_error("cannot write --prior-out " + o.prior_out);
   fmt::print("wrote {} (model prior)\n", o.prior_out);
 }
@@ -71,14 +71,14 @@ void write_prior(const Options& o) {
 int run_from_log(const Options& o) {
   log::Metadata meta;
   const std::vector<Sample> samples = log::read_all(o.log, &meta);
-  const twin::calib::RigPlan plan = twin::calib::load_rig_plan(o.plan);
-  twin::calib::ExtractReport rep;
-  const auto segs = twin::calib::extract_segments(samples, meta, plan, o.log, &rep);
+  const calib::RigPlan plan = calib::load_rig_plan(o.plan);
+  calib::ExtractReport rep;
+  const auto segs = calib::extract_segments(samples, meta, plan, o.log, &rep);
   est::CalibFitOptions fo;
   fo.method = parse_method(o.method.empty() ? "least_squares" : o.method);
   const est::CalibFit fit = est::fit_calibration(segs, fo);
   const est::GSensitivityFit g = est::fit_g_sensitivity(segs, fit);
-  twin::calib::RigConditions rig;
+  calib::RigConditions rig;
   rig.source = "log " + o.log + ", plan " + o.plan;
   rig.latitude_deg = rep.latitude_deg;
   rig.sample_rate_hz = rep.sample_rate_hz;
@@ -88,7 +88,7 @@ int run_from_log(const Options& o) {
   rig.hinge2_axis = meta.hinge2_axis();
   rig.plan = plan;
   rig.samples_used = rep.samples_used;
-  twin::calib::save_calib(o.out, fit, rig, &g);
+  calib::save_calib(o.out, fit, rig, &g);
   print_summary(fit, rig, rep, g);
   fmt::print("wrote {}\n", o.out);
   write_prior(o);
@@ -96,11 +96,11 @@ int run_from_log(const Options& o) {
 }
 
 int run_from_scenario(const Options& o) {
-  const twin::calib::CalibScenario cs = twin::calib::load_calib_scenario(o.scenario);
-  twin::calib::RigRun run;
+  const calib::CalibScenario cs = calib::load_calib_scenario(o.scenario);
+  calib::RigRun run;
   {
     Progress progress("calibration rig");
-    run = twin::calib::run_rig(cs, [&](double f) {
+    run = calib::run_rig(cs, [&](double f) {
       progress.update(f);
       return !stop_requested().load();
     });
@@ -115,16 +115,16 @@ int run_from_scenario(const Options& o) {
     fmt::print("wrote {} (rig log)\n", o.save_log);
   }
   if (!o.save_plan.empty()) {
-    twin::calib::save_rig_plan(o.save_plan, run.plan);
+    calib::save_rig_plan(o.save_plan, run.plan);
     fmt::print("wrote {} (rig plan)\n", o.save_plan);
   }
-  twin::calib::ExtractReport rep;
-  const auto segs = twin::calib::extract_segments(run.samples, run.meta, run.plan, o.scenario, &rep);
+  calib::ExtractReport rep;
+  const auto segs = calib::extract_segments(run.samples, run.meta, run.plan, o.scenario, &rep);
   est::CalibFitOptions fo;
   fo.method = parse_method(o.method.empty() ? cs.rig.method : o.method);
   const est::CalibFit fit = est::fit_calibration(segs, fo);
   const est::GSensitivityFit g = est::fit_g_sensitivity(segs, fit);
-  twin::calib::RigConditions rig;
+  calib::RigConditions rig;
   rig.source = "scenario " + o.scenario + " (the twin's pan/tilt rig)";
   rig.latitude_deg = rep.latitude_deg;
   rig.sample_rate_hz = rep.sample_rate_hz;
@@ -134,7 +134,7 @@ int run_from_scenario(const Options& o) {
   rig.hinge2_axis = run.meta.hinge2_axis();
   rig.plan = run.plan;
   rig.samples_used = rep.samples_used;
-  twin::calib::save_calib(o.out, fit, rig, &g);
+  calib::save_calib(o.out, fit, rig, &g);
   print_summary(fit, rig, rep, g);
   // the fit against the twin's own true M, absolute and in units of the fit's 1-sigma
   double worst = 0.0, worst_sigma = 0.0;

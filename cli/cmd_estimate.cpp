@@ -12,13 +12,13 @@
 #include <fmt/format.h>
 #include <fmt/os.h>
 
+#include "calibration/calib_file.hpp"
 #include "cli/command.hpp"
 #include "cli/estimate_figures.hpp"
 #include "cli/estimate_health.hpp"
 #include "estimator/calibration.hpp"
 #include "estimator/pipeline.hpp"
 #include "estimator/tune.hpp"
-#include "twin/calib/calib_file.hpp"
 
 namespace driftless::cli {
 namespace {
@@ -268,7 +268,7 @@ int run_estimate_cmd(const EstimateArgs& a) {
   log::LogReader reader(a.log);
   // --calib: the calibrated matrices M replace R in eq. (1)-(2) (docs/calibration.md)
   if (!a.calib.empty()) {
-    const twin::calib::CalibFile c = twin::calib::load_calib(a.calib);
+    const calib::CalibFile c = calib::load_calib(a.calib);
     const auto& meta = reader.metadata();
     if ((c.hinge1_axis.normalized() - meta.hinge1_axis().normalized()).norm() > 1e-6 ||
         (c.hinge2_axis.normalized() - meta.hinge2_axis().normalized()).norm() > 1e-6) {

@@ -16,13 +16,13 @@
 #endif
 
 #include "cli/command.hpp"
-#include "twin/sweep/jobs.hpp"
-#include "twin/sweep/sweep.hpp"
+#include "studies/jobs.hpp"
+#include "studies/sweep.hpp"
 
 namespace driftless::cli {
 namespace {
 
-using namespace driftless::twin::sweep;
+using namespace driftless::studies;
 
 struct Options {
   std::string config;

@@ -19,6 +19,10 @@ endif()
 #   #include "estimator/log.hpp"   (and estimator/ never includes twin/, hil_bridge/ or renders/)
 set(DRIFTLESS_SOURCE_ROOT ${PROJECT_SOURCE_DIR})
 
+# the tests' temporary folder (TMPDIR), one per build tree
+set(DRIFTLESS_TEST_TMPDIR ${PROJECT_BINARY_DIR}/tmp)
+file(MAKE_DIRECTORY ${DRIFTLESS_TEST_TMPDIR})
+
 # driftless_add_test(name SOURCES ... LIBS ...): one GoogleTest binary registered with CTest.
 function(driftless_add_test name)
   cmake_parse_arguments(ARG "" "" "SOURCES;LIBS;LABELS" ${ARGN})
@@ -28,7 +32,10 @@ function(driftless_add_test name)
     DRIFTLESS_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
     DRIFTLESS_BINARY_DIR="${PROJECT_BINARY_DIR}")
   set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR}/tests)
-  gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60 PROPERTIES LABELS "${ARG_LABELS}"
+  # TMPDIR inside the build tree: two build trees (a second clone, the sanitizer build) running
+  # their suites at once never share a temporary file
+  gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60
+    PROPERTIES LABELS "${ARG_LABELS}" ENVIRONMENT "TMPDIR=${DRIFTLESS_TEST_TMPDIR}"
     WORKING_DIRECTORY ${PROJECT_BINARY_DIR})
 endfunction()
 

@@ -1077,7 +1077,7 @@ CompareResult compare(const Replay& r, const CompareModel& model, const CompareO
       // candidate LSBs: the model's, common full-scale ranges, and the data's smallest step
       std::vector<double> steps;
       if (p.quantization.enabled) steps.push_back(1.0 / p.quantization.sensitivity_lsb_per_dps);
-      for (double sens : {131.0, 65.5, 32.8, 16.4}) steps.push_back(1.0 / sens);
+      for (int fs_sel = 0; fs_sel < 4; ++fs_sel) steps.push_back(1.0 / mpu6050::gyro_lsb_per_dps(fs_sel));
       {
         std::vector<double> u(y.begin(), y.begin() + static_cast<std::ptrdiff_t>(std::min<std::size_t>(y.size(), 20000)));
         std::sort(u.begin(), u.end());
@@ -1549,11 +1549,11 @@ void apply_candidate(CompareModel& model, const Candidate& c) {
         if (sensor_of(p.name) == s && p.name.find("delay_s") != std::string::npos) delay = p.value;
       if (!std::isfinite(delay)) continue;
       SensorParams& p = model.sensor[s];
-      const double have = p.lowpass_latency.enabled ? mpu6050_dlpf(p.lowpass_latency.dlpf_cfg).gyro_delay_s : 0.0;
+      const double have = p.lowpass_latency.enabled ? mpu6050::dlpf_setting(p.lowpass_latency.dlpf_cfg).gyro_delay_s : 0.0;
       int best = 0;
       double err = kInf;
       for (int cfg = 0; cfg <= 6; ++cfg) {
-        const double d = std::abs(mpu6050_dlpf(cfg).gyro_delay_s - (have + delay));
+        const double d = std::abs(mpu6050::dlpf_setting(cfg).gyro_delay_s - (have + delay));
         if (d < err) { err = d; best = cfg; }
       }
       p.lowpass_latency.enabled = true;

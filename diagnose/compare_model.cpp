@@ -8,6 +8,7 @@
 #include <fmt/core.h>
 #include <mujoco/mujoco.h>
 
+#include "estimator/geometry.hpp"
 #include "twin/world.hpp"
 
 namespace driftless::diagnose {
@@ -220,8 +221,8 @@ SensorPrediction predict_sensor(const Replay& r, int s, const SensorParams& p, c
   // the error about the hinge axis relative to the logged angle (twin/world.hpp stop_rad)
   const Eigen::Vector2d err = (s == 0 ? box.stop1_error_deg : box.stop2_error_deg) +
                               Eigen::Vector2d(settled_offset_deg.row(s).transpose());  // [-stop, +stop]
-  const Eigen::Matrix3d Rt_minus = platform_rotation(r.hinge_axis[s], err[0]).transpose();
-  const Eigen::Matrix3d Rt_plus = platform_rotation(r.hinge_axis[s], err[1]).transpose();
+  const Eigen::Matrix3d Rt_minus = geo::rot_about_axis_deg(r.hinge_axis[s], err[0]).transpose();
+  const Eigen::Matrix3d Rt_plus = geo::rot_about_axis_deg(r.hinge_axis[s], err[1]).transpose();
   const bool stop_errors = err.cwiseAbs().maxCoeff() > 0.0;
   // time offset and the sensor's own sample delay: the sensor reads the truth of that long ago
   // (linear interpolation of the replayed truth)

@@ -1,5 +1,7 @@
 #include "diagnose/replay.hpp"
 
+#include "estimator/geometry.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -84,15 +86,6 @@ double median_dt(const std::vector<Raw>& raw) {
   auto mid = dt.begin() + static_cast<std::ptrdiff_t>(dt.size() / 2);
   std::nth_element(dt.begin(), mid, dt.end());
   return *mid;
-}
-
-// rotation vector (rad) of a unit quaternion
-Eigen::Vector3d rotation_vector(Eigen::Quaterniond q) {
-  if (q.w() < 0) q.coeffs() = -q.coeffs();
-  const Eigen::Vector3d v = q.vec();
-  const double s = v.norm();
-  if (s < 1e-12) return 2.0 * v;
-  return v * (2.0 * std::atan2(s, q.w()) / s);
 }
 
 // largest swing of a sensor's output inside rest intervals of both platforms, deg/s
@@ -238,11 +231,8 @@ Replay build(std::vector<Raw> raw, const log::Metadata& meta, std::uint32_t fiel
     raw[k].q.normalize();
   }
 
-  const double lat_rad = lat * kRadPerDeg;
-  const Eigen::Vector3d earth_enu =
-      kEarthRateRadps * Eigen::Vector3d(0, std::cos(lat_rad), std::sin(lat_rad));
-  const Eigen::Vector3d dearth_dlat_enu =
-      kEarthRateRadps * Eigen::Vector3d(0, -std::sin(lat_rad), std::cos(lat_rad));
+  const Eigen::Vector3d earth_enu = geo::earth_rate_enu_radps(lat);
+  const Eigen::Vector3d dearth_dlat_enu = geo::earth_rate_enu_dlat_radps_per_rad(lat);
   const Eigen::Vector3d g_enu(0, 0, kStandardGravityMps2);  // f = a - g, g = (0,0,-9.81)
 
   auto quat = [&](std::size_t k) {
@@ -268,7 +258,7 @@ Replay build(std::vector<Raw> raw, const log::Metadata& meta, std::uint32_t fiel
     std::vector<Eigen::Vector3d> mean_rate(n - 1);
     for (std::size_t k = 0; k + 1 < n; ++k) {
       const Eigen::Quaterniond dq = quat(k).conjugate() * quat(k + 1);
-      mean_rate[k] = rotation_vector(dq) / (out.t_s[k + 1] - out.t_s[k]);
+      mean_rate[k] = geo::rotvec_rad(dq) / (out.t_s[k + 1] - out.t_s[k]);
     }
     const std::vector<double> c = interval_mean_fir();
     const auto M = c.size();
@@ -422,7 +412,7 @@ Replay build(std::vector<Raw> raw, const log::Metadata& meta, std::uint32_t fiel
         out.usable[k] = 0;
         continue;
       }
-      const Eigen::Matrix3d R = platform_rotation(axis, ang);
+      const Eigen::Matrix3d R = geo::rot_about_axis_deg(axis, ang);
       const double rate = out.plat_rate_dps[s][k];
       out.w_radps[s][k] =
           R.transpose() * out.w_body_radps[k] + (std::isfinite(rate) ? rate : 0.0) * kRadPerDeg * axis;
@@ -466,9 +456,6 @@ void ReplayOptions::validate() const {
   }
 }
 
-Eigen::Matrix3d platform_rotation(const Eigen::Vector3d& axis, double angle_deg) {
-  return Eigen::AngleAxisd(angle_deg * kRadPerDeg, axis.normalized()).toRotationMatrix();
-}
 
 Replay replay_samples(const std::vector<Sample>& samples, const log::Metadata& meta,
                       std::uint32_t fields, const ReplayOptions& opt, const std::string& where) {

@@ -78,7 +78,4 @@ Replay replay_log(const std::filesystem::path& path, const ReplayOptions& opt);
 Replay replay_samples(const std::vector<Sample>& samples, const log::Metadata& meta,
                       std::uint32_t fields, const ReplayOptions& opt, const std::string& where);
 
-/// Rotation of platform s's sensor frame in box axes: R_i = Rot(a_i, theta_i).
-Eigen::Matrix3d platform_rotation(const Eigen::Vector3d& axis, double angle_deg);
-
 }  // namespace driftless::diagnose

@@ -1,13 +1,14 @@
 #include "estimator/attitude.hpp"
 
+#include "estimator/geometry.hpp"
+
 #include <algorithm>
 #include <cmath>
 
 namespace driftless::est {
 
 AttitudeIntegrator::AttitudeIntegrator(double latitude_deg) {
-  const double phi = (std::isfinite(latitude_deg) ? latitude_deg : 0.0) * kRadPerDeg;
-  w_ie_enu_ = kEarthRateRadps * Eigen::Vector3d(0.0, std::cos(phi), std::sin(phi));
+  w_ie_enu_ = geo::earth_rate_enu_radps(std::isfinite(latitude_deg) ? latitude_deg : 0.0);
 }
 
 void AttitudeIntegrator::reset(const Eigen::Quaterniond& q, double t_s) {
@@ -32,8 +33,7 @@ void AttitudeIntegrator::step(double t_s, const Eigen::Vector3d& rate_body_dps) 
     const Eigen::Vector3d w_ib = 0.5 * (w_now + w_prev);
     const Eigen::Vector3d w_nb = w_ib - q_.conjugate() * w_ie_enu_;
     const Eigen::Vector3d phi = w_nb * dt;
-    const double angle = phi.norm();
-    if (angle > 0.0) q_ = (q_ * Eigen::Quaterniond(Eigen::AngleAxisd(angle, phi / angle))).normalized();
+    q_ = (q_ * geo::quat_from_rotvec(phi)).normalized();
   }
   t_ = t_s;
   last_rate_radps_ = w_now;
@@ -47,22 +47,11 @@ Eigen::Vector3d roll_pitch_yaw_deg(const Eigen::Quaterniond& q) {
   return Eigen::Vector3d(roll, pitch, yaw) * kDegPerRad;
 }
 
-namespace {
-
-// the rotation vector (rad) of q, taking the shorter way round (angle in [0, pi])
-Eigen::Vector3d rotation_vector(Eigen::Quaterniond q) {
-  if (q.w() < 0.0) q.coeffs() = -q.coeffs();
-  const double vn = q.vec().norm();
-  return vn > 0.0 ? Eigen::Vector3d(q.vec() / vn * (2.0 * std::atan2(vn, q.w()))) : Eigen::Vector3d::Zero();
-}
-
-}  // namespace
-
 void ErrorAccumulator::add(const Eigen::Quaterniond& q_est, const Eigen::Quaterniond& q_ref) {
   const Eigen::Quaterniond err = q_est.normalized() * q_ref.normalized().conjugate();
   // after the first call: the error's increment in ENU; the starting error (normally none: both
   // start at ref) counts in full
-  acc_rad_ += rotation_vector(started_ ? Eigen::Quaterniond(err * last_err_.conjugate()) : err);
+  acc_rad_ += geo::rotvec_rad(started_ ? Eigen::Quaterniond(err * last_err_.conjugate()) : err);
   started_ = true;
   last_err_ = err;
 }
@@ -71,7 +60,7 @@ AttitudeError attitude_error(const Eigen::Quaterniond& q_est, const Eigen::Quate
   // the error rotation in ENU, E = q_est q_ref^-1, as a rotation vector: its Up part is the
   // heading error, its North/East parts the tilt (roll/pitch for a box facing north); unlike
   // Euler-angle differences this has no singularity at +-90 deg pitch
-  const Eigen::Vector3d phi = rotation_vector(q_est.normalized() * q_ref.normalized().conjugate());
+  const Eigen::Vector3d phi = geo::rotvec_rad(q_est.normalized() * q_ref.normalized().conjugate());
   AttitudeError e;
   e.roll_deg = phi.y() * kDegPerRad;     // about North
   e.pitch_deg = phi.x() * kDegPerRad;    // about East

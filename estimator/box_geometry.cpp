@@ -4,6 +4,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "estimator/geometry.hpp"
 #include "estimator/log.hpp"
 
 namespace driftless::est {
@@ -31,19 +32,11 @@ void BoxGeometry::validate() {
 }
 
 double eq5_position_deg(int pattern, int sensor, double flip_angle_deg) {
-  static constexpr int kSign1[4] = {+1, +1, -1, -1};
-  static constexpr int kSign2[4] = {+1, -1, -1, +1};
-  const int p = ((pattern % 4) + 4) % 4;
-  return flip_angle_deg * (sensor == 1 ? kSign1[p] : kSign2[p]);
+  const geo::FlipSigns s = geo::flip_cycle_at(pattern);
+  return flip_angle_deg * (sensor == 1 ? s.plat1 : s.plat2);
 }
 
-int eq5_pattern_of(double plat1_deg, double plat2_deg) {
-  const bool s1 = plat1_deg >= 0.0, s2 = plat2_deg >= 0.0;
-  if (s1 && s2) return 0;
-  if (s1 && !s2) return 1;
-  if (!s1 && !s2) return 2;
-  return 3;
-}
+int eq5_pattern_of(double plat1_deg, double plat2_deg) { return geo::flip_cycle_index(plat1_deg, plat2_deg); }
 
 BoxGeometry box_geometry_from_metadata(const log::Metadata& meta) {
   BoxGeometry g;

@@ -11,6 +11,7 @@
 #include <Eigen/Dense>
 #include <Eigen/SVD>
 
+#include "estimator/geometry.hpp"
 #include "estimator/sample.hpp"
 
 namespace driftless::est {
@@ -41,12 +42,6 @@ Eigen::Matrix3d nearest_rotation(const Eigen::Matrix3d& A) {
   Eigen::Matrix3d D = Eigen::Matrix3d::Identity();
   if ((svd.matrixU() * svd.matrixV().transpose()).determinant() < 0) D(2, 2) = -1.0;
   return svd.matrixU() * D * svd.matrixV().transpose();
-}
-
-// rotation vector (deg) of a rotation matrix
-Eigen::Vector3d rotvec_deg(const Eigen::Matrix3d& R) {
-  const Eigen::AngleAxisd aa(R);
-  return aa.axis() * aa.angle() * kDegPerRad;
 }
 
 // vec(M) covariance from vec(M_inv) covariance: dM = -M dM_inv M, vec(dM) = -(M^T kron M) vec(dM_inv)
@@ -249,16 +244,12 @@ std::string method_name(CalibMethod m) {
   return m == CalibMethod::kTopToTop ? "top_to_top" : "least_squares";
 }
 
-Eigen::Matrix3d rotation_deg(const Eigen::Vector3d& axis, double angle_deg) {
-  return Eigen::AngleAxisd(angle_deg * kRadPerDeg, axis.normalized()).toRotationMatrix();
-}
-
 CalibMatrices CalibMatrices::nominal(const Eigen::Vector3d& hinge1_axis,
                                      const Eigen::Vector3d& hinge2_axis) {
   CalibMatrices c;
   const Eigen::Vector3d axes[2] = {hinge1_axis, hinge2_axis};
   for (int i = 0; i < 2; ++i)
-    for (int p = 0; p < 2; ++p) c.M(i, p) = rotation_deg(axes[i], position_deg(p));
+    for (int p = 0; p < 2; ++p) c.M(i, p) = geo::rot_about_axis_deg(axes[i], position_deg(p));
   return c;
 }
 
@@ -362,7 +353,7 @@ CalibErrors describe_errors(const CalibMatrices& m, int sensor, const Eigen::Vec
   for (int p = 0; p < 2; ++p) {
     const Eigen::Matrix3d M = m.M(sensor, p);
     const Eigen::Matrix3d Minv = M.inverse();
-    const Eigen::Matrix3d R_nom = rotation_deg(a, position_deg(p));
+    const Eigen::Matrix3d R_nom = geo::rot_about_axis_deg(a, position_deg(p));
     Eigen::Vector3d dir[3];
     for (int j = 0; j < 3; ++j) {
       const Eigen::Vector3d row = Minv.row(j).transpose();
@@ -377,13 +368,13 @@ CalibErrors describe_errors(const CalibMatrices& m, int sensor, const Eigen::Vec
       nonorth[k] += 0.5 * (90.0 - std::acos(c) * kDegPerRad);
     }
     // rotation part of M (box_from_sensor) against the nominal, in box axes
-    e.tilt_box_deg[p] = rotvec_deg(nearest_rotation(M) * R_nom.transpose());
+    e.tilt_box_deg[p] = geo::rotvec_rad(Eigen::Matrix3d(nearest_rotation(M) * R_nom.transpose())) * kDegPerRad;
   }
   e.nonorthogonality_deg = nonorth;
   // travel: M_-90 M_+90^-1 = T_-90 T_+90^T = Rot(a, th_-90 - th_+90); against Rot(a, -180)
   const Eigen::Matrix3d X = m.M(sensor, kPosMinus90) * m.M(sensor, kPosPlus90).inverse();
-  const Eigen::Matrix3d D = rotation_deg(a, 180.0) * nearest_rotation(X);  // = Rot(a, -travel_err)
-  const Eigen::Vector3d rv = rotvec_deg(D);
+  const Eigen::Matrix3d D = geo::rot_about_axis_deg(a, 180.0) * nearest_rotation(X);  // = Rot(a, -travel_err)
+  const Eigen::Vector3d rv = geo::rotvec_rad(D) * kDegPerRad;
   e.travel_error_deg = -rv.dot(a);
   e.travel_offaxis_deg = (rv - rv.dot(a) * a).norm();
   return e;

@@ -25,6 +25,8 @@
 
 #include "estimator/filter.hpp"
 
+#include "estimator/geometry.hpp"
+
 namespace driftless::est {
 
 /// Index of a platform end stop in calibration tables: 0 = -90 deg, 1 = +90 deg.
@@ -36,9 +38,6 @@ inline constexpr double position_deg(int pos) { return pos == kPosPlus90 ? 90.0 
 int position_index(double plat_deg, double tol_deg = 10.0);
 /// "-90" / "+90".
 std::string position_name(int pos);
-
-/// Rotation about a unit axis by angle_deg (right-hand rule): R_box_from_sensor for a platform.
-Eigen::Matrix3d rotation_deg(const Eigen::Vector3d& axis, double angle_deg);
 
 /// The four calibrated matrices M_{i,p} (box_from_sensor), [sensor 0/1][position 0=-90, 1=+90].
 struct CalibMatrices {

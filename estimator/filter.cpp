@@ -8,6 +8,7 @@
 #include <Eigen/Geometry>
 #include <Eigen/LU>
 
+#include "estimator/geometry.hpp"
 #include "estimator/stats.hpp"
 #include "estimator/standstill.hpp"
 
@@ -15,10 +16,6 @@ namespace driftless::est {
 namespace {
 
 constexpr double kBiasInstabilityFactor = 0.6642824702679600;  // sqrt(2 ln 2 / pi)
-
-Eigen::Matrix3d rot_deg(const Eigen::Vector3d& axis, double deg) {
-  return Eigen::AngleAxisd(deg * kRadPerDeg, axis).toRotationMatrix();
-}
 
 bool finite(double v) { return std::isfinite(v); }
 
@@ -164,7 +161,7 @@ Eigen::Matrix3d DriftlessFilter::body_from_sensor(int sensor, double plat_deg) c
   const std::size_t i = sensor == 1 ? 0 : 1;
   if (cache_deg_[i] == plat_deg) return cache_M_[i];
   const auto& list = sensor == 1 ? cfg_.calibration.sensor1 : cfg_.calibration.sensor2;
-  Eigen::Matrix3d M = rot_deg(sensor == 1 ? box_.hinge1_axis : box_.hinge2_axis, plat_deg);
+  Eigen::Matrix3d M = geo::rot_about_axis_deg(sensor == 1 ? box_.hinge1_axis : box_.hinge2_axis, plat_deg);
   double best = cfg_.calibration.match_tolerance_deg;
   for (const auto& p : list) {
     const double d = std::fabs(p.plat_deg - plat_deg);

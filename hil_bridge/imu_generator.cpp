@@ -1,5 +1,8 @@
 #include "hil_bridge/imu_generator.hpp"
 
+#include "estimator/geometry.hpp"
+#include "estimator/random.hpp"
+
 #include <cmath>
 #include <stdexcept>
 
@@ -22,15 +25,14 @@ BoxAtRestGenerator::BoxAtRestGenerator(Params p, const EmulatedMotors* motors)
   p_.validate();
   p_.hinge1_axis.normalize();
   p_.hinge2_axis.normalize();
-  // one independent stream per sensor, so the two sensors never share noise
-  rng_[0].seed(p_.seed * 2 + 1);
-  rng_[1].seed(p_.seed * 2 + 2);
+  // the simulator's named streams, one per sensor, so the two sensors never share noise
+  rng_[0] = rnd::NormalStream(p_.seed, rnd::Stream::kSensor1);
+  rng_[1] = rnd::NormalStream(p_.seed, rnd::Stream::kSensor2);
 }
 
 Eigen::Vector3d BoxAtRestGenerator::body_rate_dps(double t_s) const {
-  // box at identity attitude in ENU: Earth rate Omega (0, cos phi, sin phi)
-  const double phi = p_.latitude_deg * kRadPerDeg;
-  Eigen::Vector3d w = kEarthRateRadps * kDegPerRad * Eigen::Vector3d(0.0, std::cos(phi), std::sin(phi));
+  // box at identity attitude in ENU: the Earth rate
+  Eigen::Vector3d w = geo::earth_rate_enu_radps(p_.latitude_deg) * kDegPerRad;
   if (p_.extra_rate_dps) w += p_.extra_rate_dps(t_s);
   return w;
 }
@@ -40,14 +42,14 @@ ImuReading BoxAtRestGenerator::sample(int sensor, double t_s) {
   const Eigen::Vector3d& axis = sensor == 0 ? p_.hinge1_axis : p_.hinge2_axis;
   const double angle_deg = motors_ ? motors_->angle_deg(sensor + 1, t_s) : 90.0;
   const double rate_dps = motors_ ? motors_->rate_dps(sensor + 1, t_s) : 0.0;
-  const Eigen::Matrix3d R = Eigen::AngleAxisd(angle_deg * kRadPerDeg, axis).toRotationMatrix();
+  const Eigen::Matrix3d R = geo::rot_about_axis_deg(axis, angle_deg);
 
-  std::normal_distribution<double> n01(0.0, 1.0);
-  auto& rng = rng_[i];
+  auto& n01 = rng_[i];
   // bias random walk, integrated over the time since this sensor's last sample
   if (!std::isnan(last_t_[i]) && t_s > last_t_[i] && p_.bias_walk_dps_rts > 0.0) {
     const double s = p_.bias_walk_dps_rts * std::sqrt(t_s - last_t_[i]);
-    walk_dps_[i] += s * Eigen::Vector3d(n01(rng), n01(rng), n01(rng));
+    const double wx = n01(), wy = n01(), wz = n01();  // in this order (argument order is unspecified)
+    walk_dps_[i] += s * Eigen::Vector3d(wx, wy, wz);
   }
   last_t_[i] = t_s;
   const double sigma = p_.noise_density_dps_rthz * std::sqrt(p_.sample_rate_hz);
@@ -55,8 +57,9 @@ ImuReading BoxAtRestGenerator::sample(int sensor, double t_s) {
   ImuReading r;
   r.true_bias_dps = p_.bias_dps[i] + walk_dps_[i];
   // y_i = R_i^T w_body + th_dot_i a_i + b_i + n_i
+  const double nx = n01(), ny = n01(), nz = n01();
   r.gyro_dps = R.transpose() * body_rate_dps(t_s) + rate_dps * axis + r.true_bias_dps +
-               sigma * Eigen::Vector3d(n01(rng), n01(rng), n01(rng));
+               sigma * Eigen::Vector3d(nx, ny, nz);
   // at rest the specific force points up (ENU z), box at identity attitude
   r.accel_mps2 = R.transpose() * Eigen::Vector3d(0.0, 0.0, kStandardGravityMps2);
   r.temp_c = p_.temp_c;

@@ -7,10 +7,10 @@
 #include <array>
 #include <cstdint>
 #include <functional>
-#include <random>
 
 #include <Eigen/Core>
 
+#include "estimator/random.hpp"
 #include "hil_bridge/motors.hpp"
 
 namespace driftless::hil {
@@ -59,7 +59,7 @@ class BoxAtRestGenerator final : public ImuGenerator {
  private:
   Params p_;
   const EmulatedMotors* motors_;
-  std::array<std::mt19937_64, 2> rng_;
+  std::array<rnd::NormalStream, 2> rng_;
   std::array<Eigen::Vector3d, 2> walk_dps_{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
   std::array<double, 2> last_t_{kNaN, kNaN};
 };

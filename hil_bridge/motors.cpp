@@ -1,5 +1,7 @@
 #include "hil_bridge/motors.hpp"
 
+#include "estimator/geometry.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -69,13 +71,13 @@ void FlipSchedule::Params::validate() const {
 FlipSchedule::FlipSchedule(Params p) : p_(p) { p_.validate(); }
 
 namespace {
-// the 4-cycle of (platform 1, platform 2) stop signs
-constexpr int kCycle[4][2] = {{+1, +1}, {-1, +1}, {-1, -1}, {+1, -1}};
 EndStop stop_of(int sign) { return sign > 0 ? EndStop::kPlus : EndStop::kMinus; }
 }  // namespace
 
 bool FlipSchedule::update(double t_s, Motors& motors, std::string* fault) {
-  const int* want = kCycle[phase_];
+  // the stop signs of the current position of eq. (5)'s cycle
+  const geo::FlipSigns cur = geo::flip_cycle_at(phase_);
+  const int want[2] = {cur.plat1, cur.plat2};
   const bool arrived =
       motors.end_stop(1) == stop_of(want[0]) && motors.end_stop(2) == stop_of(want[1]);
   if (std::isnan(since_s_)) {
@@ -104,9 +106,9 @@ bool FlipSchedule::update(double t_s, Motors& motors, std::string* fault) {
   }
   if (t_s - since_s_ >= p_.standstill_s) {
     const int next = (phase_ + 1) % 4;
-    for (int i = 0; i < 2; ++i) {
-      if (kCycle[next][i] != want[i]) motors.command(i + 1, kCycle[next][i]);
-    }
+    const int mover = geo::flip_cycle_mover(phase_);  // one platform moves per step
+    const geo::FlipSigns to = geo::flip_cycle_at(next);
+    motors.command(mover, mover == 1 ? to.plat1 : to.plat2);
     phase_ = next;
     moving_ = true;
     since_s_ = t_s;

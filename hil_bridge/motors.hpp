@@ -56,8 +56,9 @@ class EmulatedMotors final : public Motors {
   std::array<Move, 2> moves_;
 };
 
-/// Cycles the platforms through (+,+) -> (-,+) -> (-,-) -> (+,-) -> (+,+)...: one platform moves
-/// at a time and every pair of positions is held for standstill_s (the paper's k = 4n..4n+3).
+/// Cycles the platforms through eq. (5)'s positions (geo::kFlipCycle: (+,+) -> (+,-) -> (-,-) ->
+/// (-,+) -> (+,+)...): one platform moves at a time and every position is held for standstill_s
+/// (the paper's k = 4n..4n+3), in the same order as the twin's servos and the filter's paper mode.
 class FlipSchedule {
  public:
   struct Params {

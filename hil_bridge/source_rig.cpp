@@ -9,10 +9,8 @@
 #include "hil_bridge/replay_source.hpp"
 #include "hil_bridge/serial/firmware_emulator.hpp"
 #include "hil_bridge/serial/serial_source.hpp"
-#if DRIFTLESS_HIL_WITH_TWIN
 #include "hil_bridge/twin/sensor_model_generator.hpp"
 #include "hil_bridge/twin/twin_source.hpp"
-#endif
 
 namespace driftless::hil {
 
@@ -105,12 +103,8 @@ struct SerialRig final : SourceRig {
 std::unique_ptr<ImuGenerator> make_generator(const RigOptions& opt, const BoxAtRestGenerator::Params& gp,
                                              const EmulatedMotors* motors) {
   if (opt.emu_sensor.empty()) return std::make_unique<BoxAtRestGenerator>(gp, motors);
-#if DRIFTLESS_HIL_WITH_TWIN
   const twin::SensorParams sp = twin::sensor_preset(opt.emu_sensor);
   return std::make_unique<SensorModelGenerator>(sp, sp, opt.sample_rate_hz, opt.seed, gp, motors);
-#else
-  throw std::invalid_argument("hil: --emu-sensor needs the twin library, which this build lacks");
-#endif
 }
 
 }  // namespace
@@ -210,11 +204,7 @@ std::unique_ptr<SourceRig> make_source_rig(const std::string& spec, const RigOpt
     return rig;
   }
   if (spec == "twin") {
-#if DRIFTLESS_HIL_WITH_TWIN
     return make_twin_rig(opt);
-#else
-    throw std::invalid_argument("hil: the twin source needs the twin library, which this build lacks");
-#endif
   }
   throw std::invalid_argument("hil: unknown source '" + spec + "' (expected " + source_spec_help() + ")");
 }

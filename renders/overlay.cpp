@@ -1,5 +1,7 @@
 #include "renders/overlay.hpp"
 
+#include "estimator/geometry.hpp"
+
 #include <cmath>
 
 #include <Eigen/Geometry>
@@ -95,8 +97,8 @@ std::vector<TextRow> overlay_rows(const PlayState& p, const OverlayState& st) {
 }
 
 Eigen::Vector3d residual_dps(const Sample& s, const Eigen::Vector3d& a1, const Eigen::Vector3d& a2) {
-  const Eigen::Matrix3d R1 = Eigen::AngleAxisd(s.plat1_deg * kRadPerDeg, a1.normalized()).toRotationMatrix();
-  const Eigen::Matrix3d R2 = Eigen::AngleAxisd(s.plat2_deg * kRadPerDeg, a2.normalized()).toRotationMatrix();
+  const Eigen::Matrix3d R1 = geo::rot_about_axis_deg(a1, s.plat1_deg);
+  const Eigen::Matrix3d R2 = geo::rot_about_axis_deg(a2, s.plat2_deg);
   return R1 * s.gyro1_dps - R2 * s.gyro2_dps;
 }
 

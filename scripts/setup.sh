@@ -2,7 +2,7 @@
 # Install everything DriftLess Twin needs from Debian 12 packages. Idempotent: skips apt when all present.
 set -euo pipefail
 packages=(
-  build-essential cmake pkg-config ccache git
+  build-essential cmake pkg-config ccache git universal-ctags
   libmujoco-dev libqhull-dev libeigen3-dev libyaml-cpp-dev libosmesa6-dev
   libpng-dev libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev libfmt-dev libfast-float-dev
   ffmpeg gnuplot-nox openmpi-bin libopenmpi-dev

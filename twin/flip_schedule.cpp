@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "estimator/geometry.hpp"
 #include "estimator/sample.hpp"
 
 namespace driftless::twin {
@@ -82,8 +83,9 @@ void FlipController::update(double t, const Eigen::Vector2d& rate) {
     }
   }
   if (!external_ && !any_moving() && t >= next_flip_s_) {
-    // Fig. 3: platform 2 flips after (+,+) and (-,-), platform 1 after (+,-) and (-,+)
-    const int k = flips_ % 2 == 0 ? 1 : 0;
+    // Fig. 3 / eq. (5): the platform that moves from the current position of the flip cycle
+    // (platform 2 after (+,+) and (-,-), platform 1 after (+,-) and (-,+))
+    const int k = geo::flip_cycle_mover(geo::flip_cycle_index(sign_[0], sign_[1])) - 1;
     sign_[k] = -sign_[k];
     profile_[k] = TrapezoidProfile(t, ref_[k], target_for(k + 1, sign_[k]), vmax, amax);
     moving_[k] = true;

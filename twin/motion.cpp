@@ -8,22 +8,15 @@
 
 #include <fmt/core.h>
 
+#include "estimator/geometry.hpp"
+#include "estimator/random.hpp"
 #include "estimator/sample.hpp"
-#include "twin/rng.hpp"
 
 namespace driftless::twin {
 namespace {
 
 void require(bool ok, const std::string& what) {
   if (!ok) throw std::invalid_argument(what);
-}
-
-// rotation vector of a unit quaternion (shortest way), rad
-Eigen::Vector3d rotvec(Eigen::Quaterniond q) {
-  if (q.w() < 0) q.coeffs() = -q.coeffs();
-  const double n = q.vec().norm();
-  if (n < 1e-300) return Eigen::Vector3d::Zero();
-  return q.vec() * (2.0 * std::atan2(n, q.w()) / n);
 }
 
 Eigen::Quaterniond rz(double a) { return Eigen::Quaterniond(Eigen::AngleAxisd(a, Eigen::Vector3d::UnitZ())); }
@@ -87,7 +80,7 @@ double axis_angle(const std::vector<AxisMove>& moves, double t) {
   return m.from + m.dir * s;
 }
 
-std::vector<AxisMove> make_axis_moves(Rng& rng, double range_rad, double vmin, double vmax,
+std::vector<AxisMove> make_axis_moves(rnd::NormalStream& rng, double range_rad, double vmin, double vmax,
                                       double accel, double dwell_min, double dwell_max,
                                       double duration_s) {
   std::vector<AxisMove> moves;
@@ -125,7 +118,7 @@ class PanTiltMotion final : public Motion {
   PanTiltMotion(const PanTiltParams& p, double duration_s, std::uint64_t seed)
       : q_mount_(quat_from_ypr(p.mount_ypr_deg[0] * kRadPerDeg, p.mount_ypr_deg[1] * kRadPerDeg,
                                p.mount_ypr_deg[2] * kRadPerDeg)) {
-    Rng pan_rng(seed, 101), tilt_rng(seed, 102);
+    rnd::NormalStream pan_rng(seed, rnd::Stream::kPanMoves), tilt_rng(seed, rnd::Stream::kTiltMoves);
     pan_ = make_axis_moves(pan_rng, p.pan_range_deg * kRadPerDeg, p.min_rate_dps * kRadPerDeg,
                            p.max_rate_dps * kRadPerDeg, p.accel_dps2 * kRadPerDeg, p.dwell_min_s,
                            p.dwell_max_s, duration_s);
@@ -168,7 +161,7 @@ struct Bump {
 class GroundVehicleMotion final : public Motion {
  public:
   GroundVehicleMotion(const GroundVehicleParams& p, double duration_s, std::uint64_t seed) : p_(p) {
-    Rng rng(seed, 201);
+    rnd::NormalStream rng(seed, rnd::Stream::kVehicleDrive);
     DriveSegment cur;
     cur.psi0 = p.heading_deg * kRadPerDeg;
     double t = 0;
@@ -203,7 +196,7 @@ class GroundVehicleMotion final : public Motion {
       }
     }
     // bumps along the path: a Poisson process in distance
-    Rng bump_rng(seed, 202);
+    rnd::NormalStream bump_rng(seed, rnd::Stream::kVehicleBumps);
     const double total_s = cur.s0 + 100.0;
     if (p.bumps_per_km > 0 && p.bump_height_m > 0) {
       const double mean_gap = 1000.0 / p.bumps_per_km;
@@ -294,7 +287,7 @@ class GroundVehicleMotion final : public Motion {
 class ShipMotion final : public Motion {
  public:
   ShipMotion(const ShipParams& p, std::uint64_t seed) : p_(p) {
-    Rng rng(seed, 301);
+    rnd::NormalStream rng(seed, rnd::Stream::kShipPhases);
     for (double& ph : phase_) ph = rng.uniform(0, 2 * kPi);
   }
   void pose(double t, Eigen::Vector3d& p, Eigen::Quaterniond& q) const override {
@@ -405,10 +398,10 @@ MotionState Motion::at(double t) const {
   pose(t + H, pP, qP);
   pose(t - H, pM, qM);
   s.v_enu_mps = (pp - pm) / (2 * h);
-  s.w_body_radps = rotvec(qm.conjugate() * qp) / (2 * h);
+  s.w_body_radps = geo::rotvec_rad(qm.conjugate() * qp) / (2 * h);
   s.a_enu_mps2 = (pP - 2 * s.p_enu_m + pM) / (H * H);
-  const Eigen::Vector3d w_ahead = rotvec(s.q_enu_from_body.conjugate() * qP) / H;
-  const Eigen::Vector3d w_behind = rotvec(qM.conjugate() * s.q_enu_from_body) / H;
+  const Eigen::Vector3d w_ahead = geo::rotvec_rad(s.q_enu_from_body.conjugate() * qP) / H;
+  const Eigen::Vector3d w_behind = geo::rotvec_rad(qM.conjugate() * s.q_enu_from_body) / H;
   s.dw_body_radps2 = (w_ahead - w_behind) / H;
   return s;
 }

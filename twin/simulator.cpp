@@ -1,5 +1,8 @@
 #include "twin/simulator.hpp"
 
+#include "estimator/geometry.hpp"
+#include "estimator/random.hpp"
+
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -20,18 +23,13 @@ std::string vec_text(const Eigen::Vector3d& v) { return fmt::format("{} {} {}", 
 
 }  // namespace
 
-Eigen::Vector3d earth_rate_enu_radps(double latitude_deg) {
-  const double phi = latitude_deg * kRadPerDeg;
-  return kEarthRateRadps * Eigen::Vector3d(0.0, std::cos(phi), std::sin(phi));
-}
-
 Simulator::Simulator(const Scenario& scenario, SimOptions options)
     : scenario_((scenario.validate(), scenario)),
       options_(options),
       world_(scenario.model.box, scenario.physics_dt_s),
       motion_(make_motion(scenario.motion, scenario.duration_s, scenario.seed, scenario.base_dir)),
       flips_(scenario.flip_schedule, scenario.model.box),
-      earth_enu_radps_(earth_rate_enu_radps(scenario.latitude_deg)),
+      earth_enu_radps_(geo::earth_rate_enu_radps(scenario.latitude_deg)),
       steps_per_sample_(scenario.steps_per_sample()),
       total_(scenario.total_samples()) {
   if (scenario.model.time_offset_s < 0) {
@@ -41,8 +39,8 @@ Simulator::Simulator(const Scenario& scenario, SimOptions options)
         scenario.model.time_offset_s));
   }
   // each sensor draws its run-to-run values and noise from its own stream of the seed
-  sensors_.emplace_back(scenario.model.sensor1, scenario.sample_rate_hz, derive_seed(scenario.seed, 1001));
-  sensors_.emplace_back(scenario.model.sensor2, scenario.sample_rate_hz, derive_seed(scenario.seed, 1002));
+  sensors_.emplace_back(scenario.model.sensor1, scenario.sample_rate_hz, rnd::stream_seed(scenario.seed, rnd::Stream::kSensor1));
+  sensors_.emplace_back(scenario.model.sensor2, scenario.sample_rate_hz, rnd::stream_seed(scenario.seed, rnd::Stream::kSensor2));
   // initial state: box at its t = 0 pose, both platforms at rest on their + positions
   const MotionState m0 = motion_->at(0.0);
   world_.set_base(m0.p_enu_m, m0.q_enu_from_body, m0.v_enu_mps, m0.w_body_radps);

@@ -40,9 +40,6 @@ struct SimOptions {
   bool fast_standstill = true;
 };
 
-/// Earth rotation rate in ENU at latitude phi: Omega (0, cos phi, sin phi), rad/s.
-Eigen::Vector3d earth_rate_enu_radps(double latitude_deg);
-
 /// A running simulation of one scenario.
 class Simulator {
  public:

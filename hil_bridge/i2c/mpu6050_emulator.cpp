@@ -8,8 +8,6 @@ namespace driftless::hil {
 using namespace mpu6050;
 
 namespace {
-// gyro DLPF group delay, s, for DLPF_CFG 0..7 (register map table, section 4.3)
-constexpr std::array<double, 8> kGyroDelayS{0.00098, 0.0019, 0.0028, 0.0048, 0.0083, 0.0134, 0.0186, 0.00098};
 // more samples than this in one catch-up cannot all matter: the FIFO holds 73 records
 constexpr std::uint64_t kMaxCatchUp = 200;
 }  // namespace
@@ -32,7 +30,7 @@ double Mpu6050Emulator::sample_rate_hz() const {
   return mpu6050::sample_rate_hz(regs_[kConfig] & 7, regs_[kSmplrtDiv]);
 }
 
-double Mpu6050Emulator::gyro_delay_s() const { return kGyroDelayS[regs_[kConfig] & 7]; }
+double Mpu6050Emulator::gyro_delay_s() const { return gyro_dlpf_delay_s(regs_[kConfig] & 7); }
 
 void Mpu6050Emulator::reanchor() {
   t_anchor_s_ = clock_.now_s();

@@ -1,6 +1,7 @@
-// MPU-6050 register map (the subset the bridge uses) and the raw <-> physical conversions,
+// MPU-6050 register map (the subset the bridge uses) and the raw <-> register conversions,
 // after the InvenSense "MPU-6000/MPU-6050 Register Map and Descriptions" rev. 4.2.
-// Shared by the driver (i2c/mpu6050_driver) and the emulator (i2c/mpu6050_emulator).
+// Shared by the driver (i2c/mpu6050_driver) and the emulator (i2c/mpu6050_emulator). The
+// datasheet's numbers (sensitivities, rates, DLPF, temperature law) live in estimator/mpu6050.hpp.
 #pragma once
 
 #include <algorithm>
@@ -8,7 +9,16 @@
 #include <cmath>
 #include <cstdint>
 
+#include "estimator/mpu6050.hpp"
+
 namespace driftless::hil::mpu6050 {
+
+// the datasheet facts, under the register map's names
+using driftless::mpu6050::accel_lsb_per_g;
+using driftless::mpu6050::gyro_full_scale_dps;
+using driftless::mpu6050::gyro_lsb_per_dps;
+using driftless::mpu6050::gyro_output_rate_hz;
+using driftless::mpu6050::sample_rate_hz;
 
 // i2c addresses: AD0 low / high
 inline constexpr std::uint8_t kAddrAd0Low = 0x68;
@@ -48,34 +58,21 @@ inline constexpr int kFifoSizeBytes = 1024;
 // one FIFO record with accel + temp + gyro enabled: the same 14 bytes as a 0x3B..0x48 burst
 inline constexpr int kRecordBytes = 14;
 
-/// Gyro sensitivity, LSB per deg/s, for FS_SEL 0..3 (+-250, 500, 1000, 2000 deg/s).
-inline double gyro_lsb_per_dps(int fs_sel) {
-  constexpr std::array<double, 4> k{131.0, 65.5, 32.8, 16.4};
-  return k[static_cast<std::size_t>(fs_sel & 3)];
-}
-/// Gyro full scale, deg/s, for FS_SEL 0..3.
-inline double gyro_full_scale_dps(int fs_sel) { return 250.0 * (1 << (fs_sel & 3)); }
-/// Accelerometer sensitivity, LSB per g, for AFS_SEL 0..3 (+-2, 4, 8, 16 g).
-inline double accel_lsb_per_g(int afs_sel) { return 16384.0 / (1 << (afs_sel & 3)); }
-
-/// Gyroscope output rate before SMPLRT_DIV, Hz: 8 kHz with the DLPF off (DLPF_CFG 0 or 7), else 1 kHz.
-inline double gyro_output_rate_hz(int dlpf_cfg) {
-  return (dlpf_cfg & 7) == 0 || (dlpf_cfg & 7) == 7 ? 8000.0 : 1000.0;
-}
-/// Sample rate, Hz = gyro output rate / (1 + SMPLRT_DIV).
-inline double sample_rate_hz(int dlpf_cfg, int smplrt_div) {
-  return gyro_output_rate_hz(dlpf_cfg) / (1.0 + (smplrt_div & 0xFF));
-}
-/// Gyro DLPF bandwidth, Hz, for DLPF_CFG 0..6 (7 is reserved: treated as off).
+/// Gyro DLPF bandwidth, Hz, for DLPF_CFG 0..7 (7 is reserved: treated as off).
 inline double gyro_dlpf_bandwidth_hz(int dlpf_cfg) {
-  constexpr std::array<double, 8> k{256.0, 188.0, 98.0, 42.0, 20.0, 10.0, 5.0, 256.0};
-  return k[static_cast<std::size_t>(dlpf_cfg & 7)];
+  return driftless::mpu6050::kDlpfTable[static_cast<std::size_t>(driftless::mpu6050::effective_dlpf_cfg(dlpf_cfg))]
+      .gyro_bandwidth_hz;
+}
+/// Gyro DLPF group delay, s, for DLPF_CFG 0..7 (7 is reserved: treated as off).
+inline double gyro_dlpf_delay_s(int dlpf_cfg) {
+  return driftless::mpu6050::kDlpfTable[static_cast<std::size_t>(driftless::mpu6050::effective_dlpf_cfg(dlpf_cfg))]
+      .gyro_delay_s;
 }
 
-/// Temperature, degC, from the raw TEMP_OUT register: raw/340 + 36.53.
-inline double temp_c_from_raw(std::int16_t raw) { return raw / 340.0 + 36.53; }
-/// The inverse, rounded and clipped to int16.
-inline std::int16_t temp_raw_from_c(double temp_c);
+/// Temperature, degC, from the raw TEMP_OUT register.
+inline double temp_c_from_raw(std::int16_t raw) {
+  return raw / driftless::mpu6050::kTempLsbPerDegC + driftless::mpu6050::kTempOffsetDegC;
+}
 
 /// Rounds to the nearest int16, clipping at the ends (where a real ADC saturates).
 inline std::int16_t clip_round_i16(double v) {
@@ -83,7 +80,10 @@ inline std::int16_t clip_round_i16(double v) {
   const double r = std::nearbyint(v);
   return static_cast<std::int16_t>(std::clamp(r, -32768.0, 32767.0));
 }
-inline std::int16_t temp_raw_from_c(double temp_c) { return clip_round_i16((temp_c - 36.53) * 340.0); }
+/// The inverse of temp_c_from_raw, rounded and clipped to int16.
+inline std::int16_t temp_raw_from_c(double temp_c) {
+  return clip_round_i16((temp_c - driftless::mpu6050::kTempOffsetDegC) * driftless::mpu6050::kTempLsbPerDegC);
+}
 
 /// Big-endian int16 at p (the register order: high byte first).
 inline std::int16_t be16(const std::uint8_t* p) {

@@ -1,5 +1,8 @@
 #include "hil_bridge/twin/sensor_model_generator.hpp"
 
+#include "estimator/geometry.hpp"
+#include "estimator/random.hpp"
+
 #include <cmath>
 
 #include <Eigen/Geometry>
@@ -12,19 +15,18 @@ SensorModelGenerator::SensorModelGenerator(const twin::SensorParams& sensor1, co
     : box_(std::move(box)), motors_(motors) {
   box_.hinge1_axis.normalize();
   box_.hinge2_axis.normalize();
-  // one seed stream per sensor, so the two never share draws
-  models_[0] = std::make_unique<twin::SensorModel>(sensor1, sample_rate_hz, seed * 2 + 1);
-  models_[1] = std::make_unique<twin::SensorModel>(sensor2, sample_rate_hz, seed * 2 + 2);
+  // the simulator's named streams: the same seed emulates the same two units as `simulate`
+  models_[0] = std::make_unique<twin::SensorModel>(sensor1, sample_rate_hz, rnd::stream_seed(seed, rnd::Stream::kSensor1));
+  models_[1] = std::make_unique<twin::SensorModel>(sensor2, sample_rate_hz, rnd::stream_seed(seed, rnd::Stream::kSensor2));
 }
 
 ImuReading SensorModelGenerator::sample(int sensor, double t_s) {
   const Eigen::Vector3d& axis = sensor == 0 ? box_.hinge1_axis : box_.hinge2_axis;
   const double angle_deg = motors_ ? motors_->angle_deg(sensor + 1, t_s) : 90.0;
   const double rate_dps = motors_ ? motors_->rate_dps(sensor + 1, t_s) : 0.0;
-  const Eigen::Matrix3d R = Eigen::AngleAxisd(angle_deg * kRadPerDeg, axis).toRotationMatrix();
-  // box at identity attitude in ENU: Earth rate Omega (0, cos phi, sin phi), gravity reaction up
-  const double phi = box_.latitude_deg * kRadPerDeg;
-  Eigen::Vector3d w_body_radps = kEarthRateRadps * Eigen::Vector3d(0.0, std::cos(phi), std::sin(phi));
+  const Eigen::Matrix3d R = geo::rot_about_axis_deg(axis, angle_deg);
+  // box at identity attitude in ENU: Earth rate, gravity reaction up
+  Eigen::Vector3d w_body_radps = geo::earth_rate_enu_radps(box_.latitude_deg);
   if (box_.extra_rate_dps) w_body_radps += box_.extra_rate_dps(t_s) * kRadPerDeg;
   twin::SensorTruth truth;
   truth.t_s = t_s;

@@ -53,12 +53,12 @@ if "$bin" hil --source emu-serial --emu-sensor nosuchchip --out "$out/s2" --dura
   fail "emu-serial: unknown --emu-sensor accepted"
 fi
 
-# the twin with its servos commanded by the bridge's flip schedule: platform 1 flips first
+# the twin with its servos commanded by the bridge's flip schedule, in eq. (5)'s order (platform 2 first)
 "$bin" hil --source twin --twin-flips bridge --standstill 5 --duration 30 --out "$out/tb" > /dev/null
 grep -q "^# flip_control: bridge" "$out/tb/log.csv" || fail "twin bridge flips: metadata"
 # the positions the platforms rested at, in order (columns 8, 9: plat1_deg, plat2_deg)
 order=$(awk -F, '!/^#/ && $1 != "t" && $8 != "" && $9 != "" { p = ($8 + 0) "," ($9 + 0); if (p != last) { printf "%s ", p; last = p } }' "$out/tb/log.csv")
-[[ $order == "90,90 -90,90 -90,-90 90,-90 "* ]] || fail "twin bridge flips: positions '$order', expected the bridge's cycle 90,90 -90,90 -90,-90 90,-90"
+[[ $order == "90,90 90,-90 -90,-90 -90,90 "* ]] || fail "twin bridge flips: positions '$order', expected eq. (5)'s cycle 90,90 90,-90 -90,-90 -90,90"
 "$bin" check --log "$out/tb/log.csv" > "$out/tb.check" || fail "twin bridge flips: check"
 
 # a run killed mid-way (SIGKILL: no chance to finish) leaves a valid log that says so

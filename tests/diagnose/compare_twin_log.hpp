@@ -10,6 +10,7 @@
 #include <fmt/core.h>
 
 #include "diagnose/compare.hpp"
+#include "tests/temp_path.hpp"
 #include "twin/scenario.hpp"
 #include "twin/simulator.hpp"
 
@@ -44,8 +45,7 @@ inline Scenario scenario(const std::string& name, double duration_s, std::uint64
 
 /// Simulates `sc` into a log file named after `tag` in the temp folder; returns its path.
 inline std::filesystem::path simulate(const Scenario& sc, const std::string& tag) {
-  const auto path = std::filesystem::temp_directory_path() /
-                    fmt::format("driftless_twinlog_{}_{}_{}.csv", tag, sc.seed, static_cast<long>(sc.duration_s));
+  const auto path = test::temp_path(fmt::format("driftless_twinlog_{}_{}_{}.csv", tag, sc.seed, static_cast<long>(sc.duration_s)));
   simulate_to_log(sc, path);
   return path;
 }

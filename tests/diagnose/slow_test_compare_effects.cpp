@@ -68,7 +68,7 @@ TEST(CompareEffects, LowpassLatency) {
   c.log2.lowpass_latency.dlpf_cfg = 5;
   const auto r = run(c, 32);
   expect_top(r, "lowpass_latency");
-  const double want = mpu6050_dlpf(5).gyro_delay_s - mpu6050_dlpf(3).gyro_delay_s;
+  const double want = mpu6050::dlpf_setting(5).gyro_delay_s - mpu6050::dlpf_setting(3).gyro_delay_s;
   EXPECT_NEAR(param(r.ranking.front(), "s1.delay_s"), want, 0.2 * want);
   CompareModel m = default_compare_model();
   m.sensor = {c.model1, c.model2};

@@ -12,6 +12,8 @@
 
 #include "tests/diagnose/compare_twin_log.hpp"
 
+#include "tests/temp_path.hpp"
+
 namespace driftless::diagnose {
 
 using namespace driftless::twin;  // the sensor model, scenario and simulator
@@ -47,7 +49,7 @@ Outcome run(const Case& c) {
   if (o.before.verdict == "missing_effect" && o.before.ranking.front().applicable) {
     CompareModel upd = m;
     apply_candidate(upd, o.before.ranking.front());
-    const auto yaml = std::filesystem::temp_directory_path() / ("driftless_twin_" + c.effect + ".yaml");
+    const auto yaml = test::temp_path("driftless_twin_" + c.effect + ".yaml");
     save_compare_model(upd, yaml);
     o.after = compare(rp, load_compare_model(yaml), CompareOptions{});
     std::filesystem::remove(yaml);
@@ -201,7 +203,7 @@ TEST(CompareTwinEffects, LowpassLatency) {
   };
   c.effect = "lowpass_latency";
   c.param = "s1.delay_s";
-  c.truth = mpu6050_dlpf(5).gyro_delay_s - mpu6050_dlpf(3).gyro_delay_s;
+  c.truth = mpu6050::dlpf_setting(5).gyro_delay_s - mpu6050::dlpf_setting(3).gyro_delay_s;
   check(c);
 }
 

@@ -10,6 +10,7 @@
 #include "tests/diagnose/compare_test_log.hpp"
 #include "diagnose/compare.hpp"
 #include "diagnose/report.hpp"
+#include "tests/temp_path.hpp"
 
 namespace driftless::diagnose {
 
@@ -129,7 +130,7 @@ TEST(CompareReport, EmbeddedPlotsAreNonEmpty) {
   const Replay r = replay_samples(lg.samples, lg.meta, lg.fields, ReplayOptions{}, "t.csv");
   CompareModel m = default_compare_model();
   m.sensor = {p, p};
-  const auto dir = std::filesystem::temp_directory_path() / "driftless_report_plots_test";
+  const auto dir = test::temp_path("driftless_report_plots_test");
   std::filesystem::remove_all(dir);
   // WHEN the report is written
   write_report(compare(r, m, CompareOptions{}), dir);

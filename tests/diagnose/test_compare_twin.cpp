@@ -10,6 +10,8 @@
 
 #include "tests/diagnose/compare_twin_log.hpp"
 
+#include "tests/temp_path.hpp"
+
 namespace driftless::diagnose {
 
 using namespace driftless::twin;  // the sensor model, scenario and simulator
@@ -58,7 +60,7 @@ TEST(CompareTwin, ScaleFactorFoundAppliedThroughYaml) {
   // AND --apply writes a model that compare reads back, with the systematic residual gone
   CompareModel upd = m;
   apply_candidate(upd, best);
-  const auto yaml = std::filesystem::temp_directory_path() / "driftless_twin_scale_applied.yaml";
+  const auto yaml = test::temp_path("driftless_twin_scale_applied.yaml");
   save_compare_model(upd, yaml);
   const CompareModel back = load_compare_model(yaml);
   EXPECT_NEAR(back.sensor[0].scale_factor.value_pct[0], upd.sensor[0].scale_factor.value_pct[0], 1e-6);
@@ -87,7 +89,7 @@ TEST(CompareTwin, EndStopErrorFoundAndWrittenToTheBox) {
   // AND --apply writes it into model.box (a scenario simulate reads back) and the error falls
   CompareModel upd = m;
   apply_candidate(upd, best);
-  const auto yaml = std::filesystem::temp_directory_path() / "driftless_twin_stop_applied.yaml";
+  const auto yaml = test::temp_path("driftless_twin_stop_applied.yaml");
   save_compare_model(upd, yaml);
   const Scenario back_sc = load_scenario(yaml.string());
   EXPECT_NEAR(back_sc.model.box.stop2_error_deg[1], sc.model.box.stop2_error_deg[1], 0.1);

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "estimator/calibration.hpp"
+#include "estimator/geometry.hpp"
 #include "estimator/sample.hpp"
 
 namespace driftless::est {
@@ -22,7 +23,7 @@ struct Truth {
   double stop_error_deg[2][2];     // [sensor][pos]: actual angle = nominal + error
   Eigen::Vector3d bias_dps[2];
   Eigen::Matrix3d M_inv(int i, int p) const {
-    const Eigen::Matrix3d T = rotation_deg(hinge[i], position_deg(p) + stop_error_deg[i][p]);
+    const Eigen::Matrix3d T = geo::rot_about_axis_deg(hinge[i], position_deg(p) + stop_error_deg[i][p]);
     return C[i] * T.transpose();
   }
   CalibMatrices matrices() const {
@@ -42,7 +43,7 @@ Truth planted_truth() {
     Eigen::Matrix3d K = Eigen::Matrix3d::Zero();  // cross-coupling
     K << 0, 0.005, -0.005, 0.005 * sgn, 0, 0.005, -0.005, 0.005, 0;
     const Eigen::Matrix3d mount =
-        rotation_deg(Eigen::Vector3d(1.0, 1.0 * sgn, 0.5).normalized(), 1.0);  // 1 deg misalignment
+        geo::rot_about_axis_deg(Eigen::Vector3d(1.0, 1.0 * sgn, 0.5).normalized(), 1.0);  // 1 deg misalignment
     t.C[i] = (Eigen::Matrix3d::Identity() + scale.asDiagonal().toDenseMatrix()) *
              (Eigen::Matrix3d::Identity() + K) * mount.transpose();
     t.stop_error_deg[i][kPosMinus90] = 0.0;

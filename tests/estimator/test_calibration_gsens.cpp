@@ -4,6 +4,7 @@
 
 #include "estimator/calibration.hpp"
 #include "estimator/filter.hpp"
+#include "estimator/geometry.hpp"
 #include "estimator/log.hpp"
 
 namespace driftless::est {
@@ -30,7 +31,7 @@ Rig make_rig(const Eigen::Matrix3d G[2], const Eigen::Vector3d b0[2], const Eige
       const double temp = 25.0 + 0.1 * n;  // warming up through the rig
       for (int i = 0; i < 2; ++i) {
         // gravity (specific force up, 1 g) in sensor axes: R_box_from_sensor^T up
-        const Eigen::Vector3d f = rotation_deg(hinge[i], position_deg(p)).transpose() * up_box[o];
+        const Eigen::Vector3d f = geo::rot_about_axis_deg(hinge[i], position_deg(p)).transpose() * up_box[o];
         s.f_mean_g[static_cast<std::size_t>(i)] = f;
         s.temp_mean_c[static_cast<std::size_t>(i)] = with_temp ? temp : kNaN;
         SegmentBias b;

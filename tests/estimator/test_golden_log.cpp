@@ -10,6 +10,8 @@
 
 #include "tests/estimator/synth.hpp"
 
+#include "tests/temp_path.hpp"
+
 namespace driftless::test {
 namespace {
 
@@ -38,7 +40,7 @@ TEST(GoldenLogTest, RegeneratingTheGoldenLogGivesTheSameBytes) {
   const std::filesystem::path committed =
       std::filesystem::path(DRIFTLESS_SOURCE_DIR) / "tests/data/estimator_golden/log.csv";
   if (std::getenv("DRIFTLESS_UPDATE_GOLDEN") != nullptr) synth_log(golden_params(), committed);
-  const auto fresh = std::filesystem::temp_directory_path() / "driftless_golden_log.csv";
+  const auto fresh = test::temp_path("driftless_golden_log.csv");
   synth_log(golden_params(), fresh);
   ASSERT_TRUE(std::filesystem::exists(committed)) << committed;
   EXPECT_EQ(slurp(fresh), slurp(committed)) << "the synthetic generator changed; update on purpose "

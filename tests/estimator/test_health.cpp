@@ -8,18 +8,14 @@
 #include "estimator/health.hpp"
 #include "estimator/pipeline.hpp"
 #include "tests/estimator/synth.hpp"
+#include "tests/temp_path.hpp"
 
 namespace driftless::est {
 namespace {
 
-std::filesystem::path temp_path(const std::string& name) {
-  auto dir = std::filesystem::temp_directory_path() / "driftless_test_health";
-  std::filesystem::create_directories(dir);
-  return dir / name;
-}
 
 EstimateSummary run_synth(const test::SynthParams& p, const std::string& name, const EstimatorConfig& cfg = {}) {
-  const auto path = temp_path(name);
+  const auto path = test::temp_path(name);
   test::synth_log(p, path);
   log::LogReader reader(path);
   return run_estimate(reader, cfg, nullptr);

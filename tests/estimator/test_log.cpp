@@ -6,11 +6,13 @@
 
 #include "estimator/log.hpp"
 
+#include "tests/temp_path.hpp"
+
 namespace driftless::log {
 namespace {
 
 std::filesystem::path temp_file(const std::string& name) {
-  auto dir = std::filesystem::temp_directory_path() / "driftless_test_log";
+  auto dir = test::temp_path("driftless_test_log");
   std::filesystem::create_directories(dir);
   return dir / (name + "_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()));
 }

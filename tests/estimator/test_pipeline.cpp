@@ -5,12 +5,13 @@
 
 #include "estimator/pipeline.hpp"
 #include "tests/estimator/synth.hpp"
+#include "tests/temp_path.hpp"
 
 namespace driftless::est {
 namespace {
 
 std::filesystem::path temp_path(const std::string& name) {
-  auto dir = std::filesystem::temp_directory_path() / "driftless_test_pipeline";
+  auto dir = test::temp_path("driftless_test_pipeline");
   std::filesystem::create_directories(dir);
   return dir / name;
 }

@@ -7,6 +7,7 @@
 #include "estimator/pipeline.hpp"
 #include "estimator/standstill.hpp"
 #include "tests/estimator/synth.hpp"
+#include "tests/temp_path.hpp"
 
 namespace driftless::est {
 namespace {
@@ -88,7 +89,7 @@ TEST(StandstillTest, AWholeLogStandstillGivesAnUpdateAndSaysWhatStaysUnobservabl
   p.duration_s = 120.0;
   p.standstill_s = 1e9;  // one standstill for the whole log
   p.noise_sigma_dps = 0.05;
-  const auto path = std::filesystem::temp_directory_path() / "driftless_whole_log_standstill.csv";
+  const auto path = test::temp_path("driftless_whole_log_standstill.csv");
   test::synth_log(p, path);
   // WHEN estimate runs
   log::LogReader reader(path);
@@ -122,7 +123,7 @@ TEST(StandstillTest, ReLocksAreReportedWithTheirTime) {
   test::SynthParams p;
   p.duration_s = 600.0;
   p.noise_sigma_dps = 0.05;
-  const auto path = std::filesystem::temp_directory_path() / "driftless_relock_report.csv";
+  const auto path = test::temp_path("driftless_relock_report.csv");
   {
     log::LogWriter w(path, test::synth_metadata(p), kFieldTrueBias);
     test::synth_samples(p, [&](const Sample& s) {

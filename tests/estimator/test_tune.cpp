@@ -8,15 +8,11 @@
 #include "estimator/pipeline.hpp"
 #include "estimator/tune.hpp"
 #include "tests/estimator/synth.hpp"
+#include "tests/temp_path.hpp"
 
 namespace driftless::est {
 namespace {
 
-std::filesystem::path temp_path(const std::string& name) {
-  auto dir = std::filesystem::temp_directory_path() / "driftless_test_tune";
-  std::filesystem::create_directories(dir);
-  return dir / name;
-}
 
 // 10x the MPU6050's noise (N = 0.05 deg/s/sqrt(Hz)) and 5x its bias instability: a Gauss-Markov
 // wander with tau far above the revisit time acts as a random walk with K^2 = 2 sigma^2 / tau
@@ -69,7 +65,7 @@ TEST(TuneTest, TooLittleDataKeepsTheConfiguredValues) {
 TEST(TuneTest, AutoTunedFilterIsConsistentOnTenTimesTheNoise) {
   // GIVEN the noisy sensor's log and no configuration
   Noisy n(23, 1800.0);
-  const auto path = temp_path("noisy.csv");
+  const auto path = test::temp_path("noisy.csv");
   test::synth_log(n.p, path);
   log::LogReader untuned_reader(path);
   const auto untuned = run_estimate(untuned_reader, EstimatorConfig{}, nullptr);

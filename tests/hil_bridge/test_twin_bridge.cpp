@@ -11,8 +11,8 @@
 
 #include <gtest/gtest.h>
 
-#if DRIFTLESS_HIL_WITH_TWIN
 #include "estimator/filter.hpp"
+#include "estimator/geometry.hpp"
 #include "estimator/log.hpp"
 #include "hil_bridge/i2c/emulated_bus.hpp"
 #include "hil_bridge/i2c/i2c_source.hpp"
@@ -20,12 +20,11 @@
 #include "hil_bridge/source_rig.hpp"
 #include "hil_bridge/twin/sensor_model_generator.hpp"
 #include "hil_bridge/twin/twin_source.hpp"
-#endif
+#include "tests/temp_path.hpp"
 
 namespace driftless::hil {
 namespace {
 
-#if DRIFTLESS_HIL_WITH_TWIN
 TEST(TwinSource, StreamsTheSimulatorAtItsRate) {
   twin::Scenario sc = twin::default_scenario();
   sc.duration_s = 3.0;
@@ -158,7 +157,8 @@ TEST(TwinMotors, BridgeFlipScheduleDrivesTheTwinInTheLiveLoop) {
   rig->source->describe(meta);
   const std::filesystem::path path = std::filesystem::temp_directory_path() /
                                      ("driftless-twin-bridge-" + std::to_string(::getpid()) + ".csv");
-  est::DriftlessFilter filter(est::EstimatorConfig{}, est::box_geometry_from_metadata(meta));
+  // the paper's filter (mode: paper) expects eq. (5)'s order of positions
+  est::DriftlessFilter filter(est::paper_config(), est::box_geometry_from_metadata(meta));
   LiveStats st;
   {
     log::LogWriter writer(path, meta, rig->source->fields());
@@ -170,9 +170,8 @@ TEST(TwinMotors, BridgeFlipScheduleDrivesTheTwinInTheLiveLoop) {
     st = loop.run(*rig->source, nullptr, stop);
     writer.finish(st.complete, st.end_reason);
   }
-  // THEN the log holds every row and the platforms went through the bridge's cycle
-  // (+,+) -> (-,+) -> (-,-) -> (+,-) -> (+,+): platform 1 first, where the scenario's own
-  // schedule (Fig. 3) would have moved platform 2 first
+  // THEN the log holds every row and the platforms went through eq. (5)'s cycle
+  // (+,+) -> (+,-) -> (-,-) -> (-,+) -> (+,+), the same order as the twin's own schedule (Fig. 3)
   EXPECT_TRUE(st.complete);
   log::Metadata back;
   const std::vector<Sample> rows = log::read_all(path, &back);
@@ -185,14 +184,17 @@ TEST(TwinMotors, BridgeFlipScheduleDrivesTheTwinInTheLiveLoop) {
     if (positions.empty() || positions.back() != std::make_pair(s.plat1_deg, s.plat2_deg))
       positions.emplace_back(s.plat1_deg, s.plat2_deg);
   }
-  const std::vector<std::pair<double, double>> cycle = {{90, 90}, {-90, 90}, {-90, -90}, {90, -90}, {90, 90}};
   ASSERT_GE(positions.size(), 4u);
-  for (std::size_t i = 0; i < std::min(positions.size(), cycle.size()); ++i) {
-    EXPECT_EQ(positions[i], cycle[i]) << "position " << i;
+  for (std::size_t i = 0; i < positions.size(); ++i) {
+    const geo::FlipSigns want = geo::flip_cycle_at(static_cast<long long>(i));
+    EXPECT_EQ(positions[i], std::make_pair(90.0 * want.plat1, 90.0 * want.plat2)) << "position " << i;
   }
-  // the true MuJoCo angles follow the commands, and the estimator updated at the standstills
+  // the true MuJoCo angles follow the commands, and the paper-mode estimator updated at the
+  // standstills with every measured position where eq. (5) expects it
   EXPECT_NEAR(rows.back().true_plat1_deg, positions.back().first, 1.0);
   EXPECT_GE(filter.counters().updates, 3u);
+  EXPECT_EQ(filter.counters().schedule_mismatches, 0u);
+  EXPECT_EQ(filter.counters().rejected, 0u);
 }
 
 TEST(TwinMotors, ScenarioDrivenTwinRefusesCommands) {
@@ -215,7 +217,7 @@ std::vector<Sample> emu_serial_samples(const std::string& preset, std::size_t n)
   opt.emu_sensor = preset;
   opt.seed = 5;
   const std::string tag = "emu-sensor-" + preset + "-" + std::to_string(::getpid());
-  opt.work_dir = (std::filesystem::temp_directory_path() / tag).string();
+  opt.work_dir = test::temp_path(tag).string();
   std::filesystem::create_directories(opt.work_dir);
   auto rig = make_source_rig("emu-serial", opt);
   EXPECT_EQ(rig->start(), "");
@@ -270,9 +272,6 @@ TEST(EmuSerial, EmuSensorDrivesTheEmulatedMicrocontroller) {
   bad.emu_sensor = "no-such-chip";
   EXPECT_THROW(make_source_rig("emu-serial", bad), std::exception);
 }
-#else
-TEST(TwinBridge, NeedsTheTwinLibrary) { GTEST_SKIP() << "built without driftless::twin"; }
-#endif
 
 }  // namespace
 }  // namespace driftless::hil

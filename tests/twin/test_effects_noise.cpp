@@ -86,7 +86,7 @@ TEST(EffectsNoise, NoiseAliasesWhenTheDlpfIsWiderThanNyquist) {
   SensorModel m3(p, fs, 13);
   s2 = 0;
   for (int k = 0; k < n; ++k) s2 += std::pow(m3.step(SensorTruth{k / fs, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()}).gyro_radps[1] * kDegPerRad, 2);
-  const DlpfSetting d = mpu6050_dlpf(3);
+  const DlpfSetting d = mpu6050::dlpf_setting(3);
   const LowpassDesign lp = design_lowpass(d.gyro_bandwidth_hz, d.gyro_delay_s, fs);
   // variance gain of the IIR + two-tap delay: sum of squared impulse response
   double gain2 = 0, u_prev = 0;

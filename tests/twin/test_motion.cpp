@@ -7,13 +7,14 @@
 #include <gtest/gtest.h>
 
 #include "estimator/sample.hpp"
+#include "tests/temp_path.hpp"
 #include "twin/motion.hpp"
 
 namespace driftless::twin {
 namespace {
 
 std::filesystem::path temp_file(const std::string& name, const std::string& text) {
-  const auto dir = std::filesystem::temp_directory_path() / "driftless_test_motion";
+  const auto dir = test::temp_path("driftless_test_motion");
   std::filesystem::create_directories(dir);
   const auto p = dir / name;
   std::ofstream(p) << text;

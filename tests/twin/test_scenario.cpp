@@ -6,6 +6,8 @@
 
 #include "twin/scenario.hpp"
 
+#include "tests/temp_path.hpp"
+
 namespace driftless::twin {
 namespace {
 
@@ -105,7 +107,7 @@ TEST(Scenario, MissingFileSaysSo) {
 }
 
 TEST(Scenario, ModelFileHoldsOnlyTheModel) {
-  const auto dir = std::filesystem::temp_directory_path() / "driftless_test_scenario";
+  const auto dir = test::temp_path("driftless_test_scenario");
   std::filesystem::create_directories(dir);
   std::ofstream(dir / "model.yaml") << "model:\n  box:\n    end_stop_deg: 80\n";
   const ModelConfig m = load_model_config(dir / "model.yaml", ModelConfig{});

@@ -206,7 +206,7 @@ TEST(SensorModel, DlpfGroupDelayMatchesTheDatasheet) {
       p.lowpass_latency.enabled = true;
       p.lowpass_latency.dlpf_cfg = cfg;
       SensorModel m(p, fs, 1);
-      const DlpfSetting d = mpu6050_dlpf(cfg);
+      const DlpfSetting d = mpu6050::dlpf_setting(cfg);
       EXPECT_NEAR(m.gyro_lowpass().dc_group_delay_s(fs), d.gyro_delay_s, 1e-15);
       EXPECT_NEAR(m.accel_lowpass().dc_group_delay_s(fs), d.accel_delay_s, 1e-15);
       const double slope = 0.5;  // rad/s per s
@@ -230,7 +230,7 @@ TEST(SensorModel, DlpfGroupDelayMatchesTheDatasheet) {
 TEST(SensorModel, ContinuousDlpfDelayFollowsTheDatasheetRelation) {
   // GIVEN the datasheet rows: a continuous delay equal to a row's gives that row's bandwidth
   for (int cfg = 0; cfg <= 6; ++cfg) {
-    const DlpfSetting d = mpu6050_dlpf(cfg);
+    const DlpfSetting d = mpu6050::dlpf_setting(cfg);
     EXPECT_NEAR(mpu6050_gyro_bandwidth_for_delay_hz(d.gyro_delay_s), d.gyro_bandwidth_hz, 1e-9 * d.gyro_bandwidth_hz);
   }
   // between rows the bandwidth falls monotonically, and halfway in log delay it is the
@@ -241,7 +241,7 @@ TEST(SensorModel, ContinuousDlpfDelayFollowsTheDatasheetRelation) {
     EXPECT_LT(bw, last) << delay_ms;
     last = bw;
   }
-  const DlpfSetting a = mpu6050_dlpf(3), b = mpu6050_dlpf(4);
+  const DlpfSetting a = mpu6050::dlpf_setting(3), b = mpu6050::dlpf_setting(4);
   EXPECT_NEAR(mpu6050_gyro_bandwidth_for_delay_hz(std::sqrt(a.gyro_delay_s * b.gyro_delay_s)),
               std::sqrt(a.gyro_bandwidth_hz * b.gyro_bandwidth_hz), 1e-9);
   // WHEN the model runs a continuous delay (no matching row) on a ramp
@@ -292,7 +292,7 @@ TEST(SensorModel, SampleDelayShiftsTheTruthOnly) {
   // THEN the output is the truth of 15 ms ago (gyro and accelerometer), and the delays add
   EXPECT_NEAR(r.gyro_radps[2], slope * (3.0 - 0.015), 1e-12);
   EXPECT_NEAR(r.accel_mps2[1], slope * (3.0 - 0.015), 1e-12);
-  EXPECT_NEAR(rq.gyro_radps[0], slope * (3.0 - 0.015 - mpu6050_dlpf(3).gyro_delay_s), 1e-10);
+  EXPECT_NEAR(rq.gyro_radps[0], slope * (3.0 - 0.015 - mpu6050::dlpf_setting(3).gyro_delay_s), 1e-10);
   // AND a constant input is untouched from the first sample on (the delay line starts full)
   SensorModel c(p, kFs, 1);
   EXPECT_NEAR(c.step(truth_at(0.0, dps(3, 2, 1))).gyro_radps[1], 2.0 * kRadPerDeg, 1e-15);

@@ -7,6 +7,8 @@
 #include <gtest/gtest.h>
 
 #include "estimator/log.hpp"
+#include "estimator/geometry.hpp"
+#include "tests/temp_path.hpp"
 #include "tests/twin/mujoco_fixture.hpp"
 #include "twin/simulator.hpp"
 
@@ -55,10 +57,10 @@ TEST_F(SimulatorTest, StaticBoxSeesTheEarthRate) {
   Sample s;
   ASSERT_TRUE(sim.next(s));
   const Eigen::Quaterniond q = quat_from_ypr(30 * kRadPerDeg, 20 * kRadPerDeg, -10 * kRadPerDeg);
-  const Eigen::Vector3d expected = q.conjugate() * earth_rate_enu_radps(52.0);
+  const Eigen::Vector3d expected = q.conjugate() * geo::earth_rate_enu_radps(52.0);
   EXPECT_LT((sim.truth().w_body_radps - expected).norm(), 1e-15);
   EXPECT_NEAR(s.true_rate_body_dps.norm() * 3600.0, 15.041, 0.001);
-  EXPECT_NEAR(earth_rate_enu_radps(52.0).z(), kEarthRateRadps * std::sin(52 * kRadPerDeg), 0);
+  EXPECT_NEAR(geo::earth_rate_enu_radps(52.0).z(), kEarthRateRadps * std::sin(52 * kRadPerDeg), 0);
 }
 
 // GIVEN a static box, WHEN platforms rest and flip, THEN each gyro's truth is R_i^T w_body at
@@ -122,7 +124,7 @@ std::string slurp(const std::filesystem::path& p) {
 }
 
 TEST_F(SimulatorTest, SameSeedGivesAByteIdenticalLog) {
-  const auto dir = std::filesystem::temp_directory_path() / "driftless_test_sim";
+  const auto dir = test::temp_path("driftless_test_sim");
   std::filesystem::create_directories(dir);
   Scenario sc = load_scenario("vehicle");
   sc.duration_s = 6;
@@ -142,7 +144,7 @@ TEST_F(SimulatorTest, SameSeedGivesAByteIdenticalLog) {
 }
 
 TEST_F(SimulatorTest, StoppedRunLeavesAValidIncompleteLog) {
-  const auto dir = std::filesystem::temp_directory_path() / "driftless_test_sim";
+  const auto dir = test::temp_path("driftless_test_sim");
   std::filesystem::create_directories(dir);
   const auto r = simulate_to_log(short_static(30), dir / "stopped.csv", [](double f) { return f < 0.1; });
   EXPECT_FALSE(r.complete);

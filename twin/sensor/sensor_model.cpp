@@ -80,49 +80,7 @@ double accel_adc_axis_mps2(const AccelQuantizationParams& q, double a) {
 
 }  // namespace
 
-// ---- random streams ----
-
-std::uint64_t derive_seed(std::uint64_t seed, std::uint64_t stream) {
-  auto mix = [](std::uint64_t z) {  // splitmix64 finaliser
-    z += 0x9E3779B97F4A7C15ull;
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-  };
-  return mix(mix(seed) ^ mix(stream * 0xD1B54A32D192ED03ull + 0x632BE59BD9B4E019ull));
-}
-
-double NormalStream::operator()() {
-  if (has_spare_) {
-    has_spare_ = false;
-    return spare_;
-  }
-  double u, v, s;
-  do {
-    u = 2.0 * uniform() - 1.0;
-    v = 2.0 * uniform() - 1.0;
-    s = u * u + v * v;
-  } while (s >= 1.0 || s == 0.0);
-  const double m = std::sqrt(-2.0 * std::log(s) / s);
-  spare_ = v * m;
-  has_spare_ = true;
-  return u * m;
-}
-
 // ---- DLPF ----
-
-DlpfSetting mpu6050_dlpf(int cfg) {
-  // MPU-6000/6050 register map rev 4.2, register 26 (CONFIG): bandwidth Hz, delay ms
-  static const DlpfSetting table[7] = {
-      {260.0, 0.0e-3, 256.0, 0.98e-3}, {184.0, 2.0e-3, 188.0, 1.9e-3},
-      {94.0, 3.0e-3, 98.0, 2.8e-3},    {44.0, 4.9e-3, 42.0, 4.8e-3},
-      {21.0, 8.5e-3, 20.0, 8.3e-3},    {10.0, 13.8e-3, 10.0, 13.4e-3},
-      {5.0, 19.0e-3, 5.0, 18.6e-3},
-  };
-  if (cfg < 0 || cfg > 6)
-    throw std::invalid_argument("MPU6050 dlpf_cfg must be 0..6, got " + std::to_string(cfg));
-  return table[cfg];
-}
 
 double mpu6050_gyro_bandwidth_for_delay_hz(double delay_s) {
   if (!(delay_s > 0.0) || !std::isfinite(delay_s))
@@ -132,15 +90,15 @@ double mpu6050_gyro_bandwidth_for_delay_hz(double delay_s) {
   constexpr int kRows = 7;
   const double x = std::log(delay_s);
   int i = 0;
-  while (i + 2 < kRows && x > std::log(mpu6050_dlpf(i + 1).gyro_delay_s)) ++i;
-  const DlpfSetting a = mpu6050_dlpf(i), b = mpu6050_dlpf(i + 1);
+  while (i + 2 < kRows && x > std::log(mpu6050::dlpf_setting(i + 1).gyro_delay_s)) ++i;
+  const DlpfSetting a = mpu6050::dlpf_setting(i), b = mpu6050::dlpf_setting(i + 1);
   const double xa = std::log(a.gyro_delay_s), xb = std::log(b.gyro_delay_s);
   const double u = (x - xa) / (xb - xa);
   return std::exp(std::log(a.gyro_bandwidth_hz) + u * (std::log(b.gyro_bandwidth_hz) - std::log(a.gyro_bandwidth_hz)));
 }
 
 DlpfSetting lowpass_setting(const LowpassLatencyParams& p) {
-  if (!(p.delay_s > 0.0)) return mpu6050_dlpf(p.dlpf_cfg);
+  if (!(p.delay_s > 0.0)) return mpu6050::dlpf_setting(p.dlpf_cfg);
   const double bw = p.bandwidth_hz > 0.0 ? p.bandwidth_hz : mpu6050_gyro_bandwidth_for_delay_hz(p.delay_s);
   return {bw, p.delay_s, bw, p.delay_s};
 }

@@ -5,12 +5,15 @@
 
 #include <array>
 #include <cstdint>
-#include <random>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include <Eigen/Core>
+
+#include "estimator/mpu6050.hpp"
+
+#include "estimator/random.hpp"
 
 namespace YAML {
 class Node;
@@ -107,15 +110,16 @@ struct TemperatureParams {
   Eigen::Vector3d bias_tc_sigma_dps_per_degc = Eigen::Vector3d::Zero();
   Eigen::Vector3d scale_tc_pct_per_degc = Eigen::Vector3d::Zero();
   Eigen::Vector3d scale_tc_sigma_pct_per_degc = Eigen::Vector3d::Zero();
-  double output_sensitivity_lsb_per_degc = 340.0;  // temp register: T = code / 340 + 36.53
-  double output_offset_degc = 36.53;
+  // temp register: T = code / 340 + 36.53 (datasheet)
+  double output_sensitivity_lsb_per_degc = mpu6050::kTempLsbPerDegC;
+  double output_offset_degc = mpu6050::kTempOffsetDegC;
   bool operator==(const TemperatureParams&) const = default;
 };
 
 /// 9a quantization: code = round(y * sensitivity), output = code / sensitivity.
 struct QuantizationParams {
   bool enabled = true;
-  double sensitivity_lsb_per_dps = 131.0;
+  double sensitivity_lsb_per_dps = mpu6050::gyro_lsb_per_dps(0);  // FS_SEL 0
   bool operator==(const QuantizationParams&) const = default;
 };
 
@@ -201,7 +205,7 @@ struct AccelScaleFactorParams {
 /// accel_quantization: LSB grid and clip at +-full scale.
 struct AccelQuantizationParams {
   bool enabled = true;
-  double sensitivity_lsb_per_g = 16384.0;
+  double sensitivity_lsb_per_g = mpu6050::accel_lsb_per_g(0);  // AFS_SEL 0
   double full_scale_g = 2.0;
   bool operator==(const AccelQuantizationParams&) const = default;
 };
@@ -257,30 +261,12 @@ void emit_sensor_params(YAML::Emitter& out, const SensorParams& p);
 
 // ---- building blocks the model uses, public for tests, compare and diagnosis ----
 
-/// A seed for sub-stream `stream` of `seed` (splitmix64 mix; streams never collide in practice).
-std::uint64_t derive_seed(std::uint64_t seed, std::uint64_t stream);
+/// The one random-number module (estimator/random.hpp), under the names the sensor model uses.
+using rnd::derive_seed;
+using rnd::NormalStream;
 
-/// Portable standard-normal stream: mt19937_64 + Marsaglia polar (same numbers on every platform).
-class NormalStream {
- public:
-  explicit NormalStream(std::uint64_t seed = 0) : engine_(seed) {}
-  /// Next N(0,1) draw.
-  double operator()();
-  /// Next uniform draw in [0, 1).
-  double uniform() { return static_cast<double>(engine_() >> 11) * 0x1.0p-53; }
-
- private:
-  std::mt19937_64 engine_;
-  double spare_ = 0.0;
-  bool has_spare_ = false;
-};
-
-/// One row of the MPU6050 DLPF_CFG table (register 26), datasheet rev 3.4 section 4.6.
-struct DlpfSetting {
-  double accel_bandwidth_hz, accel_delay_s, gyro_bandwidth_hz, gyro_delay_s;
-};
-/// The DLPF table row for cfg 0..6; throws std::invalid_argument otherwise.
-DlpfSetting mpu6050_dlpf(int dlpf_cfg);
+/// The MPU6050 DLPF_CFG table row (estimator/mpu6050.hpp, the one copy of the datasheet).
+using mpu6050::DlpfSetting;
 
 /// Gyro bandwidth, Hz, that the MPU6050 datasheet pairs with a DLPF group delay `delay_s` (> 0):
 /// log-log interpolation between the DLPF_CFG rows, their end segments extended beyond them.

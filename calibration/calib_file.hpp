@@ -1,0 +1,57 @@
+// calib.yaml: the calibrated matrices M per sensor and end stop, their 1-sigma, the fit residuals
+// and the rig conditions. Written by `driftless calibrate`, read by `driftless estimate --calib`
+// and by the twin (as a model prior). Format: docs/calibration.md.
+#pragma once
+
+#include <array>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "estimator/calibration.hpp"
+#include "calibration/rig_plan.hpp"
+
+namespace driftless::calib {
+
+inline constexpr const char* kCalibFormat = "driftless-calib 1";
+
+/// Where and how the calibration was made.
+struct RigConditions {
+  std::string source;                    // "scenario FILE" / "log FILE, plan FILE"
+  double latitude_deg = driftless::kNaN;   // deg
+  double sample_rate_hz = driftless::kNaN; // Hz
+  bool earth_rate_removed = false;
+  std::array<double, 2> mean_temp_c{driftless::kNaN, driftless::kNaN};  // degC, per sensor
+  Eigen::Vector3d hinge1_axis = Eigen::Vector3d::UnitZ();  // box axes
+  Eigen::Vector3d hinge2_axis = Eigen::Vector3d::UnitX();
+  RigPlan plan;                          // the segments used (times, orientations, rates)
+  std::vector<std::size_t> samples_used; // plateau samples per segment
+};
+
+/// The contents of calib.yaml that its readers use.
+struct CalibFile {
+  std::string method;                    // top_to_top | least_squares
+  est::CalibMatrices M;                  // [sensor][pos], box_from_sensor
+  std::array<std::array<Eigen::Matrix3d, 2>, 2> M_sigma{};  // 1-sigma per coefficient (0 if absent)
+  std::array<std::array<Eigen::Vector3d, 2>, 2> residual_rms_dps{};
+  Eigen::Vector3d hinge1_axis = Eigen::Vector3d::UnitZ();
+  Eigen::Vector3d hinge2_axis = Eigen::Vector3d::UnitX();
+  double latitude_deg = driftless::kNaN;
+  bool earth_rate_removed = false;
+  std::string source;
+  /// g-sensitivity per sensor (sensorN.g_sensitivity.G_dps_per_g, deg/s per g), when fitted
+  bool has_g_sensitivity = false;
+  std::array<Eigen::Matrix3d, 2> G_dps_per_g{Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero()};
+};
+
+/// Writes calib.yaml (throws std::runtime_error naming the path when it cannot be written).
+/// With a valid `g`, each sensor block also holds its g_sensitivity.
+void save_calib(const std::filesystem::path& path, const est::CalibFit& fit,
+                const RigConditions& rig, const est::GSensitivityFit* g = nullptr);
+/// Reads calib.yaml; throws std::invalid_argument naming file, line and key (missing matrix,
+/// wrong shape, singular M, another format).
+CalibFile load_calib(const std::filesystem::path& path);
+
+}  // namespace driftless::calib

@@ -1,0 +1,405 @@
+// The simulated calibration rig on the twin's pan/tilt unit (see rig_sim.hpp).
+#include "calibration/rig_sim.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+#include <fmt/core.h>
+#include <yaml-cpp/yaml.h>
+
+#include "calibration/yaml_io.hpp"
+#include "estimator/geometry.hpp"
+#include "estimator/random.hpp"
+#include "twin/flip_schedule.hpp"
+#include "twin/motion.hpp"
+#include "twin/sensor/sensor_model.hpp"
+#include "twin/simulator.hpp"
+#include "twin/world.hpp"
+
+namespace driftless::calib {
+
+using twin::Scenario;
+using twin::World;
+using twin::BoxParams;
+using twin::MotionState;
+using twin::TrapezoidProfile;
+using twin::SensorTruth;
+using twin::SensorReading;
+using twin::SensorParams;
+using twin::SensorModel;
+using twin::SensorInstance;
+using twin::Carrier;
+using twin::Motion;
+using twin::parse_scenario;
+namespace {
+
+// ---- the rate table: square wave with finite acceleration, closed form -----------------------
+
+// the table rate (deg/s, signed about the segment axis) and turned angle (deg) since t_start_s
+struct TableProfile {
+  const PlanSegment* s;
+  double a;  // deg/s^2
+
+  double rate_at_end() const {
+    const double span = s->t_end_s - s->t_start_s;
+    const double k = std::ceil(span / s->half_period_s) - 1.0;
+    return rate_in(static_cast<long>(k), span - k * s->half_period_s);
+  }
+  // rate tau seconds into half period k
+  double rate_in(long k, double tau) const {
+    const double R = s->rate_dps, sk = (k % 2 == 0) ? s->first_sign : -s->first_sign;
+    if (k == 0) return sk * std::min(a * tau, R);
+    return sk * std::min(-R + a * tau, R);
+  }
+  // angle turned during the first tau seconds of half period k
+  double angle_in(long k, double tau) const {
+    const double R = s->rate_dps, sk = (k % 2 == 0) ? s->first_sign : -s->first_sign;
+    if (k == 0) {
+      const double tr = R / a;
+      return sk * (tau <= tr ? 0.5 * a * tau * tau : 0.5 * R * tr + R * (tau - tr));
+    }
+    const double tr = 2.0 * R / a;
+    return sk * (tau <= tr ? -R * tau + 0.5 * a * tau * tau : R * (tau - tr));
+  }
+  double ramp_down_s() const { return std::abs(rate_at_end()) / a; }
+  // angle (deg) at time t: ramps, plateaus, and the ramp down after t_end_s
+  double angle(double t) const {
+    if (t <= s->t_start_s) return 0.0;
+    const double T = s->half_period_s;
+    const double tt = std::min(t, s->t_end_s) - s->t_start_s;
+    const long kmax = static_cast<long>(std::floor(tt / T));
+    double ang = 0.0;
+    for (long k = 0; k < kmax; ++k) ang += angle_in(k, T);
+    ang += angle_in(kmax, tt - static_cast<double>(kmax) * T);
+    if (t > s->t_end_s) {
+      const double r0 = rate_at_end();
+      const double td = std::min(t - s->t_end_s, ramp_down_s());
+      ang += r0 * td - (r0 > 0 ? 1.0 : -1.0) * 0.5 * a * td * td;
+    }
+    return ang;
+  }
+};
+
+double smoothstep(double x) {
+  x = std::clamp(x, 0.0, 1.0);
+  return x * x * x * (10.0 + x * (-15.0 + 6.0 * x));  // C2: zero rate and acceleration at the ends
+}
+
+Eigen::Quaterniond rz_deg(double deg) {
+  return geo::quat_from_rotvec(Eigen::Vector3d::UnitZ() * (deg * kRadPerDeg));
+}
+
+// the pan/tilt unit as a rate table: the box mounted with the segment axis up, turned about up
+class RigMotion final : public Motion {
+ public:
+  RigMotion(const RigPlan& plan, double accel_dps2, double remount_s)
+      : plan_(plan), accel_(accel_dps2), remount_s_(remount_s) {
+    for (const auto& s : plan_.segments) {
+      TableProfile tp{&s, accel_};
+      end_q_.push_back(rz_deg(tp.angle(s.t_end_s + tp.ramp_down_s())) * orientation_mount(s.axis_box));
+      rest_s_.push_back(s.t_end_s + tp.ramp_down_s());
+    }
+  }
+  void pose(double t, Eigen::Vector3d& p, Eigen::Quaterniond& q) const override {
+    const auto& segs = plan_.segments;
+    std::size_t k = 0;
+    while (k + 1 < segs.size() && t >= segs[k + 1].t_start_s) ++k;
+    const PlanSegment& s = segs[k];
+    const TableProfile tp{&s, accel_};
+    if (k == 0 && t < s.t_start_s) {
+      q = orientation_mount(s.axis_box);
+    } else if (t <= rest_s_[k] || k + 1 == segs.size()) {
+      q = rz_deg(tp.angle(t)) * orientation_mount(s.axis_box);
+    } else {
+      // re-orientation to the next segment's mount, then rest
+      const Eigen::Quaterniond next = orientation_mount(segs[k + 1].axis_box);
+      q = end_q_[k].slerp(smoothstep((t - rest_s_[k]) / remount_s_), next);
+    }
+    const Eigen::Quaterniond yoke = rz_deg(0.0);
+    p = World::pan_tilt_axis_enu_m() + yoke * World::box_on_tilt_head_m();
+  }
+  Carrier carrier() const override { return Carrier::pan_tilt; }
+
+ private:
+  RigPlan plan_;
+  double accel_, remount_s_;
+  std::vector<Eigen::Quaterniond> end_q_;
+  std::vector<double> rest_s_;
+};
+
+// ---- the platforms: pressed onto their stops; flipped in a gap when the next segment asks ----
+
+struct PlatformPlan {
+  struct Flip {
+    double t0_s;
+    TrapezoidProfile profile;
+    double known_from_s;  // the system knows the new angle again from here
+  };
+  double initial_sign = -1.0;
+  std::vector<Flip> flips;
+};
+
+PlatformPlan platform_plan(const RigPlan& plan, const RigParams& rig, const BoxParams& box, int i) {
+  PlatformPlan pp;
+  const auto deg = [i](const PlanSegment& s) { return i == 1 ? s.plat1_deg : s.plat2_deg; };
+  const double press_rad = (box.end_stop_deg + box.motor.overtravel_deg) * kRadPerDeg;
+  pp.initial_sign = deg(plan.segments.front()) > 0 ? 1.0 : -1.0;
+  double sign = pp.initial_sign;
+  for (std::size_t k = 1; k < plan.segments.size(); ++k) {
+    const double want = deg(plan.segments[k]) > 0 ? 1.0 : -1.0;
+    if (want == sign) continue;
+    const auto& prev = plan.segments[k - 1];
+    const double t0 = prev.t_end_s + rig.remount_s + 0.5;
+    TrapezoidProfile prof(t0, sign * press_rad, want * press_rad, box.motor.max_speed_dps * kRadPerDeg,
+                          box.motor.max_accel_dps2 * kRadPerDeg);
+    const double known = prof.end_s() + 0.5;
+    if (known > plan.segments[k].t_start_s) {
+      throw std::invalid_argument(fmt::format(
+          "calibration: the platforms need {:.1f} s to re-orient and flip after segment '{}' but "
+          "the gap is {:.1f} s; raise calibration.gap_s", known - prev.t_end_s, prev.name,
+          plan.segments[k].t_start_s - prev.t_end_s));
+    }
+    pp.flips.push_back({t0, prof, known});
+    sign = want;
+  }
+  return pp;
+}
+
+double reference_rad(const PlatformPlan& pp, const BoxParams& box, double t) {
+  const double press_rad = (box.end_stop_deg + box.motor.overtravel_deg) * kRadPerDeg;
+  double ref = pp.initial_sign * press_rad;
+  for (const auto& f : pp.flips)
+    if (t >= f.t0_s) ref = f.profile.angle_rad(t);
+  return ref;
+}
+
+// the angle the system knows (end-stop switches): +-90 at rest, NaN while a flip runs
+double known_deg(const PlatformPlan& pp, const BoxParams& box, double t) {
+  double sign = pp.initial_sign;
+  for (const auto& f : pp.flips) {
+    if (t < f.t0_s) break;
+    if (t < f.known_from_s) return kNaN;
+    sign = f.profile.target_rad() > 0 ? 1.0 : -1.0;
+  }
+  return sign * box.end_stop_deg;
+}
+
+// ---- scenario file: a normal scenario plus a `calibration:` block -----------------------------
+
+std::string read_text(const std::filesystem::path& path) {
+  std::ifstream f(path);
+  if (!f) throw std::invalid_argument(path.string() + ": cannot open calibration scenario");
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+RigParams parse_rig(const YAML::Node& n, const std::string& file) {
+  using namespace yio;
+  static const std::set<std::string> kKeys = {
+      "rate_dps", "segment_s", "half_period_s", "settle_s", "gap_s", "start_s", "orientations",
+      "gyro_full_scale_dps", "table_accel_dps2", "remount_s", "method"};
+  if (!n.IsMap()) fail(file, n, "calibration", "expected a map (docs/calibration.md)");
+  for (const auto& kv : n)
+    if (!kKeys.count(kv.first.Scalar()))
+      fail(file, kv.first, "calibration." + kv.first.Scalar(), "unknown key (see docs/calibration.md)");
+  RigParams r;
+  auto& p = r.procedure;
+  p.gap_s = 8.0;
+  const auto num = [&](const char* k, double& v) {
+    if (n[k]) v = as_double(n[k], file, std::string("calibration.") + k);
+  };
+  num("rate_dps", p.rate_dps);
+  num("segment_s", p.segment_s);
+  num("half_period_s", p.half_period_s);
+  num("settle_s", p.settle_s);
+  num("gap_s", p.gap_s);
+  num("start_s", p.start_s);
+  num("gyro_full_scale_dps", p.gyro_full_scale_dps);
+  num("table_accel_dps2", r.table_accel_dps2);
+  num("remount_s", r.remount_s);
+  if (n["method"]) r.method = as_string(n["method"], file, "calibration.method");
+  if (const auto o = n["orientations"]) {
+    if (!o.IsSequence()) fail(file, o, "calibration.orientations", "expected a list such as [XY, YZ, XZ]");
+    p.orientations.clear();
+    for (const auto& x : o) p.orientations.push_back(as_string(x, file, "calibration.orientations"));
+  }
+  try {
+    r.validate();
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(where(file, n) + ": calibration: " + e.what());
+  }
+  return r;
+}
+
+}  // namespace
+
+void RigParams::validate() const {
+  procedure.validate();
+  if (!(table_accel_dps2 > 0.0)) throw std::invalid_argument("table_accel_dps2 must be > 0 deg/s^2");
+  const double ramp_s = 2.0 * procedure.rate_dps / table_accel_dps2;
+  if (procedure.settle_s < ramp_s) {
+    throw std::invalid_argument(fmt::format(
+        "settle_s = {} s is shorter than the table's reversal ({} s at {} deg/s^2): samples of the "
+        "reversal would enter the fit", procedure.settle_s, ramp_s, table_accel_dps2));
+  }
+  if (!(remount_s > 0.0) || remount_s + 0.5 > procedure.gap_s)
+    throw std::invalid_argument("remount_s must be > 0 and at least 0.5 s shorter than gap_s");
+  if (method != "least_squares" && method != "top_to_top")
+    throw std::invalid_argument("method must be least_squares or top_to_top, got '" + method + "'");
+}
+
+CalibScenario load_calib_scenario(const std::filesystem::path& path) {
+  const std::string file = path.string();
+  std::string text = read_text(path);
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    throw std::invalid_argument(file + ": " + e.what());
+  }
+  if (!root.IsMap() || !root["calibration"]) {
+    throw std::invalid_argument(file + ": no `calibration:` block: not a calibration scenario "
+                                       "(see models/scenarios/calibration.yaml, docs/calibration.md)");
+  }
+  CalibScenario cs;
+  cs.rig = parse_rig(root["calibration"], file);
+  // hand the rest to the scenario parser with the calibration lines blanked (line numbers kept)
+  int first = -1, next = 1 << 30;
+  for (const auto& kv : root) {
+    const int line = kv.first.Mark().line;
+    if (kv.first.Scalar() == "calibration") first = line;
+  }
+  for (const auto& kv : root) {
+    const int line = kv.first.Mark().line;
+    if (line > first) next = std::min(next, line);
+  }
+  std::istringstream in(text);
+  std::string out, l;
+  for (int i = 0; std::getline(in, l); ++i) out += (i >= first && i < next ? std::string() : l) + "\n";
+  cs.scenario = parse_scenario(out, file, path.parent_path());
+  cs.rig.procedure.start_s = std::max(cs.rig.procedure.start_s, 1.0);
+  return cs;
+}
+
+RigRun run_rig(const CalibScenario& cs, const std::function<bool(double)>& progress) {
+  const Scenario& sc = cs.scenario;
+  sc.validate();
+  cs.rig.validate();
+  RigRun run;
+  run.plan = standard_plan(cs.rig.procedure);
+  const BoxParams& box = sc.model.box;
+  const PlatformPlan pp[2] = {platform_plan(run.plan, cs.rig, box, 1),
+                              platform_plan(run.plan, cs.rig, box, 2)};
+  const RigMotion motion(run.plan, cs.rig.table_accel_dps2, cs.rig.remount_s);
+  World world(box, sc.physics_dt_s);
+  const Eigen::Vector3d earth = geo::earth_rate_enu_radps(sc.latitude_deg);
+
+  // sensors: the scenario's sensor blocks over the MPU6050 preset
+  SensorModel sensor[2] = {
+      SensorModel(sc.model.sensor1, sc.sample_rate_hz,
+                  rnd::stream_seed(sc.seed, rnd::Stream::kSensor1)),
+      SensorModel(sc.model.sensor2, sc.sample_rate_hz,
+                  rnd::stream_seed(sc.seed, rnd::Stream::kSensor2))};
+
+  // initial state: the box on the table, platforms pressed onto their first stops
+  const MotionState m0 = motion.at(0.0);
+  world.set_base(m0.p_enu_m, m0.q_enu_from_body, m0.v_enu_mps, m0.w_body_radps);
+  for (int i = 1; i <= 2; ++i) {
+    world.set_platform(i, box.stop_rad(i, pp[i - 1].initial_sign > 0 ? 1 : -1), 0.0);
+    world.set_motor_reference(i, reference_rad(pp[i - 1], box, 0.0));
+  }
+  world.pose_carrier(Carrier::pan_tilt, m0.p_enu_m, m0.q_enu_from_body);
+  mj_forward(world.model(), world.data());
+
+  run.meta.set("sample_rate_hz", fmt::format("{}", sc.sample_rate_hz));
+  run.meta.set("latitude_deg", fmt::format("{}", sc.latitude_deg));
+  const Eigen::Vector3d a1 = box.hinge_axis(1), a2 = box.hinge_axis(2);
+  run.meta.set("hinge1_axis", fmt::format("{} {} {}", a1.x(), a1.y(), a1.z()));
+  run.meta.set("hinge2_axis", fmt::format("{} {} {}", a2.x(), a2.y(), a2.z()));
+  run.meta.set("source", "twin");
+  run.meta.set("scenario", sc.name);
+  run.meta.set("seed", std::to_string(sc.seed));
+  run.meta.set("motion", "calibration_rig");
+  run.meta.set("carrier", "pan_tilt");
+
+  const double duration_s = run.plan.segments.back().t_end_s + 1.0;
+  const long steps_per_sample = sc.steps_per_sample();
+  const auto n_samples = static_cast<std::uint64_t>(std::floor(duration_s * sc.sample_rate_hz));
+  const mjModel* m = world.model();
+  mjData* d = world.data();
+  double rest_sum[2][2] = {{0, 0}, {0, 0}}, rest_n[2][2] = {{0, 0}, {0, 0}}, temp_sum[2] = {0, 0};
+  run.samples.reserve(n_samples);
+  std::uint64_t step = 0;
+  for (std::uint64_t k = 0; k < n_samples; ++k) {
+    if (progress && k % 1000 == 0 && !progress(static_cast<double>(k) / static_cast<double>(n_samples)))
+      throw std::runtime_error("calibration rig stopped by the user");
+    Sample out;
+    for (long j = 0; j < steps_per_sample; ++j, ++step) {
+      const bool output = j == 0;
+      const double t = static_cast<double>(step) * sc.physics_dt_s;
+      const MotionState ms = motion.at(t);
+      world.set_base(ms.p_enu_m, ms.q_enu_from_body, ms.v_enu_mps, ms.w_body_radps);
+      for (int i = 1; i <= 2; ++i) world.set_motor_reference(i, reference_rad(pp[i - 1], box, t));
+      d->time = t;
+      mj_step1(m, d);
+      world.drive_base(ms.a_enu_mps2, ms.dw_body_radps2);
+      double plat_rad[2] = {world.platform_angle_rad(1), world.platform_angle_rad(2)};
+      mj_step2(m, d);
+      if (!output) continue;
+      out.t_s = t;
+      out.set_q_enu_from_body(ms.q_enu_from_body);
+      out.ref_p_enu_m = ms.p_enu_m;
+      out.true_plat1_deg = plat_rad[0] * kDegPerRad;
+      out.true_plat2_deg = plat_rad[1] * kDegPerRad;
+      out.true_rate_body_dps = (ms.w_body_radps + ms.q_enu_from_body.conjugate() * earth) * kDegPerRad;
+      out.plat1_deg = known_deg(pp[0], box, t);
+      out.plat2_deg = known_deg(pp[1], box, t);
+      for (int i = 0; i < 2; ++i) {
+        const Eigen::Matrix3d R = world.R_enu_from_sensor(i + 1);
+        SensorTruth truth;
+        truth.t_s = t;
+        truth.w_radps = world.mj_gyro(i + 1) + R.transpose() * earth;
+        truth.f_mps2 = world.mj_accel(i + 1);
+        const SensorReading r = sensor[i].step(truth);
+        (i == 0 ? out.gyro1_dps : out.gyro2_dps) = r.gyro_radps * kDegPerRad;
+        (i == 0 ? out.accel1_mps2 : out.accel2_mps2) = r.accel_mps2;
+        (i == 0 ? out.true_bias1_dps : out.true_bias2_dps) = r.bias_radps * kDegPerRad;
+        (i == 0 ? out.temp1_c : out.temp2_c) = r.temp_c;
+        temp_sum[i] += r.temp_c;
+      }
+      // where the platforms really rest during the fit's plateaus
+      for (const auto& s : run.plan.segments) {
+        if (!s.on_plateau(t)) continue;
+        for (int i = 0; i < 2; ++i) {
+          rest_sum[i][s.position(i)] += plat_rad[i] * kDegPerRad;
+          rest_n[i][s.position(i)] += 1;
+        }
+      }
+    }
+    run.samples.push_back(out);
+  }
+  if (progress) progress(1.0);
+
+  // the true M: sensor calibration C from the realised model, T from the rest angles
+  const Eigen::Vector3d hinge[2] = {a1, a2};
+  for (int i = 0; i < 2; ++i) {
+    const SensorInstance& inst = sensor[i].instance();
+    const SensorParams& p = sensor[i].params();
+    const double dT = temp_sum[i] / static_cast<double>(n_samples) - p.temperature.reference_degc;
+    const Eigen::Vector3d k = inst.scale + inst.scale_tc_per_degc * dT;
+    const Eigen::Matrix3d C = inst.misalignment * k.asDiagonal() * inst.R_sensor_from_nominal;
+    for (int pos = 0; pos < 2; ++pos) {
+      run.rest_angle_deg[i][pos] = rest_n[i][pos] > 0 ? rest_sum[i][pos] / rest_n[i][pos] : kNaN;
+      run.true_M.M(i, pos) =
+          (C * geo::rot_about_axis_deg(hinge[i], run.rest_angle_deg[i][pos]).transpose()).inverse();
+    }
+  }
+  return run;
+}
+
+}  // namespace driftless::calib

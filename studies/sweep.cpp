@@ -1,0 +1,482 @@
+// Sweep file, grid expansion, parallel runner and result table. Format: docs/sweep.md.
+#include "studies/sweep.hpp"
+
+#include "estimator/random.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <mutex>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+
+#include <yaml-cpp/yaml.h>
+
+namespace driftless::studies {
+namespace {
+
+std::string where(const std::string& file, const YAML::Node& n) {
+  return file + ":" + std::to_string(n.Mark().line + 1);
+}
+
+[[noreturn]] void fail(const std::string& file, const YAML::Node& n, const std::string& msg) {
+  throw std::runtime_error(where(file, n) + ": " + msg);
+}
+
+double as_double(const std::string& file, const YAML::Node& n, const std::string& key) {
+  try {
+    return n.as<double>();
+  } catch (const YAML::Exception&) {
+    fail(file, n, "'" + key + "' must be a number");
+  }
+}
+
+std::string fmt_double(double v) {
+  if (std::isnan(v)) return "";
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.9g", v);
+  return buf;
+}
+
+// CSV field: no commas or quotes or newlines in our text fields
+std::string csv_text(std::string s) {
+  for (char& c : s) {
+    if (c == ',' || c == '"' || c == '\n' || c == '\r') c = ';';
+  }
+  return s;
+}
+
+}  // namespace
+
+void SweepConfig::validate() const {
+  const std::string f = file.empty() ? std::string("sweep") : file.string();
+  if (runner != "fast" && runner != "twin" && runner != "fdi" && runner != "fdi_twin") {
+    throw std::invalid_argument(f + ": runner must be fast, twin, fdi or fdi_twin (got '" + runner + "')");
+  }
+  if (monte_carlo < 1) throw std::invalid_argument(f + ": monte_carlo must be >= 1");
+  if (duration_s < 0) throw std::invalid_argument(f + ": duration_s must be >= 0 s");
+  std::set<std::string> names;
+  for (const auto& a : grid) {
+    if (a.name.empty()) throw std::invalid_argument(f + ": a grid axis has no name");
+    if (!names.insert(a.name).second) {
+      throw std::invalid_argument(f + ": grid axis '" + a.name + "' appears twice");
+    }
+    if (a.values.empty()) throw std::invalid_argument(f + ": grid axis '" + a.name + "' has no values");
+    if (a.set.empty()) throw std::invalid_argument(f + ": grid axis '" + a.name + "' sets no key");
+  }
+  for (const auto& p : plots) {
+    if (!names.count(p.x)) {
+      throw std::invalid_argument(f + ": plot x '" + p.x + "' is not a grid axis");
+    }
+    if (!p.series.empty() && !names.count(p.series)) {
+      throw std::invalid_argument(f + ": plot series '" + p.series + "' is not a grid axis");
+    }
+    if (p.y.empty()) throw std::invalid_argument(f + ": a plot needs at least one y metric");
+  }
+}
+
+std::size_t SweepConfig::points() const {
+  std::size_t n = 1;
+  for (const auto& a : grid) n *= a.values.size();
+  return n;
+}
+
+SweepConfig parse_sweep(const std::string& yaml_text, const std::string& file,
+                        const std::filesystem::path& base_dir) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml_text);
+  } catch (const YAML::Exception& e) {
+    throw std::runtime_error(file + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
+  }
+  if (!root.IsMap()) throw std::runtime_error(file + ": a sweep file is a YAML map (docs/sweep.md)");
+  SweepConfig c;
+  c.file = file;
+  static const std::set<std::string> known = {"name",  "description", "runner", "scenario",
+                                              "duration_s", "monte_carlo", "seed", "grid",
+                                              "fixed", "plot", "plots"};
+  for (const auto& kv : root) {
+    const auto key = kv.first.as<std::string>();
+    if (!known.count(key)) {
+      fail(file, kv.first, "unknown key '" + key +
+                               "' (expected name, description, runner, scenario, duration_s, "
+                               "monte_carlo, seed, grid, fixed, plots)");
+    }
+  }
+  c.name = root["name"] ? root["name"].as<std::string>() : std::filesystem::path(file).stem().string();
+  if (root["description"]) c.description = root["description"].as<std::string>();
+  if (root["runner"]) c.runner = root["runner"].as<std::string>();
+  if (root["scenario"]) {
+    const auto s = root["scenario"].as<std::string>();
+    const std::filesystem::path p(s);
+    // a bare word without a suffix is a built-in scenario name
+    c.scenario = (p.has_extension() && p.is_relative()) ? base_dir / p : p;
+  }
+  if (root["duration_s"]) c.duration_s = as_double(file, root["duration_s"], "duration_s");
+  if (root["monte_carlo"]) c.monte_carlo = static_cast<int>(as_double(file, root["monte_carlo"], "monte_carlo"));
+  if (root["seed"]) c.seed = static_cast<std::uint64_t>(as_double(file, root["seed"], "seed"));
+  if (const auto g = root["grid"]) {
+    if (!g.IsMap()) fail(file, g, "'grid' must map axis names to value lists or {set, values}");
+    for (const auto& kv : g) {
+      GridAxis a;
+      a.name = kv.first.as<std::string>();
+      // copy-construct (yaml-cpp's Node::operator= would write into the referenced node)
+      const YAML::Node vals = kv.second.IsMap() ? YAML::Node(kv.second["values"]) : kv.second;
+      if (kv.second.IsMap()) {
+        if (const auto s = kv.second["set"]) {
+          if (s.IsSequence()) {
+            for (const auto& x : s) a.set.push_back(x.as<std::string>());
+          } else {
+            a.set.push_back(s.as<std::string>());
+          }
+        }
+        if (kv.second["vector3"]) a.vector3 = kv.second["vector3"].as<bool>();
+        if (kv.second["boolean"]) a.boolean = kv.second["boolean"].as<bool>();
+        if (const auto r = kv.second["range"]) {  // {range: [from, to, step]}
+          if (!r.IsSequence() || r.size() != 3) fail(file, r, "'range' is [from, to, step]");
+          const double from = as_double(file, r[0], "range"), to = as_double(file, r[1], "range"),
+                       step = as_double(file, r[2], "range");
+          if (!(step > 0) || to < from) fail(file, r, "'range' needs step > 0 and to >= from");
+          for (double v = from; v <= to + 1e-9 * step; v += step) a.values.push_back(v);
+        }
+      }
+      if (vals) {
+        if (!vals.IsSequence()) fail(file, kv.second, "grid axis '" + a.name + "': values must be a list");
+        for (const auto& v : vals) a.values.push_back(as_double(file, v, a.name));
+      }
+      if (a.set.empty()) a.set.push_back(a.name);
+      c.grid.push_back(std::move(a));
+    }
+  }
+  if (const auto f = root["fixed"]) {
+    if (!f.IsMap()) fail(file, f, "'fixed' must map key paths to values");
+    for (const auto& kv : f) {
+      YAML::Emitter e;
+      e << YAML::Flow << kv.second;
+      c.fixed.emplace_back(kv.first.as<std::string>(), e.c_str());
+    }
+  }
+  const YAML::Node given = root["plots"] ? root["plots"] : root["plot"];
+  if (given) {
+    YAML::Node plots(YAML::NodeType::Sequence);
+    if (given.IsMap()) {
+      plots.push_back(given);
+    } else {
+      for (const auto& p : given) plots.push_back(p);
+    }
+    for (const auto& p : plots) {
+      PlotSpec s;
+      if (!p["x"]) fail(file, p, "a plot needs 'x' (a grid axis)");
+      s.x = p["x"].as<std::string>();
+      if (p["y"]) {
+        if (p["y"].IsSequence()) {
+          for (const auto& y : p["y"]) s.y.push_back(y.as<std::string>());
+        } else {
+          s.y.push_back(p["y"].as<std::string>());
+        }
+      }
+      if (p["series"]) s.series = p["series"].as<std::string>();
+      if (p["logx"]) s.logx = p["logx"].as<bool>();
+      if (p["logy"]) s.logy = p["logy"].as<bool>();
+      c.plots.push_back(std::move(s));
+    }
+  }
+  try {
+    c.validate();
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(e.what());
+  }
+  return c;
+}
+
+SweepConfig load_sweep(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(path.string() + ": cannot open sweep file");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return parse_sweep(ss.str(), path.string(), path.parent_path());
+}
+
+std::uint64_t run_seed(std::uint64_t base_seed, int mc) {
+  // 31 bits: scenario files and other tools read a seed as a plain integer
+  return rnd::mix64(base_seed * 0x100000001B3ull + static_cast<std::uint64_t>(mc)) >> 33;
+}
+
+std::vector<RunSpec> expand(const SweepConfig& cfg) {
+  std::vector<RunSpec> out;
+  const std::size_t points = cfg.points();
+  out.reserve(points * static_cast<std::size_t>(cfg.monte_carlo));
+  for (std::size_t p = 0; p < points; ++p) {
+    std::vector<double> values(cfg.grid.size());
+    std::size_t rest = p;
+    for (std::size_t a = cfg.grid.size(); a-- > 0;) {
+      const auto& ax = cfg.grid[a];
+      values[a] = ax.values[rest % ax.values.size()];
+      rest /= ax.values.size();
+    }
+    for (int mc = 0; mc < cfg.monte_carlo; ++mc) {
+      RunSpec s;
+      s.index = out.size();
+      s.point = p;
+      s.mc = mc;
+      s.seed = run_seed(cfg.seed, mc);
+      s.values = values;
+      out.push_back(std::move(s));
+    }
+  }
+  return out;
+}
+
+std::vector<RunResult> run_parallel(const std::vector<RunSpec>& specs,
+                                    const std::vector<std::size_t>& indices, const SweepJob& job,
+                                    int threads,
+                                    const std::function<void(std::size_t, std::size_t)>& on_done,
+                                    const std::atomic<bool>* stop) {
+  std::vector<RunResult> results(indices.size());
+  if (threads <= 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  threads = std::min<int>(threads, std::max<std::size_t>(1, indices.size()));
+  std::atomic<std::size_t> next{0};
+  std::mutex mu;
+  std::size_t done = 0;
+  auto worker = [&] {
+    for (;;) {
+      const std::size_t k = next.fetch_add(1);
+      if (k >= indices.size()) return;
+      const RunSpec& spec = specs.at(indices[k]);
+      RunResult r;
+      r.index = spec.index;
+      const auto t0 = std::chrono::steady_clock::now();
+      if (stop && stop->load()) {
+        r.error = "stopped";
+      } else {
+        try {
+          r.metrics = job(spec);
+          r.ok = true;
+        } catch (const std::exception& e) {
+          r.error = csv_text(e.what());
+        }
+      }
+      r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      results[k] = std::move(r);
+      std::lock_guard<std::mutex> lock(mu);
+      ++done;
+      if (on_done) on_done(done, indices.size());
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int i = 1; i < threads; ++i) pool.emplace_back(worker);
+  worker();
+  for (auto& t : pool) t.join();
+  return results;
+}
+
+std::string serialize_result(const RunResult& r) {
+  std::ostringstream out;
+  out << r.index << '\t' << (r.ok ? 1 : 0) << '\t' << r.wall_s << '\t' << csv_text(r.error);
+  char buf[40];
+  for (const auto& [k, v] : r.metrics) {
+    std::snprintf(buf, sizeof buf, "%.17g", v);
+    out << '\t' << k << '=' << buf;
+  }
+  return out.str();
+}
+
+RunResult parse_result(const std::string& line) {
+  std::vector<std::string> f;
+  std::size_t a = 0;
+  for (;;) {
+    const std::size_t b = line.find('\t', a);
+    f.push_back(line.substr(a, b == std::string::npos ? std::string::npos : b - a));
+    if (b == std::string::npos) break;
+    a = b + 1;
+  }
+  if (f.size() < 4) throw std::runtime_error("sweep: malformed gathered result line: " + line);
+  RunResult r;
+  r.index = std::stoull(f[0]);
+  r.ok = f[1] == "1";
+  r.wall_s = std::strtod(f[2].c_str(), nullptr);
+  r.error = f[3];
+  for (std::size_t i = 4; i < f.size(); ++i) {
+    const auto eq = f[i].find('=');
+    if (eq == std::string::npos) throw std::runtime_error("sweep: malformed metric: " + f[i]);
+    r.metrics.emplace_back(f[i].substr(0, eq), std::strtod(f[i].c_str() + eq + 1, nullptr));
+  }
+  return r;
+}
+
+std::vector<std::map<std::string, Aggregate>> summarize(const SweepConfig& cfg,
+                                                        const std::vector<RunResult>& results) {
+  const std::size_t points = cfg.points();
+  std::vector<std::map<std::string, std::vector<double>>> vals(points);
+  for (const auto& r : results) {
+    if (!r.ok) continue;
+    const std::size_t p = r.index / static_cast<std::size_t>(cfg.monte_carlo);
+    if (p >= points) continue;
+    for (const auto& [k, v] : r.metrics) vals[p][k].push_back(v);
+  }
+  std::vector<std::map<std::string, Aggregate>> out(points);
+  for (std::size_t p = 0; p < points; ++p) {
+    for (const auto& [k, v] : vals[p]) {
+      Aggregate g;
+      g.n = v.size();
+      double s = 0, s2 = 0;
+      g.min = g.max = v.front();
+      for (double x : v) {
+        s += x;
+        s2 += x * x;
+        g.min = std::min(g.min, x);
+        g.max = std::max(g.max, x);
+      }
+      g.mean = s / g.n;
+      g.rms = std::sqrt(s2 / g.n);
+      double ss = 0;
+      for (double x : v) ss += (x - g.mean) * (x - g.mean);
+      g.std = g.n > 1 ? std::sqrt(ss / (g.n - 1)) : 0.0;
+      out[p][k] = g;
+    }
+  }
+  return out;
+}
+
+std::size_t write_outputs(const SweepConfig& cfg, const std::vector<RunSpec>& specs,
+                          const std::vector<RunResult>& results_in, const std::filesystem::path& dir,
+                          bool run_gnuplot) {
+  std::filesystem::create_directories(dir);
+  std::vector<const RunResult*> by_index(specs.size(), nullptr);
+  for (const auto& r : results_in) {
+    if (r.index >= specs.size() || by_index[r.index]) {
+      throw std::runtime_error("sweep: result index " + std::to_string(r.index) +
+                               " out of range or duplicated");
+    }
+    by_index[r.index] = &r;
+  }
+  // metric columns: union in first-seen order (successful runs)
+  std::vector<std::string> metrics;
+  for (const auto* r : by_index) {
+    if (!r) continue;
+    for (const auto& [k, v] : r->metrics) {
+      if (std::find(metrics.begin(), metrics.end(), k) == metrics.end()) metrics.push_back(k);
+    }
+  }
+  std::size_t failed = 0;
+  {
+    std::ofstream out(dir / "runs.csv");
+    if (!out) throw std::runtime_error((dir / "runs.csv").string() + ": cannot write");
+    out << "# sweep: " << csv_text(cfg.name) << "\n# runner: " << cfg.runner
+        << "\n# monte_carlo: " << cfg.monte_carlo << "\n# seed: " << cfg.seed << "\n";
+    out << "run,point,mc,seed";
+    for (const auto& a : cfg.grid) out << ',' << a.name;
+    out << ",status";
+    for (const auto& m : metrics) out << ',' << m;
+    out << '\n';
+    for (std::size_t i = 0; i < specs.size(); ++i) {
+      const RunSpec& s = specs[i];
+      out << s.index << ',' << s.point << ',' << s.mc << ',' << s.seed;
+      for (double v : s.values) out << ',' << fmt_double(v);
+      const RunResult* r = by_index[i];
+      if (!r || !r->ok) {
+        ++failed;
+        out << ",failed: " << (r ? csv_text(r->error) : std::string("missing (never ran)"));
+        for (std::size_t m = 0; m < metrics.size(); ++m) out << ',';
+        out << '\n';
+        continue;
+      }
+      out << ",ok";
+      for (const auto& m : metrics) {
+        auto it = std::find_if(r->metrics.begin(), r->metrics.end(),
+                               [&](const auto& kv) { return kv.first == m; });
+        out << ',' << (it == r->metrics.end() ? std::string() : fmt_double(it->second));
+      }
+      out << '\n';
+    }
+  }
+  std::vector<RunResult> ok_results;
+  for (const auto* r : by_index) {
+    if (r) ok_results.push_back(*r);
+  }
+  const auto agg = summarize(cfg, ok_results);
+  {
+    std::ofstream out(dir / "summary.csv");
+    out << "point";
+    for (const auto& a : cfg.grid) out << ',' << a.name;
+    out << ",n_ok";
+    for (const auto& m : metrics) {
+      out << ',' << m << "_mean," << m << "_std," << m << "_min," << m << "_max," << m << "_rms";
+    }
+    out << '\n';
+    for (std::size_t p = 0; p < agg.size(); ++p) {
+      out << p;
+      for (std::size_t a = 0; a < cfg.grid.size(); ++a) {
+        out << ',' << fmt_double(specs[p * cfg.monte_carlo].values[a]);
+      }
+      std::size_t n = 0;
+      for (const auto& [k, g] : agg[p]) n = std::max(n, g.n);
+      out << ',' << n;
+      for (const auto& m : metrics) {
+        auto it = agg[p].find(m);
+        if (it == agg[p].end()) {
+          out << ",,,,,";
+          continue;
+        }
+        const Aggregate& g = it->second;
+        out << ',' << fmt_double(g.mean) << ',' << fmt_double(g.std) << ',' << fmt_double(g.min)
+            << ',' << fmt_double(g.max) << ',' << fmt_double(g.rms);
+      }
+      out << '\n';
+    }
+  }
+  // gnuplot: one script (and PNG) per plotted metric, mean with +-std error bars
+  for (const auto& p : cfg.plots) {
+    const auto col = [&](const std::string& name) -> int {
+      for (std::size_t a = 0; a < cfg.grid.size(); ++a) {
+        if (cfg.grid[a].name == name) return static_cast<int>(a) + 2;
+      }
+      return -1;
+    };
+    for (const auto& y : p.y) {
+      const auto mi = std::find(metrics.begin(), metrics.end(), y);
+      if (mi == metrics.end()) continue;  // metric absent (e.g. every run failed)
+      const int ycol = static_cast<int>(cfg.grid.size()) + 3 + 5 * static_cast<int>(mi - metrics.begin());
+      const std::string stem = "plot_" + y + "_vs_" + p.x;
+      std::ofstream gp(dir / (stem + ".gp"));
+      gp << "# driftless sweep '" << cfg.name << "': " << y << " against " << p.x << "\n"
+         << "set terminal pngcairo size 800,560 noenhanced\nset output '" << stem << ".png'\n"
+         << "set datafile separator ','\nset key top left\nset grid\n"
+         << "set xlabel '" << p.x << "'\nset ylabel '" << y << " (mean +- std over "
+         << cfg.monte_carlo << " seeds)'\nset title '" << csv_text(cfg.name) << "'\n";
+      if (p.logx) gp << "set logscale x\n";
+      if (p.logy) gp << "set logscale y\n";
+      const int xcol = col(p.x);
+      if (p.series.empty()) {
+        gp << "plot 'summary.csv' every ::1 using " << xcol << ":" << ycol << ":" << ycol + 1
+           << " with yerrorlines title '" << y << "'\n";
+      } else {
+        const int scol = col(p.series);
+        const auto& ax = cfg.grid[scol - 2];
+        gp << "plot ";
+        for (std::size_t k = 0; k < ax.values.size(); ++k) {
+          gp << (k ? ", \\\n     " : "") << "'summary.csv' every ::1 using ($" << scol
+             << "==" << fmt_double(ax.values[k]) << "?$" << xcol << ":1/0):" << ycol << ":"
+             << ycol + 1 << " with yerrorlines title '" << p.series << " = "
+             << fmt_double(ax.values[k]) << "'";
+        }
+        gp << "\n";
+      }
+      gp.close();
+      if (run_gnuplot && std::system("command -v gnuplot >/dev/null 2>&1") == 0) {
+        const std::string cmd = "cd '" + dir.string() + "' && gnuplot '" + stem + ".gp' 2>/dev/null";
+        if (std::system(cmd.c_str()) != 0) {
+          std::fprintf(stderr, "driftless sweep: warning: gnuplot failed on %s.gp\n", stem.c_str());
+        }
+      }
+    }
+  }
+  return failed;
+}
+
+}  // namespace driftless::studies
