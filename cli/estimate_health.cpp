@@ -61,10 +61,12 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
       return "the NIS gate rejected every update: the sensors do not fit the configured noise or "
              "model; try --tune auto, or check the hinge axes in the log header";
     case est::HealthCause::kNeverLocked:
-      return fmt::format("never locked: the largest bias sigma is {:.3g} deg/s{}; record more flips "
-                         "(both platforms, both directions) or a longer log",
-                         f.value, f.components.empty() ? std::string()
-                                                       : ", unobservable: " + component_names(f.components));
+      return fmt::format("never locked: the largest bias sigma is {:.3g} deg/s{}; {}", f.value,
+                         f.components.empty() ? std::string() : ", unobservable: " + component_names(f.components),
+                         f.suggested > 0.02 ? fmt::format("the gate rejected {:.0f} % of the updates, so the flips "
+                                                          "that observe them were not used (see below)",
+                                                          100.0 * f.suggested)
+                                            : "record more flips (both platforms, both directions) or a longer log");
     case est::HealthCause::kNoiseUnderstated:
       return fmt::format("NIS mean {:.3g} above its 95 % band: the innovations are {:.2g}x larger than the filter "
                          "expects, its sigma too small (data noisier or bias wandering more than "
@@ -72,7 +74,8 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
                          f.value, std::sqrt(f.suggested), cfg.noise_density_dps_rthz);
     case est::HealthCause::kNoiseOverstated:
       return fmt::format("NIS mean {:.3g} below its 95 % band: the innovations are {:.2g}x smaller than the "
-                         "filter expects, its sigma too large (data quieter than configured); use --tune auto",
+                         "filter expects, its sigma too large (data quieter or the bias steadier than configured): "
+                         "safe, the estimates are trusted less than they deserve",
                          f.value, std::sqrt(f.suggested));
     case est::HealthCause::kRejectionsAtPosition:
       return fmt::format("{:.0f} % of the updates at platform angles {} were rejected, few elsewhere: an error "

@@ -109,6 +109,7 @@ void HealthMonitor::add_lock_findings(HealthReport& h, const DriftlessFilter& fi
     f.cause = h.updates == 0 ? HealthCause::kNoUpdate
               : h.rejected == h.updates ? HealthCause::kAllRejected : HealthCause::kNeverLocked;
     f.value = sigma.maxCoeff();
+    f.suggested = h.rejected_fraction;  // rejections may be why the flips did not observe them
     f.components = h.unobservable;
     add(h, f);
     return;

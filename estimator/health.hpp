@@ -39,7 +39,8 @@ struct HealthFinding {
   HealthVerdict severity = HealthVerdict::kDegraded;  // kOk = a note that leaves the verdict
   double value = kNaN;        // the measured quantity (fraction, NIS mean, ...)
   double suggested = kNaN;    // kNoiseUnder/Overstated: nis_mean / dof, the factor by which the
-                              // innovation variance exceeds (or falls short of) what S predicts
+                              // innovation variance exceeds (or falls short of) what S predicts;
+                              // kNeverLocked: the rejected fraction
   // kRejectionsAtPosition: the (plat1, plat2) angle pairs (deg) where most updates were rejected
   std::vector<std::array<double, 2>> positions_deg;
   std::vector<int> components;  // kUnobservable: 0..5 = b1_x .. b2_z
