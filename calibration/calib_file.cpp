@@ -146,9 +146,10 @@ CalibFile load_calib(const std::filesystem::path& path) {
   try {
     root = YAML::LoadFile(file);
   } catch (const YAML::Exception& e) {
-    throw std::invalid_argument(file + ": cannot read calibration file: " + e.what());
+    throw InputError(file, static_cast<std::size_t>(e.mark.line) + 1, "",
+                     "cannot read calibration file: " + e.msg);
   }
-  if (!root.IsMap()) throw std::invalid_argument(file + ": not a calibration file (expected a YAML map)");
+  if (!root.IsMap()) throw InputError(file, 0, "", "not a calibration file (expected a YAML map)");
   const std::string fmt_id = as_string(root["format"], file, "format");
   if (fmt_id != kCalibFormat)
     fail(file, root["format"], "format", std::string("expected '") + kCalibFormat + "', got '" + fmt_id + "'");
@@ -182,11 +183,7 @@ CalibFile load_calib(const std::filesystem::path& path) {
       c.has_g_sensitivity = true;
     }
   }
-  try {
-    c.M.validate();
-  } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument(file + ": " + e.what());
-  }
+  with_location(file, 0, "", [&] { c.M.validate(); });
   return c;
 }
 

@@ -128,7 +128,7 @@ RigPlan standard_plan(const ProcedureParams& p) {
 
 RigPlan parse_rig_plan(const YAML::Node& node, const std::string& file) {
   using namespace yio;
-  if (!node || !node.IsMap()) throw std::invalid_argument(file + ": a rig plan must be a YAML map");
+  if (!node || !node.IsMap()) throw InputError(file, 0, "", "a rig plan must be a YAML map");
   RigPlan plan;
   if (const auto f = node["format"]; f && as_string(f, file, "format") != kRigPlanFormat)
     fail(file, f, "format", std::string("expected '") + kRigPlanFormat + "'");
@@ -179,11 +179,7 @@ RigPlan parse_rig_plan(const YAML::Node& node, const std::string& file) {
     if (const auto n = s["settle_s"]) seg.settle_s = as_double(n, file, key + ".settle_s");
     plan.segments.push_back(seg);
   }
-  try {
-    plan.validate();
-  } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument(file + ": " + e.what());
-  }
+  with_location(file, 0, "", [&] { plan.validate(); });
   return plan;
 }
 
@@ -192,7 +188,8 @@ RigPlan load_rig_plan(const std::filesystem::path& path) {
   try {
     node = YAML::LoadFile(path.string());
   } catch (const YAML::Exception& e) {
-    throw std::invalid_argument(path.string() + ": cannot read rig plan: " + e.what());
+    throw InputError(path.string(), static_cast<std::size_t>(e.mark.line) + 1, "",
+                     "cannot read rig plan: " + e.msg);
   }
   return parse_rig_plan(node, path.string());
 }

@@ -13,6 +13,7 @@
 
 #include "calibration/yaml_io.hpp"
 #include "estimator/geometry.hpp"
+#include "estimator/log_metadata.hpp"
 #include "estimator/random.hpp"
 #include "twin/flip_schedule.hpp"
 #include "twin/motion.hpp"
@@ -192,7 +193,7 @@ double known_deg(const PlatformPlan& pp, const BoxParams& box, double t) {
 
 std::string read_text(const std::filesystem::path& path) {
   std::ifstream f(path);
-  if (!f) throw std::invalid_argument(path.string() + ": cannot open calibration scenario");
+  if (!f) throw InputError(path.string(), 0, "", "cannot open calibration scenario");
   std::stringstream ss;
   ss << f.rdbuf();
   return ss.str();
@@ -228,11 +229,7 @@ RigParams parse_rig(const YAML::Node& n, const std::string& file) {
     p.orientations.clear();
     for (const auto& x : o) p.orientations.push_back(as_string(x, file, "calibration.orientations"));
   }
-  try {
-    r.validate();
-  } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument(where(file, n) + ": calibration: " + e.what());
-  }
+  with_location(file, line_of(n), "calibration", [&] { r.validate(); });
   return r;
 }
 
@@ -260,11 +257,11 @@ CalibScenario load_calib_scenario(const std::filesystem::path& path) {
   try {
     root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
-    throw std::invalid_argument(file + ": " + e.what());
+    throw InputError(file, static_cast<std::size_t>(e.mark.line) + 1, "", "broken YAML: " + e.msg);
   }
   if (!root.IsMap() || !root["calibration"]) {
-    throw std::invalid_argument(file + ": no `calibration:` block: not a calibration scenario "
-                                       "(see models/scenarios/calibration.yaml, docs/calibration.md)");
+    throw InputError(file, 0, "", "no `calibration:` block: not a calibration scenario "
+                                  "(see models/scenarios/calibration.yaml, docs/calibration.md)");
   }
   CalibScenario cs;
   cs.rig = parse_rig(root["calibration"], file);
@@ -316,22 +313,21 @@ RigRun run_rig(const CalibScenario& cs, const std::function<bool(double)>& progr
   world.pose_carrier(Carrier::pan_tilt, m0.p_enu_m, m0.q_enu_from_body);
   mj_forward(world.model(), world.data());
 
-  run.meta.set("sample_rate_hz", fmt::format("{}", sc.sample_rate_hz));
-  run.meta.set("latitude_deg", fmt::format("{}", sc.latitude_deg));
-  const Eigen::Vector3d a1 = box.hinge_axis(1), a2 = box.hinge_axis(2);
-  run.meta.set("hinge1_axis", fmt::format("{} {} {}", a1.x(), a1.y(), a1.z()));
-  run.meta.set("hinge2_axis", fmt::format("{} {} {}", a2.x(), a2.y(), a2.z()));
-  run.meta.set("source", "twin");
-  run.meta.set("scenario", sc.name);
-  run.meta.set("seed", std::to_string(sc.seed));
-  run.meta.set("motion", "calibration_rig");
-  run.meta.set("carrier", "pan_tilt");
+  log::LogInfo info;
+  info.sample_rate_hz = sc.sample_rate_hz;
+  info.latitude_deg = sc.latitude_deg;
+  info.hinge1_axis = box.hinge_axis(1);
+  info.hinge2_axis = box.hinge_axis(2);
+  info.source = "twin";
+  info.scenario = sc.name;
+  info.seed = sc.seed;
+  info.motion = "calibration_rig";
+  info.carrier = "pan_tilt";
+  log::write_log_info(run.meta, info);
 
   const double duration_s = run.plan.segments.back().t_end_s + 1.0;
   const long steps_per_sample = sc.steps_per_sample();
   const auto n_samples = static_cast<std::uint64_t>(std::floor(duration_s * sc.sample_rate_hz));
-  const mjModel* m = world.model();
-  mjData* d = world.data();
   double rest_sum[2][2] = {{0, 0}, {0, 0}}, rest_n[2][2] = {{0, 0}, {0, 0}}, temp_sum[2] = {0, 0};
   run.samples.reserve(n_samples);
   std::uint64_t step = 0;
@@ -343,14 +339,10 @@ RigRun run_rig(const CalibScenario& cs, const std::function<bool(double)>& progr
       const bool output = j == 0;
       const double t = static_cast<double>(step) * sc.physics_dt_s;
       const MotionState ms = motion.at(t);
-      world.set_base(ms.p_enu_m, ms.q_enu_from_body, ms.v_enu_mps, ms.w_body_radps);
-      for (int i = 1; i <= 2; ++i) world.set_motor_reference(i, reference_rad(pp[i - 1], box, t));
-      d->time = t;
-      mj_step1(m, d);
-      world.drive_base(ms.a_enu_mps2, ms.dw_body_radps2);
-      double plat_rad[2] = {world.platform_angle_rad(1), world.platform_angle_rad(2)};
-      mj_step2(m, d);
+      const Eigen::Vector2d ref_rad(reference_rad(pp[0], box, t), reference_rad(pp[1], box, t));
+      const twin::HingeState hinge_state = world.step_driven(t, ms, ref_rad, output);
       if (!output) continue;
+      const double* plat_rad = hinge_state.angle_rad;
       out.t_s = t;
       out.set_q_enu_from_body(ms.q_enu_from_body);
       out.ref_p_enu_m = ms.p_enu_m;
@@ -386,7 +378,7 @@ RigRun run_rig(const CalibScenario& cs, const std::function<bool(double)>& progr
   if (progress) progress(1.0);
 
   // the true M: sensor calibration C from the realised model, T from the rest angles
-  const Eigen::Vector3d hinge[2] = {a1, a2};
+  const Eigen::Vector3d hinge[2] = {box.hinge_axis(1), box.hinge_axis(2)};
   for (int i = 0; i < 2; ++i) {
     const SensorInstance& inst = sensor[i].instance();
     const SensorParams& p = sensor[i].params();

@@ -9,17 +9,20 @@
 #include <Eigen/Core>
 #include <yaml-cpp/yaml.h>
 
+#include "estimator/input_error.hpp"
+#include "estimator/numbers.hpp"
+
 namespace driftless::calib::yio {
 
-inline std::string where(const std::string& file, const YAML::Node& n) {
+// the 1-based line of a node (0 when yaml-cpp knows none)
+inline std::size_t line_of(const YAML::Node& n) {
   const YAML::Mark m = n.Mark();
-  if (m.line < 0) return file;
-  return file + ":" + std::to_string(m.line + 1);
+  return m.line < 0 ? 0 : static_cast<std::size_t>(m.line) + 1;
 }
 
 [[noreturn]] inline void fail(const std::string& file, const YAML::Node& n, const std::string& key,
                               const std::string& msg) {
-  throw std::invalid_argument(where(file, n) + ": " + key + ": " + msg);
+  throw InputError(file, line_of(n), key, msg);
 }
 
 inline double as_double(const YAML::Node& n, const std::string& file, const std::string& key) {
@@ -50,13 +53,8 @@ inline Eigen::Matrix3d as_mat3(const YAML::Node& n, const std::string& file,
   return m;
 }
 
-// numbers are written with 17 significant digits: a file read back gives the same doubles
-inline std::string num(double v) {
-  std::ostringstream s;
-  s.precision(17);
-  s << v;
-  return s.str();
-}
+// numbers are written in their shortest exact form: a file read back gives the same doubles
+inline std::string num(double v) { return exact_number(v); }
 
 inline void emit_vec3(YAML::Emitter& out, const Eigen::Vector3d& v) {
   out << YAML::Flow << YAML::BeginSeq << num(v[0]) << num(v[1]) << num(v[2]) << YAML::EndSeq;

@@ -19,6 +19,7 @@
 #include "estimator/calibration.hpp"
 #include "estimator/pipeline.hpp"
 #include "estimator/tune.hpp"
+#include "report/json.hpp"
 
 namespace driftless::cli {
 namespace {
@@ -43,24 +44,12 @@ void put(fmt::memory_buffer& b, double v, int decimals) {
   else b.push_back(',');
 }
 
-std::string json_number(double v) { return std::isfinite(v) ? fmt::format("{:.9g}", v) : "null"; }
+using report::json_number;
+using report::json_string;
 
 std::string json_vec(const est::Vector6d& v) {
   return fmt::format("[{}, {}, {}, {}, {}, {}]", json_number(v[0]), json_number(v[1]), json_number(v[2]),
                      json_number(v[3]), json_number(v[4]), json_number(v[5]));
-}
-
-std::string json_string(const std::string& s) {
-  std::string o = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') o += '\\';
-    if (static_cast<unsigned char>(c) < 0x20) {
-      o += ' ';
-      continue;
-    }
-    o += c;
-  }
-  return o + "\"";
 }
 
 // writes the per-sample and per-update files while the pass runs

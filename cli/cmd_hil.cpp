@@ -12,6 +12,7 @@
 #include "cli/command.hpp"
 #include "estimator/filter.hpp"
 #include "estimator/log.hpp"
+#include "estimator/log_metadata.hpp"
 #include "hil_bridge/live_loop.hpp"
 #include "hil_bridge/source_rig.hpp"
 
@@ -74,12 +75,14 @@ int run_hil(const HilOptions& o) {
   }
 
   log::Metadata meta;
-  meta.set("sample_rate_hz", fmt::format("{}", first->source->sample_rate_hz()));
-  meta.set("latitude_deg", "52.0");
+  log::LogInfo info;
+  info.sample_rate_hz = first->source->sample_rate_hz();
+  info.latitude_deg = 52.0;  // deg, the paper's lab; a source that knows its box overrides it
+  log::write_log_info(meta, info);
   first->source->describe(meta);
   if (second) {
     meta.set("switch_to", second->source->name());
-    meta.set("switch_at_s", fmt::format("{}", o.at_s));
+    log::set_number(meta, "switch_at_s", o.at_s);
   }
   std::uint32_t fields = first->source->fields() | (second ? second->source->fields() : 0u);
 

@@ -10,6 +10,7 @@
 #include <mujoco/mujoco.h>
 
 #include "cli/command.hpp"
+#include "report/json.hpp"
 #include "renders/render_job.hpp"
 #include "renders/twin_source.hpp"
 
@@ -44,16 +45,18 @@ ModelPtr load_mjcf(const std::string& path) {
 // video.json beside video.mp4: what the renderer wrote, for checks (driftless demo) and users
 void write_sidecar(const RenderArgs& a, const render::RenderParams& p, const render::RenderStats& st, bool complete) {
   const std::filesystem::path path = std::filesystem::path(a.out).replace_extension(".json");
-  auto num = [](double v) { return std::isfinite(v) ? fmt::format("{}", v) : std::string("null"); };
+  using report::json_number;
+  using report::json_string;
   std::ofstream f(path);
   f << fmt::format(
-      "{{\n  \"format\": \"driftless-video 1\",\n  \"output\": \"{}\",\n  \"png_fallback\": {},\n"
+      "{{\n  \"format\": \"driftless-video 1\",\n  \"output\": {},\n  \"png_fallback\": {},\n"
       "  \"complete\": {},\n  \"frames\": {},\n  \"width\": {},\n  \"height\": {},\n  \"fps\": {},\n"
       "  \"speed\": {},\n  \"first_frame_s\": {},\n  \"last_frame_s\": {},\n  \"realtime_flip_frames\": {},\n"
-      "  \"camera\": \"{}\",\n  \"wall_s\": {:.3f}\n}}\n",
-      st.output, st.png_fallback, complete, st.frames, p.scene.width_px, p.scene.height_px, p.timeline.fps,
-      p.timeline.speed, num(st.first_frame_s), num(st.last_frame_s), st.realtime_flip_frames,
-      p.scene.camera.empty() ? "auto" : p.scene.camera, st.wall_s);
+      "  \"camera\": {},\n  \"wall_s\": {:.3f}\n}}\n",
+      json_string(st.output), st.png_fallback, complete, st.frames, p.scene.width_px, p.scene.height_px,
+      json_number(p.timeline.fps), json_number(p.timeline.speed), json_number(st.first_frame_s),
+      json_number(st.last_frame_s), st.realtime_flip_frames, json_string(p.scene.camera.empty() ? "auto" : p.scene.camera),
+      st.wall_s);
   if (!f.flush()) throw std::runtime_error("cannot write " + path.string());
 }
 

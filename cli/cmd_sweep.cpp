@@ -180,7 +180,9 @@ int run_sweep(const Options& opt) {
     }
     if (bad) fmt::print(stderr, "driftless sweep: rank {}: {} of {} runs failed\n", rep.rank, bad, rep.results.size());
   }
-  const std::size_t failed = write_outputs(cfg, specs, results, opt.out, !opt.no_plots);
+  std::vector<std::string> plot_warnings;
+  const std::size_t failed = write_outputs(cfg, specs, results, opt.out, !opt.no_plots, &plot_warnings);
+  for (const auto& w : plot_warnings) fmt::print(stderr, "driftless sweep: warning: {}\n", w);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   {
     std::ofstream t(std::filesystem::path(opt.out) / "timing.txt");

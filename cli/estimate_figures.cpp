@@ -5,7 +5,8 @@
 
 #include <fmt/core.h>
 
-#include "cli/plot.hpp"
+#include "report/gnuplot.hpp"
+#include "report/plot_table.hpp"
 #include "estimator/allan.hpp"
 
 namespace driftless::cli {
@@ -132,13 +133,13 @@ FigureOutcome fig4_bias(const fs::path& dir, const EstimateFigureInputs& in) {
     body += fig4_overlay_panel(sensor, in.truth);
   }
   body += "  unset multiplot\n";
-  const std::string w = render_gnuplot(dir, "fig4_bias", kUtf8 + body);
+  const std::string w = report::render(dir, report::Figure("fig4_bias", kUtf8 + body)).message;
   return {"fig4_bias", w.empty(), w};
 }
 
 // Allan deviation of six series (raw and corrected x, y, z) from sample `first` on
-std::vector<AllanTableColumn> allan_columns(const FigureSeries& sr, std::size_t first, double rate_hz) {
-  std::vector<AllanTableColumn> cols;
+std::vector<report::AllanTableColumn> allan_columns(const FigureSeries& sr, std::size_t first, double rate_hz) {
+  std::vector<report::AllanTableColumn> cols;
   est::AllanOptions opt;
   opt.sample_rate_hz = rate_hz;
   const bool fused = sr.platforms_moved;
@@ -147,7 +148,7 @@ std::vector<AllanTableColumn> allan_columns(const FigureSeries& sr, std::size_t 
       const auto& src = fused ? (pass == 0 ? sr.raw_rate[a] : sr.cor_rate[a]) : (pass == 0 ? sr.raw1[a] : sr.cor1[a]);
       std::vector<double> x(src.begin() + static_cast<long>(first), src.end());
       const auto curve = est::allan_deviation(x, opt);
-      AllanTableColumn c;
+      report::AllanTableColumn c;
       c.name = fmt::format("{}{}_{}", pass == 0 ? "raw_" : "corrected_", fused ? "rate" : "gyro1", "xyz"[a]);
       for (const auto& p : curve.points) {
         c.tau_s.push_back(p.tau_s);
@@ -178,7 +179,7 @@ FigureOutcome fig5_allan(const fs::path& dir, const EstimateFigureInputs& in) {
             fmt::format("only {:.1f} s of data after lock at {:.1f} s (needs {:.0f} s)", span_s, in.lock_s, kMinAllanSpanS)};
   }
   const auto cols = allan_columns(sr, first, in.sample_rate_hz);
-  write_allan_table(dir / "allan_fig5.csv", cols);
+  report::write_allan_table(dir / "allan_fig5.csv", cols);
   const double tau_lo = cols.front().tau_s.front(), tau_hi = cols.front().tau_s.back();
   std::string body = fmt::format(
       "  set logscale xy; set xlabel 'tau [s]'; set ylabel 'Allan deviation [deg/s]'; set xrange [{:.6g}:{:.6g}]\n"
@@ -193,7 +194,7 @@ FigureOutcome fig5_allan(const fs::path& dir, const EstimateFigureInputs& in) {
                         c + 1, c + 2, kAxisColour[i % 3], c, i < 3 ? 6 : 7, i < 3 ? 2 : 1, kAxisColour[i % 3], c,
                         i < 5 ? ", " : "\n");
   }
-  const std::string w = render_gnuplot(dir, "fig5_allan", kUtf8 + body);
+  const std::string w = report::render(dir, report::Figure("fig5_allan", kUtf8 + body)).message;
   return {"fig5_allan", w.empty(), w};
 }
 
@@ -226,7 +227,7 @@ FigureOutcome fig9_attitude(const fs::path& dir, const EstimateFigureInputs& in)
                         "estimate)'{}",
                         2 + a, a + 1, kAngle[a], a < 2 ? ", " : "\n");
   }
-  const std::string w = render_gnuplot(dir, "fig9_attitude", kUtf8 + body);
+  const std::string w = report::render(dir, report::Figure("fig9_attitude", kUtf8 + body)).message;
   return {"fig9_attitude", w.empty(), w};
 }
 

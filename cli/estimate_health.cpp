@@ -4,12 +4,15 @@
 
 #include <fmt/format.h>
 
+#include "report/json.hpp"
+
 namespace driftless::cli {
 namespace {
 
 constexpr const char* kComponentNames[6] = {"b1_x", "b1_y", "b1_z", "b2_x", "b2_y", "b2_z"};
 
-std::string num(double v) { return std::isfinite(v) ? fmt::format("{:.9g}", v) : "null"; }
+using report::json_number;
+using report::json_string;
 
 const char* cause_key(est::HealthCause c) {
   switch (c) {
@@ -24,15 +27,6 @@ const char* cause_key(est::HealthCause c) {
     case est::HealthCause::kRelocks: return "relocks";
   }
   return "?";
-}
-
-std::string json_text(const std::string& s) {
-  std::string o = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') o += '\\';
-    o += static_cast<unsigned char>(c) < 0x20 ? ' ' : c;
-  }
-  return o + "\"";
 }
 
 // "(90, -90) and (-90, 90) deg" (plat1, plat2)
@@ -109,16 +103,16 @@ std::string health_json(const est::HealthReport& h, const est::EstimatorConfig& 
   for (std::size_t i = 0; i < h.findings.size(); ++i) {
     findings += fmt::format("{}\n    {{\"cause\": \"{}\", \"severity\": \"{}\", \"text\": {}}}", i ? "," : "",
                             cause_key(h.findings[i].cause), est::to_string(h.findings[i].severity),
-                            json_text(describe(h.findings[i], cfg)));
+                            json_string(describe(h.findings[i], cfg)));
   }
   findings += h.findings.empty() ? "]" : "\n  ]";
   return fmt::format(
       "  \"health\": {{\"verdict\": \"{}\", \"locked\": {}, \"lock_t_s\": {}, \"updates\": {}, \"rejected\": {}, "
       "\"rejected_fraction\": {}, \"nis_updates\": {}, \"nis_dof_mean\": {}, \"nis_mean\": {}, "
       "\"nis_mean_band_95\": [{}, {}], \"relocks\": {}, \"unobservable\": {},\n  \"findings\": {}}}",
-      est::to_string(h.verdict), h.locked ? "true" : "false", num(h.lock_t_s), h.updates, h.rejected,
-      num(h.rejected_fraction), h.nis_updates, num(h.nis_dof_mean), num(h.nis_mean), num(h.nis_mean_band_lo),
-      num(h.nis_mean_band_hi), h.relocks, unobs, findings);
+      est::to_string(h.verdict), h.locked ? "true" : "false", json_number(h.lock_t_s), h.updates, h.rejected,
+      json_number(h.rejected_fraction), h.nis_updates, json_number(h.nis_dof_mean), json_number(h.nis_mean), json_number(h.nis_mean_band_lo),
+      json_number(h.nis_mean_band_hi), h.relocks, unobs, findings);
 }
 
 std::vector<std::string> health_lines(const est::HealthReport& h, const est::EstimatorConfig& cfg) {

@@ -9,7 +9,10 @@
 #include <mujoco/mujoco.h>
 
 #include "estimator/geometry.hpp"
+#include "estimator/input_error.hpp"
+#include "twin/motion.hpp"
 #include "twin/world.hpp"
+#include "twin/yaml_doc.hpp"
 
 namespace driftless::diagnose {
 
@@ -55,24 +58,16 @@ CompareModel default_compare_model() {
 CompareModel load_compare_model(const std::filesystem::path& path) {
   // a file holding only `model:` is a model config; anything else is a scenario. Both go
   // through twin-core's parser, so every key a user can write is honoured (or refused there).
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path.string());
-  } catch (const YAML::BadFile&) {
-    throw std::runtime_error(fmt::format("{}: cannot read the model file", path.string()));
-  } catch (const YAML::Exception& e) {
-    throw std::runtime_error(fmt::format("{}:{}: {}", path.string(), e.mark.line + 1, e.msg));
-  }
-  if (!root.IsMap() || !root["model"]) {
-    throw std::runtime_error(fmt::format(
-        "{}: no 'model:' key (a model file is a scenario, or a file holding only 'model: {{box: ..., "
-        "sensor1: ..., sensor2: ...}}'; see docs/compare.md)",
-        path.string()));
+  const fields::Node root = load_yaml_file(path);
+  if (!root.is_map() || root.find("model") == nullptr) {
+    throw InputError(path.string(), 0, "model",
+                     "missing (a model file is a scenario, or a file holding only 'model: {box: ..., "
+                     "sensor1: ..., sensor2: ...}'; see docs/compare.md)");
   }
   CompareModel m;
   m.source = path.string();
   ModelConfig cfg;
-  if (root.size() == 1) {
+  if (root.entries.size() == 1) {
     cfg = load_model_config(path, ModelConfig{});
   } else {
     m.scenario = load_scenario(path.string());
@@ -95,11 +90,9 @@ void save_compare_model(const CompareModel& m, const std::filesystem::path& path
   std::string text = emit_scenario(sc);
   if (!m.is_scenario) {
     // a model-only file stays one: only the `model:` block
-    YAML::Node full = YAML::Load(text);
-    YAML::Emitter out;
-    out.SetDoublePrecision(10);
-    out << YAML::BeginMap << YAML::Key << "model" << YAML::Value << full["model"] << YAML::EndMap;
-    text = out.c_str();
+    fields::Node top = fields::Node::map();
+    top.add("model", model_node(sc.model));
+    text = to_yaml(top);
   }
   std::ofstream f(path);
   if (!f) throw std::runtime_error(fmt::format("cannot write {}", path.string()));
@@ -166,25 +159,17 @@ Eigen::Matrix2d settled_stop_offsets_deg(const BoxParams& box) {
   // platform presses into MuJoCo's soft stop: settle each platform on each stop, level box held
   // still, and read how far past (nominal + error) it rests
   Eigen::Matrix2d out = Eigen::Matrix2d::Zero();
-  World world(box, 0.001);
-  mjModel* m = world.model();
-  mjData* d = world.data();
+  World world(box, 0.001, ModelScope::physics);
+  const MotionState held;  // level box at the origin, at rest
   for (int side : {-1, 1}) {
-    mj_resetData(m, d);
-    const Eigen::Vector3d p0 = Eigen::Vector3d::Zero();
-    const Eigen::Quaterniond q0 = Eigen::Quaterniond::Identity();
-    for (int i = 1; i <= 2; ++i) {
-      // start just short of the stop: the servo drives it on and presses, as after a flip
-      world.set_platform(i, box.stop_rad(i, side) - side * 0.2 * kRadPerDeg, 0.0);
-      world.set_motor_reference(i, side * (box.end_stop_deg + box.motor.overtravel_deg) * kRadPerDeg);
-    }
+    mj_resetData(world.model(), world.data());
+    // start just short of the stop: the servo drives it on and presses, as after a flip
+    for (int i = 1; i <= 2; ++i) world.set_platform(i, box.stop_rad(i, side) - side * 0.2 * kRadPerDeg, 0.0);
+    const Eigen::Vector2d ref = Eigen::Vector2d::Constant(side * (box.end_stop_deg + box.motor.overtravel_deg) * kRadPerDeg);
     const int steps = 3000, average_from = 2000;  // 3 s at 1 ms; the last second averaged
     Eigen::Vector2d sum = Eigen::Vector2d::Zero();
     for (int step = 0; step < steps; ++step) {
-      world.set_base(p0, q0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
-      mj_step1(m, d);
-      world.drive_base(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
-      mj_step2(m, d);
+      world.step_driven(0.0, held, ref, false);
       if (step >= average_from) {
         for (int i = 1; i <= 2; ++i) sum[i - 1] += world.platform_angle_rad(i) - box.stop_rad(i, side);
       }

@@ -9,54 +9,16 @@
 
 #include <fmt/core.h>
 
+#include "report/gnuplot.hpp"
+#include "report/html.hpp"
+#include "report/json.hpp"
+
 namespace driftless::diagnose {
 namespace {
 
-std::string esc_json(const std::string& s) {
-  std::string o;
-  for (char c : s) {
-    switch (c) {
-      case '"': o += "\\\""; break;
-      case '\\': o += "\\\\"; break;
-      case '\n': o += "\\n"; break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) o += fmt::format("\\u{:04x}", c);
-        else o += c;
-    }
-  }
-  return o;
-}
-std::string num(double v) { return std::isfinite(v) ? fmt::format("{:.9g}", v) : "null"; }
-
-std::string esc_html(const std::string& s) {
-  std::string o;
-  for (char c : s) {
-    if (c == '<') o += "&lt;";
-    else if (c == '>') o += "&gt;";
-    else if (c == '&') o += "&amp;";
-    else o += c;
-  }
-  return o;
-}
-
-std::string base64(const std::string& in) {
-  static const char* t = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string o;
-  std::size_t i = 0;
-  for (; i + 2 < in.size(); i += 3) {
-    const unsigned v = (static_cast<unsigned char>(in[i]) << 16) | (static_cast<unsigned char>(in[i + 1]) << 8) |
-                       static_cast<unsigned char>(in[i + 2]);
-    o += t[(v >> 18) & 63]; o += t[(v >> 12) & 63]; o += t[(v >> 6) & 63]; o += t[v & 63];
-  }
-  if (i + 1 == in.size()) {
-    const unsigned v = static_cast<unsigned char>(in[i]) << 16;
-    o += t[(v >> 18) & 63]; o += t[(v >> 12) & 63]; o += "==";
-  } else if (i + 2 == in.size()) {
-    const unsigned v = (static_cast<unsigned char>(in[i]) << 16) | (static_cast<unsigned char>(in[i + 1]) << 8);
-    o += t[(v >> 18) & 63]; o += t[(v >> 12) & 63]; o += t[(v >> 6) & 63]; o += '=';
-  }
-  return o;
-}
+using report::html_escape;
+using report::json_number;
+using report::json_string;
 
 std::string read_file(const std::filesystem::path& p) {
   std::ifstream f(p, std::ios::binary);
@@ -65,41 +27,34 @@ std::string read_file(const std::filesystem::path& p) {
   return ss.str();
 }
 
-// runs gnuplot on a script; returns the PNG bytes or "" when gnuplot is missing or failed, or
-// when it found no data to draw (its messages are kept in plots/<stem>.log)
+// renders a figure through the one gnuplot runner; the PNG bytes, or "" when gnuplot is missing,
+// failed, or found no data to draw (its messages are kept in plots/<stem>.gp.log)
 std::string gnuplot_png(const std::filesystem::path& dir, const std::string& stem, const std::string& script) {
-  const auto gp = dir / (stem + ".gp");
-  const auto png = dir / (stem + ".png");
-  const auto log = dir / (stem + ".log");
-  auto run = [&](const char* terminal) {
-    std::filesystem::remove(png);
-    {
-      std::ofstream f(gp);
-      f << "set terminal " << terminal << " size 900,420\nset output '" << png.string() << "'\n" << script;
-    }
-    const std::string cmd = fmt::format("gnuplot '{}' > '{}' 2>&1", gp.string(), log.string());
-    return std::system(cmd.c_str()) == 0;
-  };
-  // pngcairo may be absent in gnuplot-nox: fall back to the plain png terminal
-  if (!run("pngcairo font 'sans,9'") && !run("png")) return {};
-  const std::string msgs = read_file(log);
-  if (msgs.find("no valid points") != std::string::npos || msgs.find("all points") != std::string::npos) return {};
-  return read_file(png);
+  report::Figure f(stem, script);
+  f.width_px = 900;
+  f.height_px = 420;
+  f.svg = false;
+  f.csv_defaults = false;
+  f.font = "sans,9";
+  f.empty_is_failure = true;
+  std::filesystem::remove(dir / (stem + ".png"));
+  if (!report::render(dir, f).ok) return {};
+  return read_file(dir / (stem + ".png"));
 }
 
 void candidate_json(std::ostringstream& o, const Candidate& c) {
-  o << "{\"effect\": \"" << esc_json(c.effect) << "\", \"sensor\": \"" << esc_json(c.sensor) << "\", \"axis\": \""
-    << esc_json(c.axis) << "\", \"kind\": \"" << c.kind << "\", \"testable\": " << (c.testable ? "true" : "false")
+  o << "{\"effect\": " << json_string(c.effect) << ", \"sensor\": " << json_string(c.sensor) << ", \"axis\": "
+    << json_string(c.axis) << ", \"kind\": \"" << c.kind << "\", \"testable\": " << (c.testable ? "true" : "false")
     << ", \"applicable\": " << (c.applicable ? "true" : "false") << ", \"params\": [";
   for (std::size_t i = 0; i < c.params.size(); ++i) {
     const auto& p = c.params[i];
-    o << (i ? ", " : "") << "{\"name\": \"" << esc_json(p.name) << "\", \"value\": " << num(p.value)
-      << ", \"sigma\": " << num(p.sigma) << ", \"unit\": \"" << esc_json(p.unit) << "\"}";
+    o << (i ? ", " : "") << "{\"name\": " << json_string(p.name) << ", \"value\": " << json_number(p.value)
+      << ", \"sigma\": " << json_number(p.sigma) << ", \"unit\": " << json_string(p.unit) << "}";
   }
-  o << "], \"explained_fraction\": " << num(c.explained_fraction) << ", \"evidence\": " << num(c.evidence)
-    << ", \"chi2\": " << num(c.chi2) << ", \"dof\": " << c.dof << ", \"p_value\": " << num(c.p_value)
-    << ", \"note\": \"" << esc_json(c.note) << "\", \"residual_rms_after_dps\": {";
-  for (int ch = 0; ch < 6; ++ch) o << (ch ? ", " : "") << "\"" << channel_name(ch) << "\": " << num(c.rms_after_dps[ch]);
+  o << "], \"explained_fraction\": " << json_number(c.explained_fraction) << ", \"evidence\": " << json_number(c.evidence)
+    << ", \"chi2\": " << json_number(c.chi2) << ", \"dof\": " << c.dof << ", \"p_value\": " << json_number(c.p_value)
+    << ", \"note\": " << json_string(c.note) << ", \"residual_rms_after_dps\": {";
+  for (int ch = 0; ch < 6; ++ch) o << (ch ? ", " : "") << "\"" << channel_name(ch) << "\": " << json_number(c.rms_after_dps[ch]);
   o << "}}";
 }
 
@@ -108,13 +63,13 @@ void candidate_json(std::ostringstream& o, const Candidate& c) {
 std::string diagnosis_json(const CompareResult& r, const ReportExtras& x) {
   std::ostringstream o;
   o << "{\n  \"format\": \"driftless-diagnosis 1\",\n";
-  o << "  \"log\": \"" << esc_json(r.log_path) << "\",\n  \"model\": \"" << esc_json(r.model_source) << "\",\n";
-  o << "  \"verdict\": \"" << r.verdict << "\",\n  \"statement\": \"" << esc_json(r.statement) << "\",\n";
-  o << "  \"samples\": " << r.samples << ", \"samples_used\": " << r.samples_used << ", \"duration_s\": " << num(r.duration_s)
-    << ", \"sample_rate_hz\": " << num(r.sample_rate_hz) << ", \"block_s\": " << num(r.block_s)
+  o << "  \"log\": " << json_string(r.log_path) << ",\n  \"model\": " << json_string(r.model_source) << ",\n";
+  o << "  \"verdict\": \"" << r.verdict << "\",\n  \"statement\": " << json_string(r.statement) << ",\n";
+  o << "  \"samples\": " << r.samples << ", \"samples_used\": " << r.samples_used << ", \"duration_s\": " << json_number(r.duration_s)
+    << ", \"sample_rate_hz\": " << json_number(r.sample_rate_hz) << ", \"block_s\": " << json_number(r.block_s)
     << ", \"resampled\": " << (r.resampled ? "true" : "false") << ",\n";
   o << "  \"notes\": [";
-  for (std::size_t i = 0; i < r.notes.size(); ++i) o << (i ? ", " : "") << "\"" << esc_json(r.notes[i]) << "\"";
+  for (std::size_t i = 0; i < r.notes.size(); ++i) o << (i ? ", " : "") << json_string(r.notes[i]);
   o << "],\n  \"ranking\": [\n";
   for (std::size_t i = 0; i < r.ranking.size(); ++i) {
     o << "    ";
@@ -125,36 +80,36 @@ std::string diagnosis_json(const CompareResult& r, const ReportExtras& x) {
   const Candidate* best = r.ranking.empty() ? nullptr : &r.ranking.front();
   for (int c = 0; c < 6; ++c) {
     const auto& ch = r.channels[c];
-    o << "    \"" << channel_name(c) << "\": {\"before\": " << num(ch.rms_dps)
-      << ", \"after_best\": " << num(best ? best->rms_after_dps[c] : ch.rms_dps)
-      << ", \"raw\": " << num(ch.raw_rms_dps) << ", \"noise_floor\": " << num(ch.noise_floor_dps)
-      << ", \"systematic\": " << num(ch.systematic_rms_dps);
-    if (x.after) o << ", \"after_apply\": " << num(x.after->channels[c].rms_dps) << ", \"systematic_after_apply\": " << num(x.after->channels[c].systematic_rms_dps);
+    o << "    \"" << channel_name(c) << "\": {\"before\": " << json_number(ch.rms_dps)
+      << ", \"after_best\": " << json_number(best ? best->rms_after_dps[c] : ch.rms_dps)
+      << ", \"raw\": " << json_number(ch.raw_rms_dps) << ", \"noise_floor\": " << json_number(ch.noise_floor_dps)
+      << ", \"systematic\": " << json_number(ch.systematic_rms_dps);
+    if (x.after) o << ", \"after_apply\": " << json_number(x.after->channels[c].rms_dps) << ", \"systematic_after_apply\": " << json_number(x.after->channels[c].systematic_rms_dps);
     o << "}" << (c < 5 ? ",\n" : "\n");
   }
   o << "  },\n  \"channels\": {\n";
   for (int c = 0; c < 6; ++c) {
     const auto& ch = r.channels[c];
-    o << "    \"" << channel_name(c) << "\": {\"mean_dps\": " << num(ch.mean_dps) << ", \"raw_mean_dps\": " << num(ch.raw_mean_dps)
-      << ", \"white_noise_fit_dps_rthz\": " << num(ch.white_fit_dps_rthz) << ", \"ljung_box_q\": " << num(ch.ljung_box_q)
-      << ", \"ljung_box_p\": " << num(ch.ljung_box_p)
-      << ", \"autocorrelation_excess\": " << num(ch.autocorrelation_excess) << ", \"white\": " << (ch.white ? "true" : "false") << ", \"turn_on_bias_dps\": " << num(ch.turn_on_bias_dps)
-      << ", \"adev_outside_fraction\": " << num(ch.adev_outside_fraction) << "}" << (c < 5 ? ",\n" : "\n");
+    o << "    \"" << channel_name(c) << "\": {\"mean_dps\": " << json_number(ch.mean_dps) << ", \"raw_mean_dps\": " << json_number(ch.raw_mean_dps)
+      << ", \"white_noise_fit_dps_rthz\": " << json_number(ch.white_fit_dps_rthz) << ", \"ljung_box_q\": " << json_number(ch.ljung_box_q)
+      << ", \"ljung_box_p\": " << json_number(ch.ljung_box_p)
+      << ", \"autocorrelation_excess\": " << json_number(ch.autocorrelation_excess) << ", \"white\": " << (ch.white ? "true" : "false") << ", \"turn_on_bias_dps\": " << json_number(ch.turn_on_bias_dps)
+      << ", \"adev_outside_fraction\": " << json_number(ch.adev_outside_fraction) << "}" << (c < 5 ? ",\n" : "\n");
   }
   o << "  },\n  \"regimes\": [\n";
   for (std::size_t i = 0; i < r.regimes.size(); ++i) {
     const auto& g = r.regimes[i];
-    o << "    {\"group\": \"" << esc_json(g.group) << "\", \"name\": \"" << esc_json(g.name) << "\", \"samples\": " << g.samples
+    o << "    {\"group\": " << json_string(g.group) << ", \"name\": " << json_string(g.name) << ", \"samples\": " << g.samples
       << ", \"rms_dps\": [";
-    for (int c = 0; c < 6; ++c) o << (c ? ", " : "") << num(g.rms_dps[c]);
+    for (int c = 0; c < 6; ++c) o << (c ? ", " : "") << json_number(g.rms_dps[c]);
     o << "], \"mean_dps\": [";
-    for (int c = 0; c < 6; ++c) o << (c ? ", " : "") << num(g.mean_dps[c]);
+    for (int c = 0; c < 6; ++c) o << (c ? ", " : "") << json_number(g.mean_dps[c]);
     o << "]";
     if (x.after) {
       for (const auto& h : x.after->regimes) {
         if (h.group != g.group || h.name != g.name) continue;
         o << ", \"rms_after_apply_dps\": [";
-        for (int c = 0; c < 6; ++c) o << (c ? ", " : "") << num(h.rms_dps[c]);
+        for (int c = 0; c < 6; ++c) o << (c ? ", " : "") << json_number(h.rms_dps[c]);
         o << "]";
       }
     }
@@ -163,19 +118,19 @@ std::string diagnosis_json(const CompareResult& r, const ReportExtras& x) {
   o << "  ],\n  \"worst_windows\": [\n";
   for (std::size_t i = 0; i < r.worst_windows.size(); ++i) {
     const auto& w = r.worst_windows[i];
-    o << "    {\"t0_s\": " << num(w.t0_s) << ", \"t1_s\": " << num(w.t1_s) << ", \"worst_channel\": \"" << channel_name(w.worst_channel)
-      << "\", \"rms_over_floor\": " << num(w.worst_ratio) << "}" << (i + 1 < r.worst_windows.size() ? ",\n" : "\n");
+    o << "    {\"t0_s\": " << json_number(w.t0_s) << ", \"t1_s\": " << json_number(w.t1_s) << ", \"worst_channel\": \"" << channel_name(w.worst_channel)
+      << "\", \"rms_over_floor\": " << json_number(w.worst_ratio) << "}" << (i + 1 < r.worst_windows.size() ? ",\n" : "\n");
   }
   o << "  ],\n  \"correlations\": [\n";
   for (std::size_t i = 0; i < r.correlations.size(); ++i) {
     const auto& c = r.correlations[i];
-    o << "    {\"signal\": \"" << esc_json(c.signal) << "\", \"channel\": \"" << channel_name(c.channel) << "\", \"rho\": " << num(c.rho)
-      << ", \"z\": " << num(c.z) << "}" << (i + 1 < r.correlations.size() ? ",\n" : "\n");
+    o << "    {\"signal\": " << json_string(c.signal) << ", \"channel\": \"" << channel_name(c.channel) << "\", \"rho\": " << json_number(c.rho)
+      << ", \"z\": " << json_number(c.z) << "}" << (i + 1 < r.correlations.size() ? ",\n" : "\n");
   }
   o << "  ]";
   if (x.after) {
-    o << ",\n  \"after_apply\": {\"model\": \"" << esc_json(x.after_model) << "\", \"applied\": \"" << esc_json(x.applied)
-      << "\", \"verdict\": \"" << x.after->verdict << "\", \"statement\": \"" << esc_json(x.after->statement) << "\"}";
+    o << ",\n  \"after_apply\": {\"model\": " << json_string(x.after_model) << ", \"applied\": " << json_string(x.applied)
+      << ", \"verdict\": \"" << x.after->verdict << "\", \"statement\": " << json_string(x.after->statement) << "}";
   }
   o << "\n}\n";
   return o.str();
@@ -196,7 +151,7 @@ void write_report(const CompareResult& r, const std::filesystem::path& dir, cons
     std::ofstream d(plot_dir / "residual.dat");
     for (std::size_t b = 0; b < r.block_t_s.size(); ++b) {
       d << fmt::format("{:.3f}", r.block_t_s[b]);
-      for (int c = 0; c < 6; ++c) d << ' ' << num(r.block_residual_dps[c][b]) << ' ' << num(r.block_bias_dps[c][b]);
+      for (int c = 0; c < 6; ++c) d << ' ' << json_number(r.block_residual_dps[c][b]) << ' ' << json_number(r.block_bias_dps[c][b]);
       d << '\n';
     }
     d.close();  // flushed before gnuplot reads it (an open stream left the file empty)
@@ -205,7 +160,7 @@ void write_report(const CompareResult& r, const std::filesystem::path& dir, cons
       s += fmt::format("set title 'sensor {}: block-mean residual after the nuisance fit (points) and smoothed bias (lines)'\nplot ", sn + 1);
       for (int a = 0; a < 3; ++a) {
         const int c = sn * 3 + a;
-        s += fmt::format("'{}' u 1:{} w d t '{}', '' u 1:{} w l lw 2 t 'bias {}'{}", (plot_dir / "residual.dat").string(), 2 + 2 * c,
+        s += fmt::format("'{}' u 1:{} w d t '{}', '' u 1:{} w l lw 2 t 'bias {}'{}", "residual.dat", 2 + 2 * c,
                          channel_name(c), 3 + 2 * c, channel_name(c), a < 2 ? ", " : "\n");
       }
     }
@@ -217,13 +172,13 @@ void write_report(const CompareResult& r, const std::filesystem::path& dir, cons
     std::ofstream d(plot_dir / "windows.dat");
     for (const auto& w : r.windows) {
       d << fmt::format("{:.3f}", 0.5 * (w.t0_s + w.t1_s));
-      for (int c = 0; c < 6; ++c) d << ' ' << num(w.rms_dps[c]);
+      for (int c = 0; c < 6; ++c) d << ' ' << json_number(w.rms_dps[c]);
       d << '\n';
     }
     d.close();
     std::string s = "set xlabel 't (s)'\nset ylabel 'rms (deg/s)'\nset key outside right\nset title 'windowed residual rms'\nplot ";
     for (int c = 0; c < 6; ++c)
-      s += fmt::format("'{}' u 1:{} w lp t '{}'{}", (plot_dir / "windows.dat").string(), 2 + c, channel_name(c), c < 5 ? ", " : "\n");
+      s += fmt::format("'{}' u 1:{} w lp t '{}'{}", "windows.dat", 2 + c, channel_name(c), c < 5 ? ", " : "\n");
     plots.push_back({"Windowed residual RMS", gnuplot_png(plot_dir, "windows", s)});
   }
   // 3: ADEV of the residual vs the model
@@ -234,7 +189,7 @@ void write_report(const CompareResult& r, const std::filesystem::path& dir, cons
     for (std::size_t i = 0; i < np; ++i) {
       for (int c = 0; c < 6; ++c) {
         const auto& ch = r.channels[c];
-        if (i < ch.adev.points.size()) d << num(ch.adev.points[i].tau_s) << ' ' << num(ch.adev.points[i].adev) << ' ' << num(ch.adev_model[i]) << ' ';
+        if (i < ch.adev.points.size()) d << json_number(ch.adev.points[i].tau_s) << ' ' << json_number(ch.adev.points[i].adev) << ' ' << json_number(ch.adev_model[i]) << ' ';
         else d << "null null null ";
       }
       d << '\n';
@@ -242,7 +197,7 @@ void write_report(const CompareResult& r, const std::filesystem::path& dir, cons
     d.close();
     std::string s = "set logscale xy\nset xlabel 'tau (s)'\nset ylabel 'ADEV (deg/s)'\nset key outside right\nset datafile missing 'null'\nset title 'Allan deviation of the residual (points) and of the model noise (lines)'\nplot ";
     for (int c = 0; c < 6; ++c)
-      s += fmt::format("'{0}' u {1}:{2} w p t '{3}', '' u {1}:{4} w l dt 2 t '{3} model'{5}", (plot_dir / "adev.dat").string(), 1 + 3 * c,
+      s += fmt::format("'{0}' u {1}:{2} w p t '{3}', '' u {1}:{4} w l dt 2 t '{3} model'{5}", "adev.dat", 1 + 3 * c,
                        2 + 3 * c, channel_name(c), 3 + 3 * c, c < 5 ? ", " : "\n");
     plots.push_back({"Allan deviation", gnuplot_png(plot_dir, "adev", s)});
   }
@@ -251,13 +206,13 @@ void write_report(const CompareResult& r, const std::filesystem::path& dir, cons
     std::ofstream d(plot_dir / "regimes.dat");
     for (std::size_t i = 0; i < r.regimes.size(); ++i) {
       d << '"' << r.regimes[i].group << ": " << r.regimes[i].name << '"';
-      for (int c = 0; c < 6; ++c) d << ' ' << num(r.regimes[i].rms_dps[c]);
+      for (int c = 0; c < 6; ++c) d << ' ' << json_number(r.regimes[i].rms_dps[c]);
       d << '\n';
     }
     d.close();
     std::string s = "set style data histograms\nset style fill solid 0.8\nset xtics rotate by -30\nset ylabel 'rms (deg/s)'\nset key outside right\nset title 'residual rms by regime'\nplot ";
     for (int c = 0; c < 6; ++c)
-      s += fmt::format("'{}' u {}:xtic(1) t '{}'{}", (plot_dir / "regimes.dat").string(), 2 + c, channel_name(c), c < 5 ? ", " : "\n");
+      s += fmt::format("'{}' u {}:xtic(1) t '{}'{}", "regimes.dat", 2 + c, channel_name(c), c < 5 ? ", " : "\n");
     plots.push_back({"Residual by regime", gnuplot_png(plot_dir, "regimes", s)});
   }
 
@@ -266,18 +221,18 @@ void write_report(const CompareResult& r, const std::filesystem::path& dir, cons
        "body{font-family:sans-serif;max-width:1100px;margin:auto;padding:1em}table{border-collapse:collapse;margin:0.5em 0}"
        "td,th{border:1px solid #bbb;padding:2px 6px;font-size:90%;text-align:right}th{background:#eee}"
        "td.l{text-align:left}.v{font-size:120%;padding:0.5em;background:#f4f4d0}</style></head><body>\n";
-  h << "<h1>Model versus measurement</h1>\n<p>log: <code>" << esc_html(r.log_path) << "</code><br>model: <code>" << esc_html(r.model_source)
+  h << "<h1>Model versus measurement</h1>\n<p>log: <code>" << html_escape(r.log_path) << "</code><br>model: <code>" << html_escape(r.model_source)
     << "</code><br>" << r.samples << " samples, " << fmt::format("{:.1f}", r.duration_s) << " s at " << fmt::format("{:.3f}", r.sample_rate_hz)
     << " Hz; " << r.samples_used << " used (platforms at rest)" << (r.resampled ? "; <b>resampled to the model's rate</b>" : "") << "</p>\n";
-  h << "<p class='v'><b>" << esc_html(r.verdict) << "</b>: " << esc_html(r.statement) << "</p>\n";
+  h << "<p class='v'><b>" << html_escape(r.verdict) << "</b>: " << html_escape(r.statement) << "</p>\n";
   if (!r.notes.empty()) {
     h << "<h3>Assumptions</h3><ul>";
-    for (const auto& n : r.notes) h << "<li>" << esc_html(n) << "</li>";
+    for (const auto& n : r.notes) h << "<li>" << html_escape(n) << "</li>";
     h << "</ul>\n";
   }
   if (x.after) {
-    h << "<h2>Before / after</h2><p>applied: " << esc_html(x.applied) << "<br>new model: <code>" << esc_html(x.after_model)
-      << "</code><br>after: <b>" << esc_html(x.after->verdict) << "</b>: " << esc_html(x.after->statement) << "</p>\n";
+    h << "<h2>Before / after</h2><p>applied: " << html_escape(x.applied) << "<br>new model: <code>" << html_escape(x.after_model)
+      << "</code><br>after: <b>" << html_escape(x.after->verdict) << "</b>: " << html_escape(x.after->statement) << "</p>\n";
     h << "<table><tr><th>channel</th><th>rms before (deg/s)</th><th>rms after</th><th>systematic before</th><th>systematic after</th><th>noise floor</th></tr>";
     for (int c = 0; c < 6; ++c)
       h << fmt::format("<tr><td class=l>{}</td><td>{:.5f}</td><td>{:.5f}</td><td>{:.5f}</td><td>{:.5f}</td><td>{:.5f}</td></tr>", channel_name(c),
@@ -289,7 +244,7 @@ void write_report(const CompareResult& r, const std::filesystem::path& dir, cons
     for (const auto& g : r.regimes) {
       for (const auto& a : x.after->regimes) {
         if (a.group != g.group || a.name != g.name) continue;
-        h << "<tr><td class=l>" << esc_html(g.group + ": " + g.name) << "</td><td>" << g.samples << "</td>";
+        h << "<tr><td class=l>" << html_escape(g.group + ": " + g.name) << "</td><td>" << g.samples << "</td>";
         for (int c = 0; c < 6; ++c) h << fmt::format("<td>{:.4f} / {:.4f}</td>", g.rms_dps[c], a.rms_dps[c]);
         h << "</tr>";
       }
@@ -301,10 +256,10 @@ void write_report(const CompareResult& r, const std::filesystem::path& dir, cons
     const auto& c = r.ranking[i];
     std::string ps;
     for (std::size_t k = 0; k < std::min<std::size_t>(c.params.size(), 9); ++k)
-      ps += fmt::format("{}{} = {:.4g} ± {:.2g} {}", k ? "<br>" : "", esc_html(c.params[k].name), c.params[k].value, c.params[k].sigma, esc_html(c.params[k].unit));
-    if (!c.testable) ps = esc_html(c.note);
+      ps += fmt::format("{}{} = {:.4g} ± {:.2g} {}", k ? "<br>" : "", html_escape(c.params[k].name), c.params[k].value, c.params[k].sigma, html_escape(c.params[k].unit));
+    if (!c.testable) ps = html_escape(c.note);
     h << fmt::format("<tr><td>{}</td><td class=l>{}</td><td>{}</td><td class=l>{}</td><td>{}</td><td>{:.1f} %</td><td>{:.2g}</td><td class=l>{}</td></tr>", i + 1,
-                     esc_html(c.effect), esc_html(c.sensor), esc_html(c.axis), c.testable ? fmt::format("{:.1f}", c.evidence) : "n/a",
+                     html_escape(c.effect), html_escape(c.sensor), html_escape(c.axis), c.testable ? fmt::format("{:.1f}", c.evidence) : "n/a",
                      100.0 * c.explained_fraction, c.p_value, ps);
   }
   h << "</table>\n<h2>Residual per channel</h2><table><tr><th>channel</th><th>raw mean</th><th>raw rms</th><th>mean</th><th>rms</th><th>after best</th><th>noise floor</th><th>systematic</th><th>N fit (deg/s/&radic;Hz)</th><th>Ljung-Box p</th><th>turn-on bias</th></tr>";
@@ -323,7 +278,7 @@ void write_report(const CompareResult& r, const std::filesystem::path& dir, cons
   for (int c = 0; c < 6; ++c) h << "<th>" << channel_name(c) << " rms</th>";
   h << "</tr>";
   for (const auto& g : r.regimes) {
-    h << "<tr><td class=l>" << esc_html(g.group + ": " + g.name) << "</td><td>" << g.samples << "</td>";
+    h << "<tr><td class=l>" << html_escape(g.group + ": " + g.name) << "</td><td>" << g.samples << "</td>";
     for (int c = 0; c < 6; ++c) h << fmt::format("<td>{:.5f}</td>", g.rms_dps[c]);
     h << "</tr>";
   }
@@ -331,13 +286,13 @@ void write_report(const CompareResult& r, const std::filesystem::path& dir, cons
   if (!r.correlations.empty()) {
     h << "<h2>Correlations of the residual with inputs</h2><table><tr><th>signal</th><th>channel</th><th>rho</th><th>z</th></tr>";
     for (const auto& c : r.correlations)
-      h << fmt::format("<tr><td class=l>{}</td><td>{}</td><td>{:+.3f}</td><td>{:.1f}</td></tr>", esc_html(c.signal), channel_name(c.channel), c.rho, c.z);
+      h << fmt::format("<tr><td class=l>{}</td><td>{}</td><td>{:+.3f}</td><td>{:.1f}</td></tr>", html_escape(c.signal), channel_name(c.channel), c.rho, c.z);
     h << "</table>\n";
   }
   h << "<h2>Plots</h2>\n";
   for (const auto& [title, png] : plots) {
-    if (png.empty()) h << "<p>" << esc_html(title) << ": no plot (gnuplot missing or no data to draw; data and gnuplot's messages in plots/)</p>\n";
-    else h << "<h3>" << esc_html(title) << "</h3><img alt='" << esc_html(title) << "' src='data:image/png;base64," << base64(png) << "'>\n";
+    if (png.empty()) h << "<p>" << html_escape(title) << ": no plot (gnuplot missing or no data to draw; data and gnuplot's messages in plots/)</p>\n";
+    else h << "<h3>" << html_escape(title) << "</h3><img alt='" << html_escape(title) << "' src='data:image/png;base64," << report::base64(png) << "'>\n";
   }
   h << "</body></html>\n";
   std::ofstream f(dir / "report.html");

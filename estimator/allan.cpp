@@ -1,3 +1,5 @@
+// Allan, modified Allan and Hadamard deviations of an in-memory record, exact at every tau
+// (the bounded-memory streaming pass is estimator/allan_stream.cpp). Docs: docs/allan.md.
 #include "estimator/allan.hpp"
 
 #include <algorithm>
@@ -5,66 +7,108 @@
 #include <limits>
 #include <stdexcept>
 
-#include "estimator/stats.hpp"
+#include "estimator/allan_terms.hpp"
 
 namespace driftless::est {
 namespace {
 
-constexpr double kBiasInstabilityFactor = 0.6642824702679600;  // sqrt(2 ln 2 / pi)
+// the largest m a record of n samples allows for a deviation (at least one term)
+std::size_t max_cluster(std::size_t n, const AllanOptions& opt) {
+  switch (opt.deviation) {
+    case Deviation::kAllan: return n / 2;
+    case Deviation::kModifiedAllan: return (n + 1) / 3;
+    case Deviation::kHadamard: return n / 3;
+  }
+  return n / 2;
+}
 
-// cluster sizes to evaluate, ascending and unique
-std::vector<std::size_t> cluster_sizes(std::size_t n, const AllanOptions& opt) {
-  // largest m: overlapping needs N + 1 - 2m >= 1 difference; non-overlapping needs 2 clusters
-  std::size_t m_max = n / 2;  // overlapping: n + 1 - 2m >= 1; non-overlapping: n / m >= 2
-  if (opt.max_tau_s > 0.0) {
-    const double m_cap = std::floor(opt.max_tau_s * opt.sample_rate_hz + 1e-9);
-    if (m_cap < static_cast<double>(m_max)) m_max = static_cast<std::size_t>(std::max(1.0, m_cap));
-  }
+void push_unique(std::vector<std::size_t>& ms, std::size_t m) {
+  if (ms.empty() || ms.back() != m) ms.push_back(m);
+}
+
+std::vector<std::size_t> explicit_sizes(std::size_t m_max, const AllanOptions& opt,
+                                        std::vector<std::string>* notes) {
   std::vector<std::size_t> ms;
-  switch (opt.spacing) {
-    case TauSpacing::kOctave:
-      for (std::size_t m = 1; m <= m_max; m *= 2) ms.push_back(m);
-      break;
-    case TauSpacing::kLogSpaced: {
-      const double step = std::pow(10.0, 1.0 / opt.points_per_decade);
-      for (double x = 1.0; x <= static_cast<double>(m_max) + 0.5; x *= step) {
-        const auto m = static_cast<std::size_t>(std::llround(x));
-        if (m >= 1 && m <= m_max && (ms.empty() || ms.back() != m)) ms.push_back(m);
+  for (const double tau : opt.tau_s) {
+    const double m_real = tau * opt.sample_rate_hz;
+    const auto m = static_cast<std::size_t>(std::max(1.0, std::round(m_real)));
+    if (m > m_max) {
+      if (notes != nullptr) {
+        notes->push_back("tau " + std::to_string(tau) + " s dropped: longer than the record allows (" +
+                         std::to_string(static_cast<double>(m_max) / opt.sample_rate_hz) + " s)");
       }
-      break;
+      continue;
     }
-    case TauSpacing::kAll:
-      for (std::size_t m = 1; m <= m_max; ++m) ms.push_back(m);
-      break;
+    if (notes != nullptr && std::fabs(m_real - static_cast<double>(m)) > 1e-6 * m_real) {
+      notes->push_back("tau " + std::to_string(tau) + " s is not a whole number of samples: used " +
+                       std::to_string(static_cast<double>(m) / opt.sample_rate_hz) + " s");
+    }
+    ms.push_back(m);
   }
+  std::sort(ms.begin(), ms.end());
+  ms.erase(std::unique(ms.begin(), ms.end()), ms.end());
   return ms;
 }
 
-NoiseType noise_from_slope(double slope) {
-  // adev ~ tau^slope: WPM -1, WFM -1/2, FFM 0, RWFM +1/2
-  if (slope < -0.75) return NoiseType::kWhitePM;
-  if (slope < -0.25) return NoiseType::kWhiteFM;
-  if (slope < 0.25) return NoiseType::kFlickerFM;
-  return NoiseType::kRandomWalkFM;
+// the non-overlapping m-averages (mean removed) of a segment from its phase, at most
+// kMaxIdClusters of them
+std::vector<double> cluster_means(const std::vector<double>& S, std::size_t m) {
+  const std::size_t k = std::min((S.size() - 1) / m, kMaxIdClusters);
+  std::vector<double> out(k);
+  const double inv_m = 1.0 / static_cast<double>(m);
+  for (std::size_t c = 0; c < k; ++c) out[c] = (S[(c + 1) * m] - S[c * m]) * inv_m;
+  return out;
 }
 
-// local log-log slope of the curve at every point (central where possible)
-std::vector<double> local_slopes(const std::vector<AllanPoint>& pts) {
-  std::vector<double> s(pts.size(), -0.5);
-  if (pts.size() < 2) return s;
-  auto slope = [&](std::size_t a, std::size_t b) {
-    if (!(pts[a].adev > 0.0) || !(pts[b].adev > 0.0)) return 0.0;
-    return std::log(pts[b].adev / pts[a].adev) / std::log(pts[b].tau_s / pts[a].tau_s);
-  };
-  for (std::size_t i = 0; i < pts.size(); ++i) {
-    const std::size_t a = i == 0 ? 0 : i - 1;
-    const std::size_t b = i + 1 == pts.size() ? i : i + 1;
-    s[i] = slope(a, b);
+// every level's terms over one phase array; overlapping Allan and Hadamard sums run block by
+// block across the levels, so the stretches of S one level reads are still cached for the next
+// (octave m: S[i + 2m] of one level is S[i + m'] of the next)
+void accumulate_levels(Deviation dev, const std::vector<double>& S, const std::vector<std::size_t>& ms,
+                       std::size_t stride, std::vector<TermSum>& sums) {
+  if (dev == Deviation::kModifiedAllan || stride != 1) {
+    for (std::size_t j = 0; j < ms.size(); ++j) accumulate_terms(dev, S.data(), S.size(), ms[j], stride, sums[j]);
+    return;
+  }
+  constexpr std::size_t kBlock = 2048;
+  const std::size_t span = span_in_m(dev);
+  for (std::size_t i0 = 0; i0 < S.size(); i0 += kBlock) {
+    for (std::size_t j = 0; j < ms.size(); ++j) {
+      if (S.size() <= span * ms[j]) break;
+      const std::size_t i1 = std::min(i0 + kBlock, S.size() - span * ms[j]);
+      if (i0 < i1) accumulate_range(dev, S.data(), i0, i1, ms[j], 1, sums[j]);
+    }
+  }
+}
+
+struct Segments {
+  std::vector<std::size_t> begin, length;
+};
+
+Segments split_segments(std::size_t n, std::span<const std::size_t> starts) {
+  Segments s;
+  std::vector<std::size_t> b(starts.begin(), starts.end());
+  if (b.empty() || b.front() != 0) b.insert(b.begin(), 0);
+  for (std::size_t i = 0; i < b.size(); ++i) {
+    const std::size_t end = i + 1 < b.size() ? b[i + 1] : n;
+    if (b[i] > n || end < b[i] || (i + 1 < b.size() && b[i + 1] <= b[i])) {
+      throw std::invalid_argument("allan: segment starts must be ascending sample indices below the record length");
+    }
+    s.begin.push_back(b[i]);
+    s.length.push_back(end - b[i]);
   }
   return s;
 }
 
 }  // namespace
+
+const char* to_string(Deviation d) {
+  switch (d) {
+    case Deviation::kAllan: return "adev";
+    case Deviation::kModifiedAllan: return "mdev";
+    case Deviation::kHadamard: return "hdev";
+  }
+  return "?";
+}
 
 void AllanOptions::validate() const {
   if (!(sample_rate_hz > 0.0) || !std::isfinite(sample_rate_hz)) {
@@ -77,46 +121,57 @@ void AllanOptions::validate() const {
   if (!(confidence > 0.0 && confidence < 1.0)) {
     throw std::invalid_argument("allan: confidence must be in (0, 1), e.g. 0.683");
   }
-}
-
-const char* to_string(NoiseType t) {
-  switch (t) {
-    case NoiseType::kWhitePM: return "white_pm";
-    case NoiseType::kFlickerPM: return "flicker_pm";
-    case NoiseType::kWhiteFM: return "white_fm";
-    case NoiseType::kFlickerFM: return "flicker_fm";
-    case NoiseType::kRandomWalkFM: return "random_walk_fm";
+  if (spacing == TauSpacing::kExplicit) {
+    if (tau_s.empty()) throw std::invalid_argument("allan: an explicit tau list needs at least one tau (s)");
+    for (const double t : tau_s) {
+      if (!(t > 0.0) || !std::isfinite(t)) throw std::invalid_argument("allan: every tau must be > 0 s");
+    }
   }
-  return "?";
+  if (deviation == Deviation::kModifiedAllan && !overlapping) {
+    throw std::invalid_argument("allan: the modified Allan deviation is overlapping by definition");
+  }
 }
 
-double allan_edf(std::size_t n, std::size_t m, NoiseType noise) {
-  // NIST SP 1065 table 5 (Howe's simplified formulas); N counts phase points = rate samples + 1
-  const double N = static_cast<double>(n) + 1.0;
-  const double M = static_cast<double>(m);
-  double edf = 1.0;
-  switch (noise) {
-    case NoiseType::kWhitePM: edf = (N + 1.0) * (N - 2.0 * M) / (2.0 * (N - M)); break;
-    case NoiseType::kFlickerPM:
-      edf = std::exp(std::sqrt(std::max(0.0, std::log((N - 1.0) / (2.0 * M)) *
-                                                 std::log((2.0 * M + 1.0) * (N - 1.0) / 4.0))));
+std::vector<std::size_t> cluster_sizes(std::size_t n, const AllanOptions& opt, std::vector<std::string>* notes) {
+  std::size_t m_max = max_cluster(n, opt);
+  if (opt.max_tau_s > 0.0) {
+    const double m_cap = std::floor(opt.max_tau_s * opt.sample_rate_hz + 1e-9);
+    if (m_cap < static_cast<double>(m_max)) m_max = static_cast<std::size_t>(std::max(1.0, m_cap));
+  }
+  std::vector<std::size_t> ms;
+  switch (opt.spacing) {
+    case TauSpacing::kOctave:
+      for (std::size_t m = 1; m <= m_max; m *= 2) ms.push_back(m);
       break;
-    case NoiseType::kWhiteFM:
-      edf = (3.0 * (N - 1.0) / (2.0 * M) - 2.0 * (N - 2.0) / N) * 4.0 * M * M / (4.0 * M * M + 5.0);
+    case TauSpacing::kDecade:
+      for (std::size_t dec = 1; dec <= m_max; dec *= 10) {
+        for (const std::size_t k : {1, 2, 4}) {
+          if (k * dec <= m_max) ms.push_back(k * dec);
+        }
+      }
       break;
-    case NoiseType::kFlickerFM:
-      edf = m == 1 ? 2.0 * (N - 2.0) * (N - 2.0) / (2.3 * N - 4.9) : 5.0 * N * N / (4.0 * M * (N + 3.0 * M));
+    case TauSpacing::kPerDecade: {
+      const double step = std::pow(10.0, 1.0 / opt.points_per_decade);
+      for (int i = 0;; ++i) {
+        const double x = std::pow(step, i);
+        if (x > static_cast<double>(m_max) + 0.5) break;
+        const auto m = static_cast<std::size_t>(std::llround(x));
+        if (m >= 1 && m <= m_max) push_unique(ms, m);
+      }
       break;
-    case NoiseType::kRandomWalkFM:
-      edf = (N - 2.0) / M * ((N - 1.0) * (N - 1.0) - 3.0 * M * (N - 1.0) + 4.0 * M * M) /
-            ((N - 3.0) * (N - 3.0));
+    }
+    case TauSpacing::kAll:
+      for (std::size_t m = 1; m <= m_max; ++m) ms.push_back(m);
+      break;
+    case TauSpacing::kExplicit:
+      ms = explicit_sizes(m_max, opt, notes);
       break;
   }
-  // the simplified formulas lose meaning at the longest taus; one degree is the floor
-  return std::isfinite(edf) ? std::max(1.0, edf) : 1.0;
+  return ms;
 }
 
-AllanCurve allan_deviation(std::span<const double> rate, const AllanOptions& opt) {
+AllanCurve allan_deviation(std::span<const double> rate, const AllanOptions& opt,
+                           std::span<const std::size_t> segment_starts) {
   opt.validate();
   const std::size_t n = rate.size();
   if (n < 3) throw std::invalid_argument("allan: need at least 3 samples, got " + std::to_string(n));
@@ -130,123 +185,52 @@ AllanCurve allan_deviation(std::span<const double> rate, const AllanOptions& opt
     mean += rate[i];
   }
   mean /= static_cast<double>(n);
-  std::vector<double> cum(n + 1);  // cum[i] = sum of the first i samples (phase, in samples)
-  cum[0] = 0.0;
-  for (std::size_t i = 0; i < n; ++i) cum[i + 1] = cum[i] + (rate[i] - mean);
+  const Segments segs = split_segments(n, segment_starts);
+
+  // each segment's phase (cumulative sum, starting at 0), stored one after the other
+  std::vector<std::vector<double>> phase(segs.begin.size());
+  std::size_t longest = 0;
+  for (std::size_t s = 0; s < phase.size(); ++s) {
+    auto& S = phase[s];
+    S.resize(segs.length[s] + 1);
+    S[0] = 0.0;
+    const double* r = rate.data() + segs.begin[s];
+    for (std::size_t i = 0; i < segs.length[s]; ++i) S[i + 1] = S[i] + (r[i] - mean);
+    if (segs.length[s] > segs.length[longest]) longest = s;
+  }
 
   AllanCurve curve;
+  curve.deviation = opt.deviation;
   curve.sample_rate_hz = opt.sample_rate_hz;
   curve.samples = n;
-  curve.overlapping = opt.overlapping;
-  const double tau0 = 1.0 / opt.sample_rate_hz;
-  for (const std::size_t m : cluster_sizes(n, opt)) {
+  curve.segments = phase.size();
+  curve.overlapping = opt.overlapping || opt.deviation == Deviation::kModifiedAllan;
+  curve.confidence = opt.confidence;
+  CiInput ci;
+  ci.segment_lengths = segs.length;
+  // taus up to what the longest gap-free segment allows
+  const std::vector<std::size_t> ms = cluster_sizes(segs.length[longest], opt, &curve.notes);
+  std::vector<TermSum> sums(ms.size());
+  if (curve.overlapping) {
+    for (const auto& S : phase) accumulate_levels(opt.deviation, S, ms, 1, sums);
+  } else {
+    for (std::size_t j = 0; j < ms.size(); ++j) {
+      for (const auto& S : phase) accumulate_terms(opt.deviation, S.data(), S.size(), ms[j], ms[j], sums[j]);
+    }
+  }
+  for (std::size_t j = 0; j < ms.size(); ++j) {
+    if (sums[j].terms == 0) continue;
     AllanPoint p;
-    p.m = m;
-    p.tau_s = static_cast<double>(m) * tau0;
-    double sum = 0.0;
-    if (opt.overlapping) {
-      const std::size_t terms = n + 1 - 2 * m;
-      const double* c = cum.data();
-      for (std::size_t i = 0; i < terms; ++i) {
-        const double d = c[i + 2 * m] - 2.0 * c[i + m] + c[i];
-        sum += d * d;
-      }
-      p.terms = terms;
-      p.adev = std::sqrt(sum / (2.0 * double(m) * double(m) * double(terms)));
-    } else {
-      const std::size_t clusters = n / m;  // K
-      for (std::size_t k = 0; k + 1 < clusters; ++k) {
-        const double d = cum[(k + 2) * m] - 2.0 * cum[(k + 1) * m] + cum[k * m];
-        sum += d * d;
-      }
-      p.terms = clusters - 1;
-      p.adev = std::sqrt(sum / (2.0 * double(m) * double(m) * double(p.terms)));
-    }
+    p.m = ms[j];
+    p.tau_s = static_cast<double>(ms[j]) / opt.sample_rate_hz;
+    p.terms = sums[j].terms;
+    p.adev = deviation_from_sum(opt.deviation, sums[j], ms[j]);
     curve.points.push_back(p);
+    ci.cluster_means.push_back(cluster_means(phase[longest], ms[j]));
   }
-
-  // noise type from the local slope, then edf and the chi-square confidence interval
-  const auto slopes = local_slopes(curve.points);
-  const double alpha = 1.0 - opt.confidence;
-  for (std::size_t i = 0; i < curve.points.size(); ++i) {
-    AllanPoint& p = curve.points[i];
-    p.noise = noise_from_slope(slopes[i]);
-    // non-overlapping differences are nearly independent: edf ~ number of differences
-    p.edf = opt.overlapping ? allan_edf(n, p.m, p.noise) : std::max(1.0, double(p.terms));
-    const double var = p.adev * p.adev;
-    p.adev_lo = std::sqrt(var * p.edf / chi2_quantile(1.0 - 0.5 * alpha, p.edf));
-    p.adev_hi = std::sqrt(var * p.edf / chi2_quantile(0.5 * alpha, p.edf));
-  }
+  if (curve.points.empty()) throw std::invalid_argument("allan: no averaging time fits the record");
+  attach_confidence_intervals(curve, ci);
   return curve;
-}
-
-NoiseFit fit_noise_parameters(const AllanCurve& curve) {
-  NoiseFit fit;
-  const auto& pts = curve.points;
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  fit.N.value = fit.B.value = fit.K.value = nan;
-  fit.N.sigma = fit.B.sigma = fit.K.sigma = nan;
-  fit.N.tau_s = 1.0;
-  fit.K.tau_s = 3.0;
-  if (pts.size() < 2) {
-    fit.N.note = fit.B.note = fit.K.note = "too few averaging times for a fit";
-    return fit;
-  }
-  const auto slopes = local_slopes(pts);
-
-  // the minimum, searched over points with at least 2 degrees of freedom (the last few are noisy)
-  std::size_t imin = 0;
-  bool found = false;
-  for (std::size_t i = 0; i < pts.size(); ++i) {
-    if (pts[i].edf < 2.0 && found) continue;
-    if (!found || pts[i].adev < pts[imin].adev) imin = i;
-    found = true;
-  }
-  std::size_t last_searched = 0;
-  for (std::size_t i = 0; i < pts.size(); ++i) {
-    if (pts[i].edf >= 2.0) last_searched = i;
-  }
-
-  // a line of fixed slope through points [lo, hi] with |slope - target| < 0.25, weighted by edf;
-  // returns the value at tau_ref and its relative sigma
-  auto fit_line = [&](std::size_t lo, std::size_t hi, double target, double tau_ref,
-                      std::size_t m_min, NoiseParameter& out, const char* what) {
-    double sw = 0.0, swy = 0.0, edf_max = 0.0;
-    for (std::size_t i = lo; i <= hi && i < pts.size(); ++i) {
-      if (std::fabs(slopes[i] - target) >= 0.25 || !(pts[i].adev > 0.0)) continue;
-      if (pts[i].m < m_min) continue;
-      const double w = 2.0 * pts[i].edf;  // var(ln adev) ~ 1 / (2 edf)
-      sw += w;
-      swy += w * (std::log(pts[i].adev) - target * std::log(pts[i].tau_s / tau_ref));
-      edf_max = std::max(edf_max, pts[i].edf);
-    }
-    if (sw == 0.0) {
-      out.note = std::string("no ") + what + " region in the curve";
-      return;
-    }
-    out.value = std::exp(swy / sw);
-    // neighbouring taus share data, so the fit is no better than its best single point
-    out.sigma = out.value / std::sqrt(2.0 * edf_max);
-    out.valid = true;
-  };
-
-  // white noise is exact at every m; a sampled random walk reads high by (1 + 1/(2 m^2)) at small
-  // m (m = 1: +22 % in adev), so K uses only m >= 10 (< 0.5 % error)
-  fit_line(0, imin, -0.5, 1.0, 1, fit.N, "-1/2 slope (white noise)");
-  if (imin + 1 < pts.size()) {
-    fit_line(imin, pts.size() - 1, 0.5, 3.0, 10, fit.K, "+1/2 slope (rate random walk)");
-  }
-  else fit.K.note = "curve never rises: no +1/2 slope (rate random walk) region";
-
-  const AllanPoint& pm = pts[imin];
-  fit.B.value = pm.adev / kBiasInstabilityFactor;
-  fit.B.sigma = fit.B.value / std::sqrt(2.0 * pm.edf);
-  fit.B.tau_s = pm.tau_s;
-  fit.B.valid = true;
-  if (imin == last_searched && slopes[imin] < -0.25) {
-    fit.B.note = "upper bound: the curve is still falling at the longest usable tau";
-  }
-  return fit;
 }
 
 }  // namespace driftless::est

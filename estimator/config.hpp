@@ -100,7 +100,8 @@ EstimatorConfig paper_config();
 
 /// Reads a `key: value` configuration (a flat YAML subset: '#' comments, blank lines) on top of
 /// `base`. Keys are the EstimatorConfig field names; enums as text (mode: paper|general, ...).
-/// Throws std::invalid_argument naming `name`, the line and the key on a bad line.
+/// Keys may use another unit of the field's quantity (`bias_instability_dph: 36`). Throws
+/// driftless::InputError naming `name`, the line and the key on a bad line or a key given twice.
 EstimatorConfig parse_estimator_config(std::istream& in, const std::string& name,
                                        EstimatorConfig base = {});
 /// The same, applied to one key (for the CLI and YAML front ends).

@@ -115,8 +115,8 @@ double Metadata::get_number(std::string_view key, double fallback, std::string_v
   if (!v) return fallback;
   double out = kNaN;
   if (!parse_number(*v, out) || v->empty()) {
-    throw LogError(std::string(where.empty() ? "log metadata" : where) + ": key '" +
-                   std::string(key) + "': expected a number, got '" + *v + "'");
+    throw LogError(std::string(where.empty() ? "log metadata" : where), 0, std::string(key),
+                   "expected a number, got '" + *v + "'");
   }
   return out;
 }
@@ -129,8 +129,8 @@ Eigen::Vector3d Metadata::get_vector3(std::string_view key, const Eigen::Vector3
   Eigen::Vector3d out;
   std::string extra;
   if (!(in >> out[0] >> out[1] >> out[2]) || (in >> extra)) {
-    throw LogError(std::string(where.empty() ? "log metadata" : where) + ": key '" +
-                   std::string(key) + "': expected three numbers 'x y z', got '" + *v + "'");
+    throw LogError(std::string(where.empty() ? "log metadata" : where), 0, std::string(key),
+                   "expected three numbers 'x y z', got '" + *v + "'");
   }
   return out;
 }
@@ -263,14 +263,14 @@ LogReader::LogReader(const std::filesystem::path& path, ReaderOptions opts)
     : path_(path), opts_(opts) {
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) {
-    throw LogError(path.string() + ": no such file");
+    throw LogError(path.string(), 0, "", "no such file");
   }
   if (std::filesystem::is_directory(path, ec)) {
-    throw LogError(path.string() + ": is a directory, expected a driftless log (CSV)");
+    throw LogError(path.string(), 0, "", "is a directory, expected a driftless log (CSV)");
   }
   file_ = std::fopen(path.c_str(), "rb");
   if (file_ == nullptr) {
-    throw LogError(path.string() + ": cannot open: " + std::strerror(errno));
+    throw LogError(path.string(), 0, "", std::string("cannot open: ") + std::strerror(errno));
   }
   buf_.reserve(1 << 20);
 
@@ -298,8 +298,9 @@ LogReader::LogReader(const std::filesystem::path& path, ReaderOptions opts)
   if (!saw_any) {
     std::fclose(file_);
     file_ = nullptr;
-    throw LogError(path.string() + ": empty file; expected '# format: driftless-log 1' metadata "
-                   "and a header row (see docs/log-format.md)");
+    throw LogError(path.string(), 0, "",
+                   "empty file; expected '# format: driftless-log 1' metadata and a header row (see "
+                   "docs/log-format.md)");
   }
   if (columns_.empty()) {
     fail("no header row; expected a CSV header naming the columns (t, gyro1_x, ...)");
@@ -348,7 +349,7 @@ LogReader::~LogReader() {
 std::string LogReader::where() const { return path_.string() + ":" + std::to_string(line_no_); }
 
 void LogReader::fail(std::string_view what) const {
-  throw LogError(where() + ": " + std::string(what));
+  throw LogError(path_.string(), line_no_, "", std::string(what));
 }
 
 int LogReader::column_index(std::string_view name) const {

@@ -12,17 +12,15 @@
 #include <utility>
 #include <vector>
 
+#include "estimator/input_error.hpp"
 #include "estimator/sample.hpp"
 
 namespace driftless::log {
 
 inline constexpr std::string_view kFormatId = "driftless-log 1";
 
-/// A malformed or unreadable log; the message names the file and line.
-class LogError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
+/// A malformed or unreadable log: the one input-error type, naming the file, line and key.
+using LogError = InputError;
 
 /// Ordered '# key: value' metadata. Keys are unique; values are kept as text.
 class Metadata {

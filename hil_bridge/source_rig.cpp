@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <stdexcept>
 
+#include "estimator/log_metadata.hpp"
 #include "hil_bridge/i2c/emulated_bus.hpp"
 #include "hil_bridge/i2c/i2c_source.hpp"
 #include "hil_bridge/i2c/linux_i2c.hpp"
@@ -44,13 +45,12 @@ class DescribedI2cSource final : public SampleSource {
   std::uint32_t fields() const override { return inner_->fields(); }
   bool knows_platforms() const override { return false; }
   void describe(log::Metadata& meta) const override {
-    meta.set("source", name_);
-    meta.set("latitude_deg", std::to_string(box_.latitude_deg));
-    auto vec = [](const Eigen::Vector3d& v) {
-      return std::to_string(v.x()) + " " + std::to_string(v.y()) + " " + std::to_string(v.z());
-    };
-    meta.set("hinge1_axis", vec(box_.hinge1_axis));
-    meta.set("hinge2_axis", vec(box_.hinge2_axis));
+    log::LogInfo info;
+    info.latitude_deg = box_.latitude_deg;
+    info.hinge1_axis = box_.hinge1_axis;
+    info.hinge2_axis = box_.hinge2_axis;
+    info.source = name_;
+    log::write_log_info(meta, info);
   }
   Status configure() override { return inner_->configure(); }
   Status activate() override { return inner_->activate(); }

@@ -9,6 +9,10 @@
 
 namespace driftless::render {
 
+namespace {
+constexpr double kMaxCloseUpElevationDeg = -30.0;  // deg, close-ups look at least this far down
+}  // namespace
+
 CameraAxes camera_axes(const ViewAngles& v) {
   const double az = v.azimuth_deg * kRadPerDeg, el = v.elevation_deg * kRadPerDeg;
   CameraAxes a;
@@ -119,22 +123,48 @@ CameraFraming CameraDirector::box_framing(const mjData* d, const mjvOption& opt,
   return frame_points(pts, p_.view, fovy_deg_, aspect, p_.box_fill);
 }
 
+ViewAngles view_angles(const Eigen::Vector3d& forward) {
+  const Eigen::Vector3d f = forward.normalized();
+  const double el = std::asin(std::clamp(f.z(), -1.0, 1.0)) * kDegPerRad;
+  return {std::atan2(f.y(), f.x()) * kDegPerRad, std::clamp(el, -85.0, 85.0)};
+}
+
+// look mostly along the hinge axis, a quarter of the way towards the box camera's direction (so
+// the close-up keeps some depth and the cut feels continuous), from outside: when the hinge axis
+// points away from the box's middle the camera sits beyond the platform, where nothing of the
+// box stands in front of it; otherwise on the box camera's side. Never above 30 deg below the
+// horizon: the sky is not drawn
+ViewAngles CameraDirector::platform_view(const mjData* d, int platform) const {
+  const Eigen::Vector3d f_box = camera_axes(p_.view).forward;
+  const int body = bodies_.platform[platform];
+  const int jnt = m_->body_jntadr[body];
+  if (jnt < 0) return p_.view;
+  Eigen::Vector3d a = Eigen::Map<const Eigen::Vector3d>(d->xaxis + 3 * jnt).normalized();
+  const Eigen::Vector3d out = Eigen::Map<const Eigen::Vector3d>(d->xpos + 3 * body) -
+                              Eigen::Map<const Eigen::Vector3d>(d->xipos + 3 * std::max(bodies_.box, 0));
+  const bool outside = std::abs(a.dot(out)) > 0.2 * out.norm();
+  if (outside ? a.dot(out) > 0.0 : a.dot(f_box) < 0.0) a = -a;
+  ViewAngles v = view_angles(0.75 * a + 0.25 * f_box);
+  v.elevation_deg = std::min(v.elevation_deg, kMaxCloseUpElevationDeg);
+  return v;
+}
+
 // the platform turns about its hinge: frame the sphere it sweeps (the same size at every angle,
 // so the close-up does not zoom while the platform turns)
 CameraFraming CameraDirector::platform_framing(const mjData* d, const mjvOption& opt, int platform,
-                                               double aspect) const {
+                                               const ViewAngles& v, double aspect) const {
   const int body = bodies_.platform[platform];
   const Eigen::Map<const Eigen::Vector3d> centre(d->xpos + 3 * body);
   double r = 0.0;
   for (const auto& p : body_corners_world(m_, d, body, opt)) r = std::max(r, (p - centre).norm());
   if (r <= 0.0) r = m_->stat.extent / 20.0;
-  const CameraAxes ax = camera_axes(p_.view);
+  const CameraAxes ax = camera_axes(v);
   std::vector<Eigen::Vector3d> pts;
   for (const Eigen::Vector3d& a : {ax.right, ax.up, ax.forward}) {
     pts.push_back(centre + r * a);
     pts.push_back(centre - r * a);
   }
-  return frame_points(pts, p_.view, fovy_deg_, aspect, p_.closeup_fill);
+  return frame_points(pts, v, fovy_deg_, aspect, p_.closeup_fill);
 }
 
 void CameraDirector::update(const mjData* d, const mjvOption& opt, int close_up, double aspect, mjvCamera* cam) {
@@ -153,17 +183,22 @@ void CameraDirector::update(const mjData* d, const mjvOption& opt, int close_up,
   if (box_distance_m_ > 0.0) box.distance_m = box_distance_m_ + 0.25 * (box.distance_m - box_distance_m_);
   box_distance_m_ = box.distance_m;
   CameraFraming f = box;
+  ViewAngles v = p_.view;
   if (weight_ > 0.0 && platform_ >= 0) {
-    const CameraFraming near = platform_framing(d, opt, platform_, aspect);
+    const ViewAngles vn = platform_view(d, platform_);
+    const CameraFraming near = platform_framing(d, opt, platform_, vn, aspect);
     const double s = weight_ * weight_ * (3.0 - 2.0 * weight_);  // smoothstep
     f.lookat_m = (1.0 - s) * box.lookat_m + s * near.lookat_m;
     f.distance_m = std::exp((1.0 - s) * std::log(box.distance_m) + s * std::log(near.distance_m));
+    // turn the short way round
+    const double daz = std::remainder(vn.azimuth_deg - v.azimuth_deg, 360.0);
+    v = {v.azimuth_deg + s * daz, v.elevation_deg + s * (vn.elevation_deg - v.elevation_deg)};
   }
   cam->type = mjCAMERA_FREE;
   for (int k = 0; k < 3; ++k) cam->lookat[k] = f.lookat_m[k];
   cam->distance = f.distance_m;
-  cam->azimuth = p_.view.azimuth_deg;
-  cam->elevation = p_.view.elevation_deg;
+  cam->azimuth = v.azimuth_deg;
+  cam->elevation = v.elevation_deg;
 }
 
 }  // namespace driftless::render

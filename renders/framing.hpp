@@ -53,9 +53,14 @@ struct FramedBodies {
 FramedBodies find_framed_bodies(const mjModel* m, const char* base_body = "box",
                                 const char* hinge1 = "hinge1", const char* hinge2 = "hinge2");
 
+/// The view angles of a camera looking along `forward` (world axes, any length).
+ViewAngles view_angles(const Eigen::Vector3d& forward);
+
 /// Chooses the free camera frame by frame: the box filling `box_fill` of the view, or, while
-/// close_up() names a platform, that platform (with its swept circle) filling `closeup_fill`.
-/// Changes of subject are blended over `blend_frames` frames so the view never jumps.
+/// update() names a platform, that platform (the sphere it sweeps) filling `closeup_fill`, seen
+/// mostly along its hinge axis: a platform turns its board within the board's plane, so the
+/// turn shows best face-on. Changes of subject are blended over `blend_frames` frames so the
+/// view never jumps.
 class CameraDirector {
  public:
   struct Params {
@@ -75,7 +80,9 @@ class CameraDirector {
 
  private:
   CameraFraming box_framing(const mjData* d, const mjvOption& opt, double aspect) const;
-  CameraFraming platform_framing(const mjData* d, const mjvOption& opt, int platform, double aspect) const;
+  ViewAngles platform_view(const mjData* d, int platform) const;
+  CameraFraming platform_framing(const mjData* d, const mjvOption& opt, int platform, const ViewAngles& v,
+                                 double aspect) const;
 
   const mjModel* m_;
   FramedBodies bodies_;

@@ -14,6 +14,24 @@ void kinematics_for_drawing(const mjModel* m, mjData* d) {
   mj_camlight(m, d);
 }
 
+void keep_ground_under(const mjModel* m, mjData* d, int body) {
+  if (body < 0) return;
+  for (int g = 0; g < m->ngeom; ++g) {
+    if (m->geom_type[g] != mjGEOM_PLANE || m->geom_bodyid[g] != 0) continue;
+    // only a level plane whose texture runs along the world's x and y
+    if (std::abs(d->geom_xmat[9 * g + 8] - 1.0) > 1e-9 || std::abs(d->geom_xmat[9 * g] - 1.0) > 1e-9) continue;
+    // a textured plane repeats its texture texrepeat times across its 2 x size extent
+    const int mat = m->geom_matid[g];
+    for (int k = 0; k < 2; ++k) {
+      const double reps = mat >= 0 && m->mat_texrepeat[2 * mat + k] > 0 ? m->mat_texrepeat[2 * mat + k] : 1.0;
+      const double period = 2.0 * m->geom_size[3 * g + k] / reps;
+      if (!(period > 0.0)) continue;
+      const double shift = period * std::round((d->xpos[3 * body + k] - m->geom_pos[3 * g + k]) / period);
+      d->geom_xpos[3 * g + k] = m->geom_pos[3 * g + k] + shift;
+    }
+  }
+}
+
 BoxPoser::BoxPoser(const mjModel* m, const std::string& base_body, const std::string& plat1_joint,
                    const std::string& plat2_joint)
     : m_(m), d_(nullptr, &mj_deleteData) {
@@ -77,6 +95,7 @@ void BoxPoser::pose(const Sample& s) {
     if (std::isfinite(plat_deg[i])) q[plat_adr_[i]] = plat_deg[i] * kRadPerDeg;
   }
   kinematics_for_drawing(m, d_.get());
+  keep_ground_under(m, d_.get(), bodies_.box);
 }
 
 }  // namespace driftless::render

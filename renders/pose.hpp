@@ -54,4 +54,9 @@ class BoxPoser final : public WorldPoser {
 /// cameras) and cameras/lights; cheaper than mj_forward.
 void kinematics_for_drawing(const mjModel* m, mjData* d);
 
+/// Moves the drawn ground planes (planes of the world body) under `body` by whole periods of
+/// their texture, so a box carried kilometres away (vehicle, ship) still has the ground below it
+/// and the pattern stays fixed to the world. Changes only mjData's drawing positions.
+void keep_ground_under(const mjModel* m, mjData* d, int body);
+
 }  // namespace driftless::render

@@ -25,7 +25,10 @@ TwinPoser::TwinPoser(const twin::BoxParams& box, twin::Carrier carrier)
   twin::pose_world_from_sample(world_, rest, carrier_);
 }
 
-void TwinPoser::pose(const Sample& s) { twin::pose_world_from_sample(world_, s, carrier_); }
+void TwinPoser::pose(const Sample& s) {
+  twin::pose_world_from_sample(world_, s, carrier_);
+  keep_ground_under(world_.model(), world_.data(), world_.box_body());
+}
 
 ScenarioFrameSource::ScenarioFrameSource(const twin::Scenario& scenario)
     : sim_(scenario), poser_(scenario.model.box, sim_.motion().carrier()) {

@@ -9,6 +9,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "estimator/numbers.hpp"
 #include "estimator/attitude.hpp"
 #include "estimator/geometry.hpp"
 #include "estimator/random.hpp"
@@ -52,11 +53,7 @@ void set_path(YAML::Node root, const std::string& path, const YAML::Node& value)
   chain.back()[parts.back()] = value;
 }
 
-std::string number_text(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
+std::string number_text(double v) { return exact_number(v); }
 
 struct Override {
   std::string path;

@@ -17,15 +17,15 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "estimator/input_error.hpp"
+#include "estimator/numbers.hpp"
+#include "report/gnuplot.hpp"
+
 namespace driftless::studies {
 namespace {
 
-std::string where(const std::string& file, const YAML::Node& n) {
-  return file + ":" + std::to_string(n.Mark().line + 1);
-}
-
 [[noreturn]] void fail(const std::string& file, const YAML::Node& n, const std::string& msg) {
-  throw std::runtime_error(where(file, n) + ": " + msg);
+  throw InputError(file, static_cast<std::size_t>(n.Mark().line + 1), "", msg);
 }
 
 double as_double(const std::string& file, const YAML::Node& n, const std::string& key) {
@@ -36,12 +36,8 @@ double as_double(const std::string& file, const YAML::Node& n, const std::string
   }
 }
 
-std::string fmt_double(double v) {
-  if (std::isnan(v)) return "";
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.9g", v);
-  return buf;
-}
+// a CSV number: exact, NaN as an empty field
+std::string fmt_double(double v) { return std::isnan(v) ? std::string() : exact_number(v); }
 
 // CSV field: no commas or quotes or newlines in our text fields
 std::string csv_text(std::string s) {
@@ -92,9 +88,9 @@ SweepConfig parse_sweep(const std::string& yaml_text, const std::string& file,
   try {
     root = YAML::Load(yaml_text);
   } catch (const YAML::Exception& e) {
-    throw std::runtime_error(file + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
+    throw InputError(file, static_cast<std::size_t>(e.mark.line) + 1, "", "broken YAML: " + e.msg);
   }
-  if (!root.IsMap()) throw std::runtime_error(file + ": a sweep file is a YAML map (docs/sweep.md)");
+  if (!root.IsMap()) throw InputError(file, 0, "", "a sweep file is a YAML map (docs/sweep.md)");
   SweepConfig c;
   c.file = file;
   static const std::set<std::string> known = {"name",  "description", "runner", "scenario",
@@ -186,17 +182,13 @@ SweepConfig parse_sweep(const std::string& yaml_text, const std::string& file,
       c.plots.push_back(std::move(s));
     }
   }
-  try {
-    c.validate();
-  } catch (const std::invalid_argument& e) {
-    throw std::runtime_error(e.what());
-  }
+  with_location("", 0, "", [&] { c.validate(); });  // validate() names the file itself
   return c;
 }
 
 SweepConfig load_sweep(const std::filesystem::path& path) {
   std::ifstream in(path);
-  if (!in) throw std::runtime_error(path.string() + ": cannot open sweep file");
+  if (!in) throw InputError(path.string(), 0, "", "cannot open sweep file");
   std::stringstream ss;
   ss << in.rdbuf();
   return parse_sweep(ss.str(), path.string(), path.parent_path());
@@ -278,11 +270,7 @@ std::vector<RunResult> run_parallel(const std::vector<RunSpec>& specs,
 std::string serialize_result(const RunResult& r) {
   std::ostringstream out;
   out << r.index << '\t' << (r.ok ? 1 : 0) << '\t' << r.wall_s << '\t' << csv_text(r.error);
-  char buf[40];
-  for (const auto& [k, v] : r.metrics) {
-    std::snprintf(buf, sizeof buf, "%.17g", v);
-    out << '\t' << k << '=' << buf;
-  }
+  for (const auto& [k, v] : r.metrics) out << '\t' << k << '=' << exact_number(v);
   return out.str();
 }
 
@@ -345,7 +333,7 @@ std::vector<std::map<std::string, Aggregate>> summarize(const SweepConfig& cfg,
 
 std::size_t write_outputs(const SweepConfig& cfg, const std::vector<RunSpec>& specs,
                           const std::vector<RunResult>& results_in, const std::filesystem::path& dir,
-                          bool run_gnuplot) {
+                          bool run_gnuplot, std::vector<std::string>* plot_warnings) {
   std::filesystem::create_directories(dir);
   std::vector<const RunResult*> by_index(specs.size(), nullptr);
   for (const auto& r : results_in) {
@@ -443,10 +431,8 @@ std::size_t write_outputs(const SweepConfig& cfg, const std::vector<RunSpec>& sp
       if (mi == metrics.end()) continue;  // metric absent (e.g. every run failed)
       const int ycol = static_cast<int>(cfg.grid.size()) + 3 + 5 * static_cast<int>(mi - metrics.begin());
       const std::string stem = "plot_" + y + "_vs_" + p.x;
-      std::ofstream gp(dir / (stem + ".gp"));
-      gp << "# driftless sweep '" << cfg.name << "': " << y << " against " << p.x << "\n"
-         << "set terminal pngcairo size 800,560 noenhanced\nset output '" << stem << ".png'\n"
-         << "set datafile separator ','\nset key top left\nset grid\n"
+      std::ostringstream gp;
+      gp << "set datafile separator ','\nset key top left\nset grid\n"
          << "set xlabel '" << p.x << "'\nset ylabel '" << y << " (mean +- std over "
          << cfg.monte_carlo << " seeds)'\nset title '" << csv_text(cfg.name) << "'\n";
       if (p.logx) gp << "set logscale x\n";
@@ -467,12 +453,16 @@ std::size_t write_outputs(const SweepConfig& cfg, const std::vector<RunSpec>& sp
         }
         gp << "\n";
       }
-      gp.close();
-      if (run_gnuplot && std::system("command -v gnuplot >/dev/null 2>&1") == 0) {
-        const std::string cmd = "cd '" + dir.string() + "' && gnuplot '" + stem + ".gp' 2>/dev/null";
-        if (std::system(cmd.c_str()) != 0) {
-          std::fprintf(stderr, "driftless sweep: warning: gnuplot failed on %s.gp\n", stem.c_str());
-        }
+      report::Figure fig(stem, gp.str());
+      fig.title_comment = "driftless sweep '" + csv_text(cfg.name) + "': " + y + " against " + p.x;
+      fig.width_px = 800;
+      fig.height_px = 560;
+      fig.svg = false;
+      fig.csv_defaults = false;
+      if (!run_gnuplot) {
+        std::ofstream(dir / (stem + ".gp")) << report::gnuplot_script(fig);
+      } else if (const auto st = report::render(dir, fig); !st.ok && plot_warnings != nullptr) {
+        plot_warnings->push_back(st.message);
       }
     }
   }

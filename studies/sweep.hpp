@@ -102,11 +102,12 @@ std::string serialize_result(const RunResult& r);
 RunResult parse_result(const std::string& line);
 
 /// Writes DIR/runs.csv (one row per run), DIR/summary.csv (mean, std, min, max per grid point),
-/// DIR/<plot>.gp gnuplot scripts and, when gnuplot is found, DIR/<plot>.png. `results` must hold
-/// every index once. Returns the number of failed runs.
+/// DIR/<plot>.gp gnuplot scripts and, with `run_gnuplot`, DIR/<plot>.png. `results` must hold
+/// every index once. Returns the number of failed runs; a plot gnuplot could not draw adds its
+/// reason to `plot_warnings` (nothing is printed).
 std::size_t write_outputs(const SweepConfig& cfg, const std::vector<RunSpec>& specs,
                           const std::vector<RunResult>& results, const std::filesystem::path& dir,
-                          bool run_gnuplot = true);
+                          bool run_gnuplot = true, std::vector<std::string>* plot_warnings = nullptr);
 
 /// Aggregate of one metric at one grid point over its successful Monte-Carlo runs.
 struct Aggregate {

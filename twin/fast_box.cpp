@@ -7,6 +7,7 @@
 #include <Eigen/Geometry>
 
 #include "estimator/geometry.hpp"
+#include "estimator/log_metadata.hpp"
 #include "estimator/random.hpp"
 #include "twin/simulator.hpp"
 
@@ -31,17 +32,16 @@ FastBox::FastBox(const Scenario& scenario)
 }
 
 log::Metadata FastBox::metadata() const {
+  log::LogInfo info;
+  info.sample_rate_hz = sc_.sample_rate_hz;
+  info.latitude_deg = sc_.latitude_deg;
+  info.hinge1_axis = a1_;
+  info.hinge2_axis = a2_;
+  info.source = "fast (closed-form kinematics, twin/fast_box.hpp)";
+  info.scenario = sc_.name;
+  info.seed = sc_.seed;
   log::Metadata m;
-  m.set("sample_rate_hz", std::to_string(sc_.sample_rate_hz));
-  m.set("latitude_deg", std::to_string(sc_.latitude_deg));
-  const auto vec = [](const Eigen::Vector3d& v) {
-    return std::to_string(v.x()) + " " + std::to_string(v.y()) + " " + std::to_string(v.z());
-  };
-  m.set("hinge1_axis", vec(a1_));
-  m.set("hinge2_axis", vec(a2_));
-  m.set("seed", std::to_string(sc_.seed));
-  m.set("scenario", sc_.name);
-  m.set("source", "fast (closed-form kinematics, twin/fast_box.hpp)");
+  log::write_log_info(m, info);
   return m;
 }
 

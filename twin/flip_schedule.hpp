@@ -58,6 +58,8 @@ class FlipController {
   double next_flip_s() const { return next_flip_s_; }
   /// Completed flips.
   long flips() const { return flips_; }
+  /// True when the platforms rest on their end stops (flip angle = end stop), pressed by the motor.
+  bool on_stops() const { return on_stops_; }
   /// Initial platform angle (rad) for platform i: on its + stop, or at +flip angle.
   double initial_angle_rad(int i) const;
 

@@ -9,6 +9,7 @@
 #include <fmt/core.h>
 
 #include "estimator/geometry.hpp"
+#include "estimator/input_error.hpp"
 #include "estimator/random.hpp"
 #include "estimator/sample.hpp"
 
@@ -475,7 +476,7 @@ void MotionConfig::validate() const {
 
 std::vector<TrajectoryPoint> read_trajectory_csv(const std::filesystem::path& path) {
   std::ifstream in(path);
-  if (!in) throw std::runtime_error(path.string() + ": cannot open trajectory file");
+  if (!in) throw InputError(path.string(), 0, "", "cannot open trajectory file");
   std::string line;
   std::size_t line_no = 0;
   int idx[8] = {-1, -1, -1, -1, -1, -1, -1, -1};  // t, px, py, pz, qw, qx, qy, qz
@@ -483,7 +484,7 @@ std::vector<TrajectoryPoint> read_trajectory_csv(const std::filesystem::path& pa
   double t_first_ns = kNaN;
   std::vector<TrajectoryPoint> pts;
   const char* names[8] = {"t", "px", "py", "pz", "qw", "qx", "qy", "qz"};
-  auto where = [&] { return path.string() + ":" + std::to_string(line_no); };
+  const auto fail = [&](const std::string& what) { throw InputError(path.string(), line_no, "", what); };
   while (std::getline(in, line)) {
     ++line_no;
     if (!line.empty() && line.back() == '\r') line.pop_back();
@@ -508,9 +509,9 @@ std::vector<TrajectoryPoint> read_trajectory_csv(const std::filesystem::path& pa
       }
       for (int k = 0; k < 8; ++k) {
         if (idx[k] < 0) {
-          throw std::runtime_error(where() + ": trajectory header lacks column '" + names[k] +
-                                   "' (expected t, px, py, pz, qw, qx, qy, qz or the EuRoC "
-                                   "'#timestamp [ns], p_RS_R_x [m], ...' layout)");
+          fail(std::string("trajectory header lacks column '") + names[k] +
+               "' (expected t, px, py, pz, qw, qx, qy, qz or the EuRoC "
+               "'#timestamp [ns], p_RS_R_x [m], ...' layout)");
         }
       }
       have_header = true;
@@ -521,13 +522,13 @@ std::vector<TrajectoryPoint> read_trajectory_csv(const std::filesystem::path& pa
     double v[8];
     for (int k = 0; k < 8; ++k) {
       const auto c = static_cast<std::size_t>(idx[k]);
-      if (c >= cols.size()) throw std::runtime_error(where() + ": row has too few fields");
+      if (c >= cols.size()) fail("row has too few fields");
       try {
         std::size_t used = 0;
         v[k] = std::stod(cols[c], &used);
         if (used != cols[c].size()) throw std::invalid_argument("junk");
       } catch (const std::exception&) {
-        throw std::runtime_error(where() + ": column '" + names[k] + "': expected a number, got '" + cols[c] + "'");
+        fail(std::string("column '") + names[k] + "': expected a number, got '" + cols[c] + "'");
       }
     }
     TrajectoryPoint pt;
@@ -541,17 +542,17 @@ std::vector<TrajectoryPoint> read_trajectory_csv(const std::filesystem::path& pa
     pt.q_enu_from_body = Eigen::Quaterniond(v[4], v[5], v[6], v[7]);
     const double n = pt.q_enu_from_body.norm();
     if (!(n > 0.5 && n < 1.5)) {
-      throw std::runtime_error(where() + ": quaternion norm " + fmt::format("{:.4g}", n) +
-                               " is not close to 1 (qw, qx, qy, qz expected, scalar first)");
+      fail("quaternion norm " + fmt::format("{:.4g}", n) +
+           " is not close to 1 (qw, qx, qy, qz expected, scalar first)");
     }
     pt.q_enu_from_body.normalize();
     if (!pts.empty() && !(pt.t_s > pts.back().t_s)) {
-      throw std::runtime_error(where() + ": time " + fmt::format("{:.9f}", pt.t_s) +
-                               " s does not increase (previous " + fmt::format("{:.9f}", pts.back().t_s) + " s)");
+      fail("time " + fmt::format("{:.9f}", pt.t_s) + " s does not increase (previous " +
+           fmt::format("{:.9f}", pts.back().t_s) + " s)");
     }
     pts.push_back(pt);
   }
-  if (pts.size() < 2) throw std::runtime_error(path.string() + ": a trajectory needs at least 2 rows");
+  if (pts.size() < 2) throw InputError(path.string(), 0, "", "a trajectory needs at least 2 rows");
   return pts;
 }
 

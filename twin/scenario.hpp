@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include <yaml-cpp/yaml.h>
-
+#include "estimator/fields.hpp"
+#include "estimator/input_error.hpp"
 #include "twin/flip_schedule.hpp"
 #include "twin/motion.hpp"
 #include "twin/sensor/sensor_model.hpp"
@@ -58,7 +58,7 @@ struct Scenario {
 };
 
 /// Loads a scenario file (or a built-in scenario by name: "default", "static", ...). Keys not
-/// given keep their defaults. Errors name the file, line and key (std::runtime_error).
+/// given keep their defaults. Errors name the file, line and key (driftless::InputError).
 Scenario load_scenario(const std::string& path_or_builtin);
 /// Parses scenario YAML text; `file` names it in error messages; `base_dir` resolves relative paths.
 Scenario parse_scenario(const std::string& yaml_text, const std::string& file,
@@ -73,5 +73,9 @@ ModelConfig load_model_config(const std::filesystem::path& path, const ModelConf
 
 /// The resolved scenario as YAML: every default explicit; parse_scenario() reads it back.
 std::string emit_scenario(const Scenario& s);
+/// The resolved scenario as a document tree (emit_scenario writes it).
+fields::Node scenario_node(const Scenario& s);
+/// A model config as the `model:` block's tree.
+fields::Node model_node(const ModelConfig& m);
 
 }  // namespace driftless::twin

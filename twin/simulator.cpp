@@ -4,31 +4,34 @@
 #include "estimator/random.hpp"
 
 #include <cmath>
+#include <condition_variable>
+#include <deque>
+#include <exception>
+#include <mutex>
 #include <stdexcept>
 #include <string>
+#include <thread>
+#include <vector>
 
 #include <fmt/core.h>
+
+#include "estimator/log_metadata.hpp"
 
 namespace driftless::twin {
 namespace {
 
-// the static fast path engages once the platforms are this still (the state is then constant
-// to far below the 1e-9 rad/s truth tolerance)
-constexpr double kFreezeRateRadps = 1e-11;
-constexpr double kFreezeAccelRadps2 = 1e-8;
 // platforms settle on their stops for this long before t = 0, s
 constexpr double kWarmupS = 1.0;
-
-std::string vec_text(const Eigen::Vector3d& v) { return fmt::format("{} {} {}", v.x(), v.y(), v.z()); }
 
 }  // namespace
 
 Simulator::Simulator(const Scenario& scenario, SimOptions options)
     : scenario_((scenario.validate(), scenario)),
       options_(options),
-      world_(scenario.model.box, scenario.physics_dt_s),
+      world_(scenario.model.box, scenario.physics_dt_s, ModelScope::physics),
       motion_(make_motion(scenario.motion, scenario.duration_s, scenario.seed, scenario.base_dir)),
       flips_(scenario.flip_schedule, scenario.model.box),
+      gate_(scenario.model.box, motion_->is_static(), scenario.sample_rate_hz),
       earth_enu_radps_(geo::earth_rate_enu_radps(scenario.latitude_deg)),
       steps_per_sample_(scenario.steps_per_sample()),
       total_(scenario.total_samples()) {
@@ -48,21 +51,23 @@ Simulator::Simulator(const Scenario& scenario, SimOptions options)
     world_.set_platform(i, flips_.initial_angle_rad(i), 0.0);
     world_.set_motor_reference(i, flips_.reference_rad(i));
   }
-  world_.pose_carrier(motion_->carrier(), m0.p_enu_m, m0.q_enu_from_body);
   // settle the platforms on their stops before t = 0 (the box held still at its t = 0 pose), so
   // the run starts at rest rather than with the stops' initial transient
-  mjModel* m = world_.model();
-  mjData* d = world_.data();
+  MotionState held = m0;
+  held.v_enu_mps = held.a_enu_mps2 = held.w_body_radps = held.dw_body_radps2 = Eigen::Vector3d::Zero();
+  const Eigen::Vector2d ref0(flips_.reference_rad(1), flips_.reference_rad(2));
   const long warmup_steps = std::lround(kWarmupS / scenario.physics_dt_s);
   for (long n = 0; n < warmup_steps; ++n) {
-    world_.set_base(m0.p_enu_m, m0.q_enu_from_body, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
-    mj_step1(m, d);
-    world_.drive_base(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
-    mj_step2(m, d);
+    const double t = static_cast<double>(n - warmup_steps) * scenario.physics_dt_s;
+    gate_.observe(t, world_.step_driven(t, held, ref0, false));
   }
-  d->time = 0.0;
+  world_.data()->time = 0.0;
   world_.set_base(m0.p_enu_m, m0.q_enu_from_body, m0.v_enu_mps, m0.w_body_radps);
-  mj_forward(m, d);
+  mj_forward(world_.model(), world_.data());
+  // the base starts moving at t = 0 (a jolt from the held warm-up pose): MuJoCo steps its transient
+  if (!motion_->is_static()) {
+    for (int i = 1; i <= 2; ++i) gate_.disturbed(i, 0.0);
+  }
 }
 
 Simulator::~Simulator() = default;
@@ -72,24 +77,26 @@ std::uint32_t Simulator::fields() {
 }
 
 log::Metadata Simulator::metadata() const {
+  log::LogInfo info;
+  info.sample_rate_hz = scenario_.sample_rate_hz;
+  info.latitude_deg = scenario_.latitude_deg;
+  info.hinge1_axis = scenario_.model.box.hinge_axis(1);
+  info.hinge2_axis = scenario_.model.box.hinge_axis(2);
+  info.source = "twin";
+  info.scenario = scenario_.name;
+  info.seed = scenario_.seed;
+  info.duration_s = scenario_.duration_s;
+  info.motion = motion_type_name(scenario_.motion.type);
+  info.carrier = carrier_name(motion_->carrier());
+  info.platform_readback = readback_name(scenario_.platform_readback);
+  info.flip_angle_deg = scenario_.flip_schedule.flip_angle_deg;
+  info.standstill_s = scenario_.flip_schedule.standstill_s;
+  if (flips_.external_control()) info.flip_control = "external";
+  info.end_stop_deg = scenario_.model.box.end_stop_deg;
+  info.sensor1_preset = scenario_.model.sensor1.preset;
+  info.sensor2_preset = scenario_.model.sensor2.preset;
   log::Metadata m;
-  m.set("sample_rate_hz", fmt::format("{}", scenario_.sample_rate_hz));
-  m.set("latitude_deg", fmt::format("{}", scenario_.latitude_deg));
-  m.set("hinge1_axis", vec_text(scenario_.model.box.hinge_axis(1)));
-  m.set("hinge2_axis", vec_text(scenario_.model.box.hinge_axis(2)));
-  m.set("source", "twin");
-  m.set("scenario", scenario_.name);
-  m.set("seed", std::to_string(scenario_.seed));
-  m.set("duration_s", fmt::format("{}", scenario_.duration_s));
-  m.set("motion", motion_type_name(scenario_.motion.type));
-  m.set("carrier", carrier_name(motion_->carrier()));
-  m.set("platform_readback", readback_name(scenario_.platform_readback));
-  m.set("flip_angle_deg", fmt::format("{}", scenario_.flip_schedule.flip_angle_deg));
-  m.set("standstill_s", fmt::format("{}", scenario_.flip_schedule.standstill_s));
-  if (flips_.external_control()) m.set("flip_control", "external");
-  m.set("end_stop_deg", fmt::format("{}", scenario_.model.box.end_stop_deg));
-  m.set("sensor1_preset", scenario_.model.sensor1.preset);
-  m.set("sensor2_preset", scenario_.model.sensor2.preset);
+  log::write_log_info(m, info);
   return m;
 }
 
@@ -101,64 +108,164 @@ void Simulator::command_platform(int i, int sign) {
   if (!flips_.external_control()) {
     throw std::invalid_argument("command_platform: the scenario's flip schedule drives the servos (call take_flip_control() first)");
   }
-  // the move starts at the next physics step; a frozen (static fast path) state thaws there
+  // the move starts at the next physics step; the rest path hands over to MuJoCo there
   flips_.command(i, sign, static_cast<double>(step_) * scenario_.physics_dt_s);
 }
 
-// one physics step at t = step_ * dt: drive the base, command the motors, step MuJoCo;
-// with `output`, the truth at t is captured between the two halves of the step
-void Simulator::physics_step(bool output) {
-  const mjModel* m = world_.model();
-  mjData* d = world_.data();
+double Simulator::output_time_s(std::uint64_t sample) const {
+  return static_cast<double>(sample * static_cast<std::uint64_t>(steps_per_sample_)) * scenario_.physics_dt_s;
+}
+
+// the first physics step whose time t = step * dt is >= t_s (the schedule's own test), at or
+// after the current step
+std::uint64_t Simulator::first_step_at(double t_s) const {
+  const double dt = scenario_.physics_dt_s;
+  if (!(t_s < static_cast<double>(total_ * static_cast<std::uint64_t>(steps_per_sample_)) * dt)) return ~std::uint64_t{0};
+  auto n = static_cast<std::uint64_t>(std::max(0.0, std::ceil(t_s / dt)));
+  while (n > 0 && static_cast<double>(n - 1) * dt >= t_s) --n;
+  while (static_cast<double>(n) * dt < t_s) ++n;
+  return std::max(n, step_);
+}
+
+// one physics step at t = step_ * dt: the flip schedule, then MuJoCo, the rest path or a replay
+void Simulator::advance(bool output) {
   const double t = static_cast<double>(step_) * scenario_.physics_dt_s;
-  const Eigen::Vector2d rates(world_.platform_rate_radps(1), world_.platform_rate_radps(2));
+  Eigen::Vector2d rates = Eigen::Vector2d::Zero();
+  if (mode_ == Mode::stepped) rates = {world_.platform_rate_radps(1), world_.platform_rate_radps(2)};
+  if (mode_ == Mode::replay) rates[replay_->platform - 1] = replay_->steps[replay_pos_].rate_radps;
   flips_.update(t, rates);
-
-  if (frozen_) {
-    if (!flips_.any_moving()) {
-      if (output) {
-        truth_ = frozen_truth_;
-        truth_.t_s = t;
-        base_ = motion_->at(t);
-      }
-      ++step_;
-      return;
-    }
-    frozen_ = false;  // a flip starts: back to full physics
+  if (mode_ == Mode::rest && flips_.any_moving()) begin_flip(t);
+  if (mode_ == Mode::replay && (flips_.moving(3 - replay_->platform) || flips_.sign(replay_->platform) != replay_->sign)) {
+    // a command the recording never saw: MuJoCo takes over from the replayed state
+    const FlipReplay::Step& s = replay_->steps[replay_pos_];
+    rest_angle_rad_[replay_->platform - 1] = s.angle_rad;
+    double rate[2] = {0, 0};
+    rate[replay_->platform - 1] = s.rate_radps;
+    thaw(rate);
   }
-
-  const MotionState ms = motion_->at(t);
-  world_.set_base(ms.p_enu_m, ms.q_enu_from_body, ms.v_enu_mps, ms.w_body_radps);
-  for (int i = 1; i <= 2; ++i) world_.set_motor_reference(i, flips_.reference_rad(i));
-  d->time = t;
-  mj_step1(m, d);  // kinematics, velocities, gyro sensors at t
-  world_.drive_base(ms.a_enu_mps2, ms.dw_body_radps2);
-  if (output) {
-    base_ = ms;
-    truth_.t_s = t;
-    for (int i = 0; i < 2; ++i) {
-      truth_.plat_rad[i] = world_.platform_angle_rad(i + 1);
-      truth_.plat_rate_radps[i] = world_.platform_rate_radps(i + 1);
-    }
-  }
-  mj_step2(m, d);  // actuation, constraints (end stops), accelerometers at t; integrate to t + dt
-  ++mj_steps_;
-  if (output) capture_truth();
-
-  // static fast path: a static box with settled platforms stays exactly as it is
-  if (options_.fast_standstill && motion_->is_static() && !flips_.any_moving()) {
-    bool still = true;
-    for (int i = 1; i <= 2; ++i) {
-      still = still && std::abs(world_.platform_rate_radps(i)) < kFreezeRateRadps &&
-              std::abs(world_.platform_accel_radps2(i)) < kFreezeAccelRadps2;
-    }
-    if (still) {
-      if (!output) capture_truth();  // truth of this (constant) state
-      frozen_truth_ = truth_;
-      frozen_ = true;
-    }
+  switch (mode_) {
+    case Mode::rest: if (output) rest_output(t); break;
+    case Mode::replay: replay_step(t, output); break;
+    case Mode::stepped: step_physics(t, output); break;
   }
   ++step_;
+}
+
+// a flip starts from the rest path: replay it when a static box saw this flip before, else let
+// MuJoCo step it (and record it, on a static box)
+void Simulator::begin_flip(double) {
+  const int moving = flips_.moving(1) && flips_.moving(2) ? 0 : (flips_.moving(1) ? 1 : 2);
+  if (!gate_.static_base() || moving == 0) {
+    thaw();
+    return;
+  }
+  const int sign = flips_.sign(moving);
+  replay_ = replays_.find(moving, sign, rest_angle_rad_[moving - 1]);
+  if (replay_ != nullptr) {
+    mode_ = Mode::replay;
+    replay_pos_ = 0;
+    return;
+  }
+  thaw();
+  replays_.start_recording(moving, sign, rest_angle_rad_[moving - 1]);
+}
+
+void Simulator::step_physics(double t, bool output) {
+  const MotionState ms = motion_->at(t);
+  const HingeState h = world_.step_driven(t, ms, Eigen::Vector2d(flips_.reference_rad(1), flips_.reference_rad(2)), output);
+  ++mj_steps_;
+  gate_.observe(t, h);
+  if (const int i = replays_.recording_platform()) {
+    if (flips_.moving(3 - i) || flips_.sign(i) != replays_.recording_sign()) {
+      replays_.stop_recording(false);  // the other platform moves too, or a reversal: not one flip
+    } else {
+      replays_.record({h.angle_rad[i - 1], h.rate_radps[i - 1], world_.platform_accel_radps2(i)});
+    }
+  }
+  if (!output) return;
+  base_ = ms;
+  truth_.t_s = t;
+  for (int i = 0; i < 2; ++i) {
+    truth_.plat_rad[i] = h.angle_rad[i];
+    truth_.plat_rate_radps[i] = h.rate_radps[i];
+  }
+  capture_truth();
+  if (options_.fast_rest) try_rest(ms, h, t);
+}
+
+// after a stepped output sample: rest from here on if the platforms settled and the coming
+// interval's loads keep them on their stops
+void Simulator::try_rest(const MotionState& base, const HingeState& hinge, double t) {
+  const double accel[2] = {world_.platform_accel_radps2(1), world_.platform_accel_radps2(2)};
+  if (flips_.any_moving() || !gate_.settled(t, hinge, accel)) return;
+  if (!gate_.holds(world_, flips_, base, base_at_output(samples_ + 1), hinge.angle_rad)) return;
+  replays_.stop_recording(true);
+  enter_rest(hinge.angle_rad);
+}
+
+void Simulator::enter_rest(const double angle_rad[2]) {
+  for (int i = 0; i < 2; ++i) rest_angle_rad_[i] = angle_rad[i];
+  mode_ = Mode::rest;
+  if (gate_.static_base()) {
+    const double zero[2] = {0, 0};
+    rest_truth(base_, rest_angle_rad_, zero, zero);
+    static_rest_truth_ = truth_;
+  }
+}
+
+const MotionState& Simulator::base_at_output(std::uint64_t sample) {
+  if (next_base_sample_ != sample) {
+    next_base_ = motion_->at(output_time_s(sample));
+    next_base_sample_ = sample;
+  }
+  return next_base_;
+}
+
+// an output sample on the rest path: the base from the motion, the platforms rigid on their stops
+void Simulator::rest_output(double t) {
+  if (gate_.static_base()) {
+    truth_ = static_rest_truth_;
+    truth_.t_s = t;
+    return;
+  }
+  base_ = base_at_output(samples_);
+  const double zero[2] = {0, 0};
+  rest_truth(base_, rest_angle_rad_, zero, zero);
+  truth_.t_s = t;
+  // the next interval: stay on the rest path, or step MuJoCo through it from the rigid state
+  if (!gate_.holds(world_, flips_, base_, base_at_output(samples_ + 1), rest_angle_rad_)) {
+    thaw();
+    for (int i = 1; i <= 2; ++i) gate_.disturbed(i, output_time_s(samples_ + 1));
+  }
+}
+
+// one step of a replayed flip; where the recording came to rest, so does the replay
+void Simulator::replay_step(double t, bool output) {
+  const int k = replay_->platform - 1;
+  const FlipReplay::Step& s = replay_->steps[replay_pos_];
+  double angle[2] = {rest_angle_rad_[0], rest_angle_rad_[1]}, rate[2] = {0, 0}, accel[2] = {0, 0};
+  angle[k] = s.angle_rad;
+  rate[k] = s.rate_radps;
+  accel[k] = s.accel_radps2;
+  if (output) {
+    rest_truth(base_, angle, rate, accel);
+    truth_.t_s = t;
+  }
+  if (++replay_pos_ < replay_->steps.size()) return;
+  rest_angle_rad_[k] = s.angle_rad;
+  if (flips_.any_moving()) {
+    thaw(rate);  // the schedule's settle test has not passed here: MuJoCo continues
+  } else {
+    enter_rest(rest_angle_rad_);
+  }
+}
+
+// leaves the rest path or a replay: MuJoCo continues from the platforms at their rest angles
+// (and the given rates, rad/s; at rest by default)
+void Simulator::thaw(const double rate_radps[2]) {
+  for (int i = 1; i <= 2; ++i) world_.set_platform(i, rest_angle_rad_[i - 1], rate_radps ? rate_radps[i - 1] : 0.0);
+  mode_ = Mode::stepped;
+  replay_ = nullptr;
 }
 
 // truth from MuJoCo's sensors (valid after mj_step2 for the time of that step) + Earth rate
@@ -175,6 +282,21 @@ void Simulator::capture_truth() {
   const mjtNum* cv = d->cvel + 6 * box;  // com-based velocity: [angular (world axes); linear]
   const Eigen::Vector3d w_world(cv[0], cv[1], cv[2]);
   truth_.w_body_radps = q_box.conjugate() * (w_world + earth_enu_radps_);
+}
+
+// truth off MuJoCo: the rigid-body kinematics of each sensor site on the base, the hinges at the
+// given angles (rad), rates (rad/s) and accelerations (rad/s^2)
+void Simulator::rest_truth(const MotionState& base, const double angle_rad[2], const double rate_radps[2],
+                           const double accel_radps2[2]) {
+  const Eigen::Vector3d earth_body = base.q_enu_from_body.normalized().conjugate() * earth_enu_radps_;
+  for (int i = 0; i < 2; ++i) {
+    const SiteMotion sm = world_.site_motion(i + 1, base, angle_rad[i], rate_radps[i], accel_radps2[i]);
+    truth_.w_sensor_radps[i] = sm.w_radps + sm.R_body_from_sensor.transpose() * earth_body;
+    truth_.f_sensor_mps2[i] = sm.f_mps2;
+    truth_.plat_rad[i] = angle_rad[i];
+    truth_.plat_rate_radps[i] = rate_radps[i];
+  }
+  truth_.w_body_radps = base.w_body_radps + earth_body;
 }
 
 void Simulator::fill_sample(Sample& out) {
@@ -236,29 +358,121 @@ void Simulator::fill_sample(Sample& out) {
 bool Simulator::next(Sample& out) {
   if (samples_ >= total_) return false;
   const std::uint64_t out_step = samples_ * static_cast<std::uint64_t>(steps_per_sample_);
-  while (step_ < out_step) physics_step(false);
-  physics_step(true);
+  while (step_ < out_step) {
+    // on the rest path nothing happens until the schedule starts the next flip
+    if (mode_ == Mode::rest) step_ = std::min(out_step, first_step_at(flips_.next_flip_s()));
+    if (step_ < out_step) advance(false);
+  }
+  advance(true);
   fill_sample(out);
   ++samples_;
   return true;
 }
 
+namespace {
+
+// formats and writes the log on a second thread, so the simulation and the writing overlap; the
+// queue holds a few blocks of samples (constant memory), the file is the same as written inline
+class BackgroundLogWriter {
+ public:
+  explicit BackgroundLogWriter(log::LogWriter& writer) : writer_(writer), thread_([this] { run(); }) {}
+  ~BackgroundLogWriter() {
+    close();
+    thread_.join();
+  }
+  BackgroundLogWriter(const BackgroundLogWriter&) = delete;
+  BackgroundLogWriter& operator=(const BackgroundLogWriter&) = delete;
+
+  /// Queues a block (waits while the queue is full); rethrows the writer's error, if any.
+  void push(std::vector<Sample>&& block) {
+    std::unique_lock lock(mutex_);
+    changed_.wait(lock, [&] { return queue_.size() < kMaxQueued || error_; });
+    if (error_) std::rethrow_exception(error_);
+    queue_.push_back(std::move(block));
+    changed_.notify_all();
+  }
+  /// Waits until every queued block is written; rethrows the writer's error, if any.
+  void drain() {
+    std::unique_lock lock(mutex_);
+    changed_.wait(lock, [&] { return (queue_.empty() && !busy_) || error_; });
+    if (error_) std::rethrow_exception(error_);
+  }
+
+ private:
+  static constexpr std::size_t kMaxQueued = 4;
+
+  void close() {
+    std::lock_guard lock(mutex_);
+    closed_ = true;
+    changed_.notify_all();
+  }
+  void run() {
+    std::unique_lock lock(mutex_);
+    while (true) {
+      changed_.wait(lock, [&] { return !queue_.empty() || closed_; });
+      if (queue_.empty()) return;
+      std::vector<Sample> block = std::move(queue_.front());
+      queue_.pop_front();
+      busy_ = true;
+      changed_.notify_all();
+      lock.unlock();
+      std::exception_ptr error;
+      try {
+        for (const Sample& s : block) writer_.write(s);
+      } catch (...) {
+        error = std::current_exception();
+      }
+      lock.lock();
+      busy_ = false;
+      if (error) {
+        error_ = error;
+        queue_.clear();
+      }
+      changed_.notify_all();
+      if (error_) return;
+    }
+  }
+
+  log::LogWriter& writer_;
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  std::deque<std::vector<Sample>> queue_;
+  bool busy_ = false, closed_ = false;
+  std::exception_ptr error_;
+  std::thread thread_;
+};
+
+}  // namespace
+
 SimulateResult simulate_to_log(const Scenario& scenario, const std::filesystem::path& log_path,
                                const std::function<bool(double)>& keep_going, SimOptions options) {
   Simulator sim(scenario, options);
   log::LogWriter writer(log_path, sim.metadata(), Simulator::fields());
-  SimulateResult r;
-  Sample s;
   const std::uint64_t poll = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(scenario.sample_rate_hz / 10));
+  constexpr std::size_t kBlock = 1024;
   bool stopped = false;
-  while (sim.next(s)) {
-    writer.write(s);
-    if (keep_going && sim.samples_done() % poll == 0 &&
-        !keep_going(static_cast<double>(sim.samples_done()) / static_cast<double>(sim.total_samples()))) {
-      stopped = true;
-      break;
+  {
+    BackgroundLogWriter background(writer);
+    std::vector<Sample> block;
+    block.reserve(kBlock);
+    Sample s;
+    while (sim.next(s)) {
+      block.push_back(s);
+      if (block.size() == kBlock) {
+        background.push(std::move(block));
+        block = {};
+        block.reserve(kBlock);
+      }
+      if (keep_going && sim.samples_done() % poll == 0 &&
+          !keep_going(static_cast<double>(sim.samples_done()) / static_cast<double>(sim.total_samples()))) {
+        stopped = true;
+        break;
+      }
     }
+    if (!block.empty()) background.push(std::move(block));
+    background.drain();
   }
+  SimulateResult r;
   r.rows = writer.rows_written();
   r.physics_steps = sim.physics_steps();
   r.complete = !stopped;

@@ -15,8 +15,10 @@
 
 #include "estimator/log.hpp"
 #include "estimator/sample.hpp"
+#include "twin/flip_replay.hpp"
 #include "twin/flip_schedule.hpp"
 #include "twin/motion.hpp"
+#include "twin/rest_path.hpp"
 #include "twin/scenario.hpp"
 #include "twin/sensor/sensor_model.hpp"
 #include "twin/world.hpp"
@@ -33,11 +35,14 @@ struct SampleTruth {
   double plat_rate_radps[2] = {0, 0};  // joint rates
 };
 
-/// Simulator switches (not part of the scenario: they change speed, never results beyond 1e-9).
+/// Simulator switches (not part of the scenario: they change speed; the differences they make are
+/// bounded in tests/twin/test_simulator.cpp and docs/model.md).
 struct SimOptions {
-  /// Skip MuJoCo steps while the box is static and both platforms have settled (state constant,
-  /// truth analytic); physics runs through every flip and whenever the base moves.
-  bool fast_standstill = true;
+  /// The kinematic rest path: while both platforms rest settled on their stops (or, on a static
+  /// box, wherever they settled), skip MuJoCo and take the truth from the rigid-body kinematics
+  /// of the base motion; MuJoCo steps every flip, its settling, and every base load that could
+  /// lift a platform off its stop. false: MuJoCo steps the whole run.
+  bool fast_rest = true;
 };
 
 /// A running simulation of one scenario.
@@ -65,13 +70,14 @@ class Simulator {
   /// next physics step. Throws std::invalid_argument on a bad platform or sign, or without
   /// take_flip_control() first.
   void command_platform(int i, int sign);
-  /// The MuJoCo world (model and data at the last sample's physics state) for rendering.
+  /// The MuJoCo world (physics scope: no carriers; renders pose their own full World). Its data
+  /// holds the last stepped state (the kinematic rest path leaves it untouched).
   World& world() { return world_; }
   const World& world() const { return world_; }
 
   std::uint64_t samples_done() const { return samples_; }
   std::uint64_t total_samples() const { return total_; }
-  /// MuJoCo steps taken so far (physics steps skipped on the static fast path are not counted).
+  /// MuJoCo steps taken so far (steps on the kinematic rest path are not counted).
   std::uint64_t physics_steps() const { return mj_steps_; }
 
   /// Metadata for a log of this run (sample rate, latitude, hinge axes, seed, scenario, carrier).
@@ -80,8 +86,21 @@ class Simulator {
   static std::uint32_t fields();
 
  private:
-  void physics_step(bool output);
+  enum class Mode { stepped, rest, replay };
+  void advance(bool output);
+  void step_physics(double t, bool output);
+  void rest_output(double t);
+  void replay_step(double t, bool output);
+  void begin_flip(double t);
+  void try_rest(const MotionState& base, const HingeState& hinge, double t);
+  void enter_rest(const double angle_rad[2]);
+  const MotionState& base_at_output(std::uint64_t sample);
+  double output_time_s(std::uint64_t sample) const;  // t of output sample k: its physics step's t
+  std::uint64_t first_step_at(double t_s) const;
+  void thaw(const double rate_radps[2] = nullptr);
   void capture_truth();
+  void rest_truth(const MotionState& base, const double angle_rad[2], const double rate_radps[2],
+                  const double accel_radps2[2]);
   void fill_sample(Sample& out);
 
   Scenario scenario_;
@@ -89,6 +108,8 @@ class Simulator {
   World world_;
   std::unique_ptr<Motion> motion_;
   FlipController flips_;
+  RestGate gate_;
+  FlipReplay replays_;
   std::vector<SensorModel> sensors_;  // sensor 1, sensor 2
   Eigen::Vector3d earth_enu_radps_;
   long steps_per_sample_;
@@ -96,10 +117,15 @@ class Simulator {
   std::uint64_t samples_ = 0;
   std::uint64_t step_ = 0;       // next physics step index (t = step * dt)
   std::uint64_t mj_steps_ = 0;
-  bool frozen_ = false;          // static fast path active
+  Mode mode_ = Mode::stepped;
+  double rest_angle_rad_[2] = {0, 0};    // hinge angles on the rest path and during a replay
+  const FlipReplay::Flip* replay_ = nullptr;  // the flip being replayed, and where in it
+  std::size_t replay_pos_ = 0;
   SampleTruth truth_;
-  SampleTruth frozen_truth_;
+  SampleTruth static_rest_truth_;        // a static box at rest: the truth is constant
   MotionState base_;             // motion state at the last output sample
+  MotionState next_base_;        // look-ahead: motion state at an output sample
+  std::uint64_t next_base_sample_ = ~std::uint64_t{0};
   std::deque<SampleTruth> history_;  // recent output truths (model.time_offset_s > 0)
 };
 

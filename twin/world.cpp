@@ -8,8 +8,10 @@
 
 #include <fmt/core.h>
 
+#include "estimator/numbers.hpp"
 #include "estimator/sample.hpp"
 #include "twin/embedded.hpp"
+#include "twin/motion.hpp"
 
 namespace driftless::twin {
 namespace {
@@ -18,7 +20,7 @@ void require(bool ok, const std::string& what) {
   if (!ok) throw std::invalid_argument(what);
 }
 
-std::string num(double v) { return fmt::format("{:.17g}", v); }
+std::string num(double v) { return exact_number(v); }  // MuJoCo reads back the same double
 std::string vec3(const Eigen::Vector3d& v) { return num(v.x()) + " " + num(v.y()) + " " + num(v.z()); }
 
 // sets attribute `attr` of the element named `name` (the one tag holding name="...") in `xml`
@@ -43,6 +45,43 @@ void set_attr(std::string& xml, const std::string& name, const std::string& attr
     tag.insert(self_closing ? tag.size() - 1 : tag.size(), a + value + "\" ");
   }
   xml.replace(open, close - open, tag);
+}
+
+// end of the element opened at `open` ('<tag ...'): past "/>" for a self-closing tag, else past
+// the matching "</tag>" (nested tags of the same name counted)
+std::size_t element_end(const std::string& xml, std::size_t open, const std::string& tag) {
+  const std::size_t gt = xml.find('>', open);
+  if (gt == std::string::npos) throw std::logic_error("box model: unterminated <" + tag + ">");
+  if (xml[gt - 1] == '/') return gt + 1;
+  int depth = 1;
+  std::size_t at = gt + 1;
+  while (depth > 0) {
+    const std::size_t next_open = xml.find("<" + tag, at), next_close = xml.find("</" + tag + ">", at);
+    if (next_close == std::string::npos) throw std::logic_error("box model: unclosed <" + tag + ">");
+    if (next_open != std::string::npos && next_open < next_close) {
+      ++depth;
+      at = next_open + 1;
+    } else {
+      --depth;
+      at = next_close + tag.size() + 3;
+    }
+  }
+  return at;
+}
+
+// removes every <tag ...> element whose opening tag contains `marker` (empty: every one)
+void erase_elements(std::string& xml, const std::string& tag, const std::string& marker) {
+  std::size_t at = 0;
+  while ((at = xml.find("<" + tag, at)) != std::string::npos) {
+    const char after = xml[at + tag.size() + 1];
+    const std::size_t gt = xml.find('>', at);
+    const bool same_tag = after == ' ' || after == '>' || after == '/' || after == '\n';
+    if (same_tag && (marker.empty() || xml.substr(at, gt - at).find(marker) != std::string::npos)) {
+      xml.erase(at, element_end(xml, at, tag) - at);
+    } else {
+      ++at;
+    }
+  }
 }
 
 void quat_to_mj(const Eigen::Quaterniond& q, mjtNum* out) {
@@ -129,6 +168,15 @@ std::string box_mjcf(const BoxParams& box) {
   return xml;
 }
 
+std::string physics_only_mjcf(const std::string& xml) {
+  std::string out = xml;
+  erase_elements(out, "body", "mocap=\"true\"");
+  erase_elements(out, "geom", "class=\"visual\"");
+  erase_elements(out, "camera", "");
+  erase_elements(out, "light", "");
+  return out;
+}
+
 ModelPtr load_mjcf_string(const std::string& xml, const std::string& name) {
   auto vfs = std::make_unique<mjVFS>();
   mj_defaultVFS(vfs.get());
@@ -144,10 +192,11 @@ ModelPtr load_mjcf_string(const std::string& xml, const std::string& name) {
   return ModelPtr(m, mj_deleteModel);
 }
 
-World::World(const BoxParams& box, double timestep_s)
-    : box_(box), model_(nullptr, mj_deleteModel), data_(nullptr, mj_deleteData) {
+World::World(const BoxParams& box, double timestep_s, ModelScope scope)
+    : box_(box), scope_(scope), model_(nullptr, mj_deleteModel), data_(nullptr, mj_deleteData) {
   require(timestep_s > 0 && timestep_s <= 0.005, "physics_dt_s must be in (0, 0.005] s");
-  model_ = load_mjcf_string(box_mjcf(box_), "driftless_box.xml");
+  const std::string xml = box_mjcf(box_);
+  model_ = load_mjcf_string(scope == ModelScope::full ? xml : physics_only_mjcf(xml), "driftless_box.xml");
   model_->opt.timestep = timestep_s;
   data_ = DataPtr(mj_makeData(model_.get()), mj_deleteData);
   if (!data_) throw std::runtime_error("MuJoCo: mj_makeData failed");
@@ -165,16 +214,20 @@ World::World(const BoxParams& box, double timestep_s)
     site_imu_[i] = id(mjOBJ_SITE, ("imu" + n).c_str());
     sadr_gyro_[i] = m->sensor_adr[id(mjOBJ_SENSOR, ("gyro" + n).c_str())];
     sadr_accel_[i] = m->sensor_adr[id(mjOBJ_SENSOR, ("accel" + n).c_str())];
+    cache_platform(i, j, site_imu_[i]);
   }
+  gravity_enu_mps2_ = Eigen::Vector3d(m->opt.gravity[0], m->opt.gravity[1], m->opt.gravity[2]);
   body_box_ = id(mjOBJ_BODY, "box");
-  body_pan_ = id(mjOBJ_BODY, "pantilt_pan");
-  body_tilt_ = id(mjOBJ_BODY, "pantilt_tilt");
-  body_vehicle_ = id(mjOBJ_BODY, "vehicle");
-  body_ship_ = id(mjOBJ_BODY, "ship");
-  mocap_pan_ = m->body_mocapid[body_pan_];
-  mocap_tilt_ = m->body_mocapid[body_tilt_];
-  mocap_vehicle_ = m->body_mocapid[body_vehicle_];
-  mocap_ship_ = m->body_mocapid[body_ship_];
+  if (scope == ModelScope::full) {
+    body_pan_ = id(mjOBJ_BODY, "pantilt_pan");
+    body_tilt_ = id(mjOBJ_BODY, "pantilt_tilt");
+    body_vehicle_ = id(mjOBJ_BODY, "vehicle");
+    body_ship_ = id(mjOBJ_BODY, "ship");
+    mocap_pan_ = m->body_mocapid[body_pan_];
+    mocap_tilt_ = m->body_mocapid[body_tilt_];
+    mocap_vehicle_ = m->body_mocapid[body_vehicle_];
+    mocap_ship_ = m->body_mocapid[body_ship_];
+  }
   scratch_qacc_.resize(static_cast<std::size_t>(m->nv));
   scratch_res_.resize(static_cast<std::size_t>(m->nv));
   geom_alpha_.resize(static_cast<std::size_t>(m->ngeom));
@@ -185,6 +238,82 @@ World::World(const BoxParams& box, double timestep_s)
   set_base(Eigen::Vector3d::Zero(), Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero(),
            Eigen::Vector3d::Zero());
   mj_forward(m, data_.get());
+}
+
+namespace {
+Eigen::Vector3d vec(const mjtNum* v) { return {v[0], v[1], v[2]}; }
+Eigen::Matrix3d mat(const mjtNum* q) { return Eigen::Quaterniond(q[0], q[1], q[2], q[3]).toRotationMatrix(); }
+}  // namespace
+
+void World::cache_platform(int i, int joint, int site) {
+  const mjModel* m = model_.get();
+  const int body = m->jnt_bodyid[joint];
+  const int box = id(mjOBJ_BODY, "box");
+  // the closed forms below take the box frame as the drive's frame and the platforms as its children
+  if (m->body_parentid[body] != box || vec(m->body_pos + 3 * box).norm() != 0.0 ||
+      m->body_quat[4 * box] != 1.0) {
+    throw std::logic_error("box model: the box body must sit at the drive's origin and carry the platforms");
+  }
+  if (m->site_bodyid[site] != body) throw std::logic_error("box model: sensor site off its platform");
+  Platform& p = plat_[i];
+  const Eigen::Vector3d jnt_pos = vec(m->jnt_pos + 3 * joint);
+  p.R_box_from_plat0 = mat(m->body_quat + 4 * body);
+  p.anchor_box_m = vec(m->body_pos + 3 * body) + p.R_box_from_plat0 * jnt_pos;
+  p.axis_plat = vec(m->jnt_axis + 3 * joint).normalized();
+  p.site_from_anchor_m = vec(m->site_pos + 3 * site) - jnt_pos;
+  p.R_plat_from_site = mat(m->site_quat + 4 * site);
+  p.mass_kg = m->body_mass[body];
+  p.com_from_anchor_m = vec(m->body_ipos + 3 * body) - jnt_pos;
+  const Eigen::Matrix3d R_iq = mat(m->body_iquat + 4 * body);
+  p.inertia_com_kgm2 = R_iq * vec(m->body_inertia + 3 * body).asDiagonal() * R_iq.transpose();
+}
+
+Eigen::Matrix3d World::R_box_from_plat(int i, double angle_rad) const {
+  const Platform& p = plat_[i - 1];
+  return p.R_box_from_plat0 * Eigen::AngleAxisd(angle_rad, p.axis_plat).toRotationMatrix();
+}
+
+SiteMotion World::site_motion(int i, const MotionState& base, double angle_rad, double rate_radps,
+                              double accel_radps2) const {
+  const Platform& p = plat_[i - 1];
+  const Eigen::Matrix3d R_bp = R_box_from_plat(i, angle_rad);
+  const Eigen::Matrix3d R_box_from_site = R_bp * p.R_plat_from_site;
+  const Eigen::Vector3d& w = base.w_body_radps;
+  const Eigen::Vector3d& dw = base.dw_body_radps2;
+  const Eigen::Vector3d axis = p.R_box_from_plat0 * p.axis_plat;  // box axes (turns with no angle)
+  // site position: box origin -> anchor -> site; its motion relative to the box is the hinge's
+  const Eigen::Vector3d rho = R_bp * p.site_from_anchor_m;
+  const Eigen::Vector3d r = p.anchor_box_m + rho;
+  const Eigen::Vector3d rho_dot = rate_radps * axis.cross(rho);
+  const Eigen::Vector3d rho_ddot = accel_radps2 * axis.cross(rho) + rate_radps * axis.cross(rho_dot);
+  const Eigen::Matrix3d R_enu_from_body = base.q_enu_from_body.normalized().toRotationMatrix();
+  const Eigen::Vector3d a_site_box = R_enu_from_body.transpose() * (base.a_enu_mps2 - gravity_enu_mps2_) +
+                                     dw.cross(r) + w.cross(w.cross(r)) + 2.0 * w.cross(rho_dot) + rho_ddot;
+  SiteMotion out;
+  out.w_radps = R_box_from_site.transpose() * (w + rate_radps * axis);
+  out.f_mps2 = R_box_from_site.transpose() * a_site_box;
+  out.R_body_from_sensor = R_box_from_site;
+  return out;
+}
+
+double World::rest_hinge_torque_nm(int i, const MotionState& base, double angle_rad) const {
+  const Platform& p = plat_[i - 1];
+  const Eigen::Matrix3d R_bp = R_box_from_plat(i, angle_rad);
+  const Eigen::Vector3d& w = base.w_body_radps;
+  const Eigen::Vector3d& dw = base.dw_body_radps2;
+  const Eigen::Vector3d c = R_bp * p.com_from_anchor_m;
+  const Eigen::Matrix3d I = R_bp * p.inertia_com_kgm2 * R_bp.transpose();
+  const Eigen::Vector3d r_com = p.anchor_box_m + c;
+  const Eigen::Matrix3d R_enu_from_body = base.q_enu_from_body.normalized().toRotationMatrix();
+  const Eigen::Vector3d a_com = R_enu_from_body.transpose() * (base.a_enu_mps2 - gravity_enu_mps2_) +
+                                dw.cross(r_com) + w.cross(w.cross(r_com));
+  const Eigen::Vector3d torque = I * dw + w.cross(I * w) + p.mass_kg * c.cross(a_com);
+  return (p.R_box_from_plat0 * p.axis_plat).dot(torque);
+}
+
+double World::motor_rest_torque_nm(double ref_rad, double angle_rad) const {
+  const MotorParams& m = box_.motor;
+  return std::clamp(m.kp_nm_per_rad * (ref_rad - angle_rad), -m.stall_torque_nm, m.stall_torque_nm);
 }
 
 int World::id(int type, const char* name) const {
@@ -236,6 +365,27 @@ void World::drive_base(const Eigen::Vector3d& a_enu_mps2, const Eigen::Vector3d&
   }
 }
 
+HingeState World::step_driven(double t_s, const MotionState& base, const Eigen::Vector2d& ref_rad,
+                               bool sensors) {
+  mjModel* m = model_.get();
+  mjData* d = data_.get();
+  set_base(base.p_enu_m, base.q_enu_from_body, base.v_enu_mps, base.w_body_radps);
+  set_motor_reference(1, ref_rad[0]);
+  set_motor_reference(2, ref_rad[1]);
+  if (!sensors) m->opt.disableflags |= mjDSBL_SENSOR;
+  d->time = t_s;
+  mj_step1(m, d);  // kinematics, velocities, gyro sensors at t
+  drive_base(base.a_enu_mps2, base.dw_body_radps2);
+  HingeState h;
+  for (int i = 0; i < 2; ++i) {
+    h.angle_rad[i] = d->qpos[qadr_hinge_[i]];
+    h.rate_radps[i] = d->qvel[vadr_hinge_[i]];
+  }
+  mj_step2(m, d);  // actuation, constraints (end stops), accelerometers at t; integrate to t + dt
+  m->opt.disableflags &= ~mjDSBL_SENSOR;
+  return h;
+}
+
 Eigen::Vector3d World::mj_gyro(int i) const {
   const mjtNum* s = data_->sensordata + sadr_gyro_[i - 1];
   return {s[0], s[1], s[2]};
@@ -269,6 +419,10 @@ void World::set_visible(int body_id, bool visible) {
 
 void World::pose_carrier(Carrier c, const Eigen::Vector3d& p_enu_m,
                          const Eigen::Quaterniond& q_enu_from_body) {
+  if (scope_ == ModelScope::physics) {
+    if (c == Carrier::none) return;
+    throw std::logic_error("World: a physics-scope model has no carriers to pose");
+  }
   mjData* d = data_.get();
   const Eigen::Quaterniond q = q_enu_from_body.normalized();
   const Eigen::Matrix3d R = q.toRotationMatrix();

@@ -57,6 +57,33 @@ std::string box_mjcf(const BoxParams& box);
 /// The embedded models/driftless_box.xml as shipped (default configuration).
 const std::string& embedded_box_mjcf();
 
+/// What a World's model holds. `full`: the shipped MJCF (carriers, decorations, cameras, lights)
+/// for rendering. `physics`: the same bodies, joints, inertias, actuators and sensors without the
+/// carriers and decorations (massless, contact-free, mocap): stepping skips their kinematics,
+/// and the dynamics are the same to the last bit.
+enum class ModelScope { full, physics };
+
+/// The MJCF text of `xml` without its decorations: mocap carrier bodies, geoms of the `visual`
+/// class, cameras and lights (see ModelScope::physics).
+std::string physics_only_mjcf(const std::string& xml);
+
+struct MotionState;  // twin/motion.hpp
+
+/// Hinge angles and rates at the start of a driven step (before MuJoCo integrates), rad, rad/s.
+struct HingeState {
+  double angle_rad[2] = {0, 0};
+  double rate_radps[2] = {0, 0};
+};
+
+/// What a sensor site feels, in the site's axes: angular rate w.r.t. the non-rotating world
+/// (rad/s, Earth not included) and specific force (m/s^2): what MuJoCo's gyro and accelerometer
+/// report.
+struct SiteMotion {
+  Eigen::Vector3d w_radps = Eigen::Vector3d::Zero();
+  Eigen::Vector3d f_mps2 = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d R_body_from_sensor = Eigen::Matrix3d::Identity();  // site axes to box axes
+};
+
 using ModelPtr = std::unique_ptr<mjModel, decltype(&mj_deleteModel)>;
 using DataPtr = std::unique_ptr<mjData, decltype(&mj_deleteData)>;
 
@@ -66,8 +93,9 @@ ModelPtr load_mjcf_string(const std::string& xml, const std::string& name = "mod
 /// The box world: owns model and data, caches ids and addresses of every named element.
 class World {
  public:
-  /// Builds the model from `box` (validated) with the given physics time step (s).
-  explicit World(const BoxParams& box, double timestep_s = 0.001);
+  /// Builds the model from `box` (validated) with the given physics time step (s); `scope`
+  /// physics drops the carriers and decorations (no pose_carrier, nothing to render).
+  explicit World(const BoxParams& box, double timestep_s = 0.001, ModelScope scope = ModelScope::full);
   World(const World&) = delete;
   World& operator=(const World&) = delete;
 
@@ -88,12 +116,37 @@ class World {
   /// Motor command of platform i: the servo reference angle, rad.
   void set_motor_reference(int i, double ref_rad);
 
+  /// The model's gravity in ENU, m/s^2.
+  const Eigen::Vector3d& gravity_enu_mps2() const { return gravity_enu_mps2_; }
+
   /// Motion driver: box pose (ENU), velocity (ENU, m/s) and body-axes angular rate (rad/s).
   void set_base(const Eigen::Vector3d& p_enu_m, const Eigen::Quaterniond& q_enu_from_body,
                 const Eigen::Vector3d& v_enu_mps, const Eigen::Vector3d& w_body_radps);
   /// After mj_step1: the generalized force that makes the box follow the given linear (ENU)
   /// and angular (body axes) acceleration exactly (the drive joints carry a huge armature).
   void drive_base(const Eigen::Vector3d& a_enu_mps2, const Eigen::Vector3d& dw_body_radps2);
+
+  /// The driven step, the one place MuJoCo steps the box along a motion: at time t_s, poses the
+  /// base at `base` (pose, velocity, rate), sets the servo references (rad), mj_step1, applies the
+  /// drive force for the base's accelerations, mj_step2. Returns the hinge state at t_s. With
+  /// `sensors`, MuJoCo's gyro/accelerometer hold their values at t_s afterwards; without, the
+  /// sensor stage is skipped (it never feeds back into the dynamics).
+  HingeState step_driven(double t_s, const MotionState& base, const Eigen::Vector2d& ref_rad,
+                         bool sensors = true);
+
+  /// Rigid-body kinematics of platform i's sensor site (1 or 2): from the base motion and the
+  /// hinge angle (rad), rate (rad/s) and acceleration (rad/s^2), the site's rate and specific
+  /// force in closed form. Equals MuJoCo's gyro/accelerometer for the same state (the kinematic
+  /// rest path's truth; tests/twin/test_world.cpp ties the two).
+  SiteMotion site_motion(int i, const MotionState& base, double angle_rad, double rate_radps = 0.0,
+                         double accel_radps2 = 0.0) const;
+  /// Hinge torque (N m, about hinge i's axis) that carries platform i rigidly at `angle_rad` on a
+  /// base moving as `base`: the axis component of I dw + w x (I w) + m c x (a_c - g) about the
+  /// hinge anchor (Newton-Euler for the platform body; the rotor armature sees only hinge motion).
+  double rest_hinge_torque_nm(int i, const MotionState& base, double angle_rad) const;
+  /// Torque (N m) the servo of platform i exerts at rest at `angle_rad` with reference `ref_rad`:
+  /// kp (ref - angle), clipped to the stall torque (the MJCF actuator at zero rate).
+  double motor_rest_torque_nm(double ref_rad, double angle_rad) const;
 
   /// Sensor readings of MuJoCo's gyro (rad/s, site axes; rate w.r.t. the non-rotating world)
   /// and accelerometer (specific force, m/s^2, site axes) of platform i, from sensordata.
@@ -103,7 +156,8 @@ class World {
   Eigen::Matrix3d R_enu_from_sensor(int i) const;
 
   /// Poses the carrier bodies (pan/tilt head, vehicle, ship) from the box pose and hides the
-  /// carriers that are not `c`. Call before mj_forward / rendering.
+  /// carriers that are not `c`. Call before mj_forward / rendering. A physics-scope world has no
+  /// carriers: std::logic_error unless `c` is Carrier::none.
   void pose_carrier(Carrier c, const Eigen::Vector3d& p_enu_m, const Eigen::Quaterniond& q_enu_from_body);
 
   /// Poses the whole world kinematically (box pose, platform angles in rad, carrier) and runs
@@ -122,6 +176,7 @@ class World {
   void set_visible(int body_id, bool visible);
 
   BoxParams box_;
+  ModelScope scope_;
   ModelPtr model_;
   DataPtr data_;
   int qadr_drive_ = 0, vadr_drive_ = 0;   // drive_x qpos / dof address (x, y, z, then ball)
@@ -132,8 +187,23 @@ class World {
   int mocap_pan_ = -1, mocap_tilt_ = -1, mocap_vehicle_ = -1, mocap_ship_ = -1;
   int body_box_ = -1;
   int body_pan_ = -1, body_tilt_ = -1, body_vehicle_ = -1, body_ship_ = -1;
-  std::vector<float> geom_alpha_;
-  std::vector<mjtNum> scratch_qacc_, scratch_res_;  // drive_base work space (no per-step allocation)  // shipped alpha of every geom (carriers are hidden by alpha 0)
+  // platform i's geometry and mass from the compiled model (platform axes at hinge angle 0)
+  struct Platform {
+    Eigen::Vector3d anchor_box_m;           // hinge anchor, box axes
+    Eigen::Matrix3d R_box_from_plat0;       // platform axes at angle 0
+    Eigen::Vector3d axis_plat;              // hinge axis, platform axes (unit)
+    Eigen::Vector3d site_from_anchor_m;     // sensor site, from the anchor, platform axes
+    Eigen::Matrix3d R_plat_from_site;
+    double mass_kg = 0;
+    Eigen::Vector3d com_from_anchor_m;      // centre of mass, from the anchor, platform axes
+    Eigen::Matrix3d inertia_com_kgm2;       // about the centre of mass, platform axes
+  };
+  Platform plat_[2];
+  Eigen::Vector3d gravity_enu_mps2_ = Eigen::Vector3d::Zero();
+  void cache_platform(int i, int joint, int site);
+  Eigen::Matrix3d R_box_from_plat(int i, double angle_rad) const;
+  std::vector<float> geom_alpha_;                   // shipped alpha of every geom (carriers are hidden by alpha 0)
+  std::vector<mjtNum> scratch_qacc_, scratch_res_;  // drive_base work space (no per-step allocation)
 };
 
 }  // namespace driftless::twin

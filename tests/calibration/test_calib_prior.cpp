@@ -6,13 +6,15 @@
 #include "calibration/prior.hpp"
 #include "estimator/geometry.hpp"
 #include "twin/sensor/sensor_model.hpp"
+#include "twin/yaml_doc.hpp"
 
 namespace driftless::calib {
 
 using twin::SensorParams;
 using twin::SensorInstance;
 using twin::ideal_sensor;
-using twin::parse_sensor_params;
+using twin::parse_yaml;
+using twin::read_sensor_params;
 namespace {
 
 TEST(CalibPrior, SensorModelBuiltFromThePriorReproducesM) {
@@ -24,8 +26,10 @@ TEST(CalibPrior, SensorModelBuiltFromThePriorReproducesM) {
   const Eigen::Vector3d hinge[2] = {c.hinge1_axis, c.hinge2_axis};
   for (int i = 0; i < 2; ++i) {
     // WHEN the twin's sensor model reads the prior (over a sensor with every effect off)
-    const SensorParams p = parse_sensor_params(root["model"][i == 0 ? "sensor1" : "sensor2"],
-                                               ideal_sensor(), "prior.yaml");
+    const SensorParams p = read_sensor_params(*parse_yaml(model_prior_yaml(c), "prior.yaml")
+                                                   .find("model")
+                                                   ->find(i == 0 ? "sensor1" : "sensor2"),
+                                               ideal_sensor(), fields::Context{"prior.yaml", ""});
     const SensorInstance inst = draw_sensor_instance(p, 1234);
     const Eigen::Matrix3d C = inst.misalignment * inst.scale.asDiagonal() * inst.R_sensor_from_nominal;
     const auto stops = root["model"]["box"][i == 0 ? "stop1_error_deg" : "stop2_error_deg"];

@@ -30,6 +30,9 @@ grep -q '"verdict": "missing_effect"' "$t/c0/diagnosis.json" || { cat "$t/c0.out
 [[ -s "$t/c0/report.html" ]] || fail "no report.html"
 grep -q "src='http" "$t/c0/report.html" && fail "report.html loads something from the network"
 grep -q "data:image/png;base64," "$t/c0/report.html" || fail "report.html embeds no plot"
+# the same with paths relative to the working folder (gnuplot runs inside plots/)
+(cd "$t" && "$bin" compare --log sim/log.csv --model model.yaml --out rel > /dev/null) || fail "compare with relative paths"
+[[ $(grep -o "data:image/png;base64," "$t/rel/report.html" | wc -l) -ge 4 ]] || fail "relative --out: report.html lacks its plots"
 
 # 2. diagnose --apply: scale_factor on sensor 1 ranks first and is written to the model
 "$bin" diagnose --log "$log" --model "$t/model.yaml" --out "$t/d0" --apply "$t/new.yaml" > "$t/d0.out" ||

@@ -43,5 +43,5 @@ grep -q "junk.csv:" "$t/junk.err" || fail "junk row: message lacks file:line"
 
 printf 'mode: paper\nsettle_s: soon\n' > "$t/bad.cfg"
 "$bin" estimate --log "$golden" --config "$t/bad.cfg" --out "$t/out_cfg" > /dev/null 2> "$t/cfg.err" && fail "bad config accepted"
-grep -q "bad.cfg:2: key 'settle_s': expected a number" "$t/cfg.err" || { cat "$t/cfg.err"; fail "bad config message"; }
+grep -q "bad.cfg:2: settle_s: expected a number" "$t/cfg.err" || { cat "$t/cfg.err"; fail "bad config message"; }
 echo "ok"

@@ -25,15 +25,20 @@ expect_error() {  # name, pattern, yaml
   out=$("$bin" simulate --scenario "$tmp/$1.yaml" --out "$tmp/x" 2>&1) && fail "$1: exit code 0"
   echo "$out" | grep -q -- "$2" || fail "$1: message '$out' lacks '$2'"
 }
-expect_error unknown_key "unknown_key.yaml:3: key 'flip_schedule.standstil_s'" $'duration_s: 5\nflip_schedule:\n  standstil_s: 4\n'
-expect_error units2 "units2.yaml:3: key 'motion.max_rate_radps': inconsistent units" $'motion:\n  type: pan_tilt\n  max_rate_radps: 0.8\n'
+expect_error unknown_key "unknown_key.yaml:3: flip_schedule.standstil_s: unknown key" $'duration_s: 5\nflip_schedule:\n  standstil_s: 4\n'
+expect_error units2 "units2.yaml:3: motion.max_rate_deg: inconsistent units" $'motion:\n  type: pan_tilt\n  max_rate_deg: 50\n'
+expect_error duplicate "duplicate.yaml:3: duration_s: key given twice (lines 1 and 3)" $'duration_s: 5\nseed: 2\nduration_s: 6\n'
 expect_error broken "broken.yaml:.*broken YAML" $'duration_s: 5\nmotion: [static\n'
-expect_error badtype "badtype.yaml:2: key 'motion.type'" $'motion:\n  type: rocket\n'
+expect_error badtype "badtype.yaml:2: motion.type: expected one of static, pan_tilt" $'motion:\n  type: rocket\n'
+# a duration no disk holds: refused before anything is written
+out=$("$bin" simulate --out "$tmp/long" --duration 1e12 2>&1) && fail "duration 1e12: exit 0"
+echo "$out" | grep -q "duration_s = .* must be in (0, 1e7\] s" || fail "duration 1e12: message '$out'"
+[ ! -e "$tmp/long/log.csv" ] || fail "duration 1e12: a log was started"
 out=$("$bin" simulate --scenario "$tmp/missing.yaml" --out "$tmp/x" 2>&1) && fail "missing file: exit 0"
 echo "$out" | grep -q "missing.yaml" || fail "missing file: '$out'"
 
 # Ctrl-C: a valid log marked complete: false
-"$bin" simulate --scenario vehicle --out "$tmp/int" --duration 600 >/dev/null 2>&1 &
+"$bin" simulate --scenario vehicle --out "$tmp/int" --duration 36000 >/dev/null 2>&1 &
 pid=$!
 sleep 1.5
 kill -INT $pid

@@ -135,12 +135,20 @@ TEST(Framing, TheDirectorClosesInAndBacksOutInTheSetFrames) {
   EXPECT_LT(cam.distance, 0.6 * box_distance);
   const Eigen::Map<const Eigen::Vector3d> plat2(poser.data()->xpos + 3 * poser.bodies().platform[1]);
   EXPECT_NEAR((Eigen::Vector3d(cam.lookat[0], cam.lookat[1], cam.lookat[2]) - plat2).norm(), 0.0, 0.01);
+  // platform 2 turns about the box's x axis at the +x end: the camera looks at it from beyond,
+  // along -x (nothing of the box in front), and from above
+  const Eigen::Vector3d f2 = camera_axes({cam.azimuth, cam.elevation}).forward;
+  EXPECT_LT(f2.x(), -0.5);
+  EXPECT_LE(cam.elevation, -30.0 + 1e-9);
   // a switch to platform 1 goes through the box: 4 frames out, then in
   for (int i = 0; i < 4; ++i) dir.update(poser.data(), opt, 0, 1.0, &cam);
   EXPECT_EQ(dir.close_up_weight(), 0.0);
   dir.update(poser.data(), opt, 0, 1.0, &cam);
   EXPECT_EQ(dir.close_up_platform(), 0);
   EXPECT_GT(dir.close_up_weight(), 0.0);
+  // platform 1 turns about the box's z axis: seen from above, mostly along its axis
+  for (int i = 0; i < 4; ++i) dir.update(poser.data(), opt, 0, 1.0, &cam);
+  EXPECT_LT(camera_axes({cam.azimuth, cam.elevation}).forward.z(), -0.8);
   // back to the box
   for (int i = 0; i < 4; ++i) dir.update(poser.data(), opt, -1, 1.0, &cam);
   EXPECT_EQ(dir.close_up_weight(), 0.0);

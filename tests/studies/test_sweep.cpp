@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "estimator/input_error.hpp"
 #include "studies/sweep.hpp"
 
 namespace driftless::studies {
@@ -68,16 +69,16 @@ TEST(Sweep, ParsesTheFile) {
 }
 
 TEST(Sweep, RejectsBadFilesWithFileAndKey) {
-  EXPECT_THROW(parse_sweep("name: x\nbogus: 1\n", "a.yaml", "."), std::runtime_error);
+  EXPECT_THROW(parse_sweep("name: x\nbogus: 1\n", "a.yaml", "."), driftless::InputError);
   try {
     parse_sweep("grid:\n  a: [1, x]\n", "b.yaml", ".");
     FAIL();
-  } catch (const std::runtime_error& e) {
+  } catch (const driftless::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("b.yaml:2"), std::string::npos) << e.what();
   }
-  EXPECT_THROW(parse_sweep("runner: magic\n", "c.yaml", "."), std::runtime_error);
+  EXPECT_THROW(parse_sweep("runner: magic\n", "c.yaml", "."), driftless::InputError);
   EXPECT_THROW(parse_sweep("grid: {a: [1]}\nplots: [{x: b, y: [e]}]\n", "d.yaml", "."),
-               std::runtime_error);
+               driftless::InputError);
 }
 
 TEST(Sweep, ExpandsLastAxisFastestWithCommonSeeds) {

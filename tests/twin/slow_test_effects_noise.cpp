@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "estimator/allan.hpp"
+#include "estimator/allan_fit.hpp"
 #include "estimator/sample.hpp"
 #include "twin/sensor/sensor_model.hpp"
 

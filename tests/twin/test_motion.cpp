@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "estimator/input_error.hpp"
 #include "estimator/sample.hpp"
 #include "tests/temp_path.hpp"
 #include "twin/motion.hpp"
@@ -152,11 +153,11 @@ TEST(Motion, BadCsvNamesFileAndLine) {
   try {
     read_trajectory_csv(f);
     FAIL();
-  } catch (const std::runtime_error& e) {
+  } catch (const driftless::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("bad.csv:3"), std::string::npos) << e.what();
   }
   const auto g = temp_file("nohdr.csv", "time,x\n0,1\n");
-  EXPECT_THROW(read_trajectory_csv(g), std::runtime_error);
+  EXPECT_THROW(read_trajectory_csv(g), driftless::InputError);
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include "estimator/input_error.hpp"
 #include "twin/scenario.hpp"
 
 #include "tests/temp_path.hpp"
@@ -14,7 +15,7 @@ namespace {
 std::string error_of(const std::string& yaml) {
   try {
     parse_scenario(yaml, "test.yaml");
-  } catch (const std::runtime_error& e) {
+  } catch (const driftless::InputError& e) {
     return e.what();
   }
   return "(no error)";
@@ -65,7 +66,7 @@ TEST(Scenario, UnknownKeyNamesFileLineAndKey) {
 }
 
 TEST(Scenario, InconsistentUnitsAreErrors) {
-  std::string e = error_of("duration_s: 10\nflip_schedule:\n  standstill_ms: 5000\n");
+  std::string e = error_of("duration_s: 10\nflip_schedule:\n  standstill_deg: 5\n");
   EXPECT_NE(e.find("test.yaml:3"), std::string::npos) << e;
   EXPECT_NE(e.find("inconsistent units"), std::string::npos) << e;
   EXPECT_NE(e.find("standstill_s"), std::string::npos) << e;
@@ -76,6 +77,33 @@ TEST(Scenario, InconsistentUnitsAreErrors) {
   EXPECT_NE(e.find("duration_s"), std::string::npos) << e;
   // the key's own unit written out is fine
   EXPECT_EQ(parse_scenario("duration_s: 10 s\nlatitude_deg: 45 deg\n", "t.yaml").duration_s, 10);
+}
+
+TEST(Scenario, KeysInAnotherUnitOfTheSameQuantityConvert) {
+  // GIVEN keys in minutes, milliseconds, km/h and kHz (one unit table for every block)
+  const Scenario s = parse_scenario(
+      "duration_min: 2\nsample_rate_khz: 0.2\nphysics_dt_ms: 1\nflip_schedule:\n  standstill_ms: 5000\n"
+      "motion:\n  type: ship\n  speed_kmh: 36\n",
+      "t.yaml");
+  // THEN they arrive in the fields' units, and the resolved form writes the canonical keys
+  EXPECT_EQ(s.duration_s, 120.0);
+  EXPECT_EQ(s.sample_rate_hz, 200.0);
+  EXPECT_EQ(s.physics_dt_s, 0.001);
+  EXPECT_EQ(s.flip_schedule.standstill_s, 5.0);
+  EXPECT_NEAR(s.motion.ship.speed_mps, 10.0, 1e-12);
+  const std::string out = emit_scenario(s);
+  EXPECT_NE(out.find("duration_s: 120"), std::string::npos) << out;
+  EXPECT_NE(out.find("standstill_s: 5"), std::string::npos) << out;
+}
+
+TEST(Scenario, DuplicateKeysAreRefusedNamingBothLines) {
+  // yaml-cpp keeps the first of two equal keys silently; the loader refuses them
+  std::string e = error_of("duration_s: 10\nseed: 3\nduration_s: 20\n");
+  EXPECT_NE(e.find("test.yaml:3: duration_s: key given twice (lines 1 and 3)"), std::string::npos) << e;
+  e = error_of("model:\n  box:\n    end_stop_deg: 90\n    end_stop_deg: 80\n");
+  EXPECT_NE(e.find("test.yaml:4: model.box.end_stop_deg: key given twice (lines 3 and 4)"), std::string::npos) << e;
+  e = error_of("model:\n  sensor1:\n    effects: {white_noise: {enabled: true, enabled: false}}\n");
+  EXPECT_NE(e.find("model.sensor1.effects.white_noise.enabled: key given twice"), std::string::npos) << e;
 }
 
 TEST(Scenario, BrokenYamlNamesTheLine) {
@@ -101,7 +129,7 @@ TEST(Scenario, MissingFileSaysSo) {
   try {
     load_scenario("/nonexistent/dir/scenario.yaml");
     FAIL();
-  } catch (const std::runtime_error& e) {
+  } catch (const driftless::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("/nonexistent/dir/scenario.yaml"), std::string::npos);
   }
 }
@@ -113,7 +141,7 @@ TEST(Scenario, ModelFileHoldsOnlyTheModel) {
   const ModelConfig m = load_model_config(dir / "model.yaml", ModelConfig{});
   EXPECT_EQ(m.box.end_stop_deg, 80);
   std::ofstream(dir / "bad_model.yaml") << "model:\n  box: {}\nmotion: {type: static}\n";
-  EXPECT_THROW(load_model_config(dir / "bad_model.yaml", ModelConfig{}), std::runtime_error);
+  EXPECT_THROW(load_model_config(dir / "bad_model.yaml", ModelConfig{}), driftless::InputError);
 }
 
 }  // namespace

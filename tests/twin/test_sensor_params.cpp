@@ -8,14 +8,19 @@
 
 #include "estimator/sample.hpp"
 #include "twin/sensor/sensor_model.hpp"
+#include "twin/yaml_doc.hpp"
 
 using namespace driftless;
 using namespace driftless::twin;
 
 namespace {
 
+SensorParams parse_block(const std::string& text, const SensorParams& base, const std::string& file) {
+  return read_sensor_params(parse_yaml(text, file), base, fields::Context{file, ""});
+}
+
 SensorParams parse(const std::string& text, const SensorParams& base = mpu6050_defaults()) {
-  return parse_sensor_params(YAML::Load(text), base, "sensors.yaml");
+  return parse_block(text, base, "sensors.yaml");
 }
 
 std::string error_of(const std::string& text) {
@@ -27,12 +32,7 @@ std::string error_of(const std::string& text) {
   return "";
 }
 
-std::string emit(const SensorParams& p) {
-  YAML::Emitter out;
-  emit_sensor_params(out, p);
-  EXPECT_TRUE(out.good()) << out.GetLastError();
-  return out.c_str();
-}
+std::string emit(const SensorParams& p) { return to_yaml(write_sensor_params(p)); }
 
 }  // namespace
 
@@ -76,13 +76,13 @@ TEST(SensorParams, EmitThenParseGivesBackTheSameParams) {
   p.sample_delay.enabled = true;
   p.sample_delay.delay_s = 0.015;
   const std::string text = emit(p);
-  const SensorParams q = parse_sensor_params(YAML::Load(text), ideal_sensor(), "");
+  const SensorParams q = parse_block(text, ideal_sensor(), "");
   EXPECT_TRUE(q == p) << text;
   // the emitted block holds every effect and its enabled flag explicitly
   const YAML::Node n = YAML::Load(text);
   for (const auto& id : effect_ids()) EXPECT_TRUE(n["effects"][id]["enabled"]) << id;
   // and ideal round-trips as well
-  EXPECT_TRUE(parse_sensor_params(YAML::Load(emit(ideal_sensor())), mpu6050_defaults(), "") ==
+  EXPECT_TRUE(parse_block(emit(ideal_sensor()), mpu6050_defaults(), "") ==
               ideal_sensor());
 }
 
@@ -155,14 +155,14 @@ TEST(SensorParams, ErrorsNameFileLineAndKey) {
   e = error_of("effects:\n  bias_instability:\n    sigma_rad: 0.1\n");
   EXPECT_NE(e.find("sensors.yaml:3:"), std::string::npos) << e;
   EXPECT_NE(e.find("effects.bias_instability.sigma_rad"), std::string::npos) << e;
-  EXPECT_NE(e.find("inconsistent unit 'rad'"), std::string::npos) << e;
+  EXPECT_NE(e.find("inconsistent units: 'sigma_rad' is in rad"), std::string::npos) << e;
   EXPECT_NE(e.find("sigma_dps"), std::string::npos) << e;
   // a rate where a density is expected
   e = error_of("effects: {white_noise: {density_dps: 0.1}}");
-  EXPECT_NE(e.find("inconsistent unit 'dps'"), std::string::npos) << e;
+  EXPECT_NE(e.find("inconsistent units: 'density_dps' is in deg/s"), std::string::npos) << e;
   // unknown key: lists the valid keys
   e = error_of("effects: {white_noise: {sigma: 0.1}}");
-  EXPECT_NE(e.find("unknown key; valid keys: enabled, density_dps_rthz"), std::string::npos) << e;
+  EXPECT_NE(e.find("unknown key (allowed here: enabled, density_dps_rthz)"), std::string::npos) << e;
   // bad value types
   EXPECT_NE(error_of("effects: {white_noise: {enabled: maybe}}").find("expected true or false"),
             std::string::npos);

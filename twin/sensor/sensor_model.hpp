@@ -11,14 +11,10 @@
 
 #include <Eigen/Core>
 
+#include "estimator/fields.hpp"
 #include "estimator/mpu6050.hpp"
-
 #include "estimator/random.hpp"
 
-namespace YAML {
-class Node;
-class Emitter;
-}  // namespace YAML
 
 namespace driftless::twin {
 
@@ -253,11 +249,12 @@ SensorParams ideal_sensor();
 /// A preset by name ("mpu6050", "ideal"); throws std::invalid_argument listing the valid names.
 SensorParams sensor_preset(std::string_view name);
 
-/// Reads a `{preset: NAME, effects: {<id>: {enabled: bool, <key_unit>: ...}}}` block over `base`.
-SensorParams parse_sensor_params(const YAML::Node& node, const SensorParams& base,
-                                 const std::string& file);
-/// Writes every parameter explicitly as a YAML map (parse of the result gives back `p`).
-void emit_sensor_params(YAML::Emitter& out, const SensorParams& p);
+/// Reads a `{preset: NAME, effects: {<id>: {enabled: bool, <key_unit>: ...}}}` block over `base`
+/// (a key in another unit of the same quantity is converted: `sigma_dph`). `ctx` names the file
+/// and the block's dotted path in errors (InputError).
+SensorParams read_sensor_params(const fields::Node& node, const SensorParams& base, const fields::Context& ctx);
+/// Every parameter explicitly, as a map (read_sensor_params of the result gives back `p`).
+fields::Node write_sensor_params(const SensorParams& p);
 
 // ---- building blocks the model uses, public for tests, compare and diagnosis ----
 

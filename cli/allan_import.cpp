@@ -1,0 +1,184 @@
+// `driftless allan` on recordings the importers read: into memory, or streamed into octave
+// accumulators with the channels shared between two threads.
+#include <algorithm>
+#include <functional>
+#include <thread>
+
+#include <fmt/core.h>
+
+#include "cli/allan_input.hpp"
+#include "estimator/allan_stream.hpp"
+
+namespace driftless::cli::allan {
+namespace {
+
+constexpr std::size_t kBlockRows = 1u << 20;
+
+std::string loc_word(const importers::ImuReader& r) {
+  return r.info().format == importers::Format::kBag ? "message" : r.info().format == importers::Format::kNpy ? "row" : "line";
+}
+
+// rows of a block that start a new gap-free piece (a gap in the stamps before them)
+std::vector<std::size_t> gap_rows(const importers::ImuBlock& b, importers::StampMonitor& mon, bool have_time, bool ignore) {
+  std::vector<std::size_t> out;
+  if (!have_time) return out;
+  for (std::size_t r = 0; r < b.rows(); ++r) {
+    if (mon.push(b.t_s[r], b.loc[r]) == importers::StampMonitor::Step::kGap && !ignore) out.push_back(r);
+  }
+  return out;
+}
+
+Loaded start_meta(const importers::ImuReader& r) {
+  Loaded out;
+  out.format = importers::to_string(r.info().format);
+  out.notes = r.info().assumptions;
+  for (const auto& ch : r.info().channels) {
+    if (ch.quantity == importers::Quantity::kTemperature) {
+      out.notes.push_back("column '" + ch.name + "' (temperature) is not analysed");
+      continue;
+    }
+    out.channels.push_back({ch.name, ch.quantity, ch.axis, {}, {0}});
+  }
+  return out;
+}
+
+// channel index in the reader -> index in Loaded::channels (-1: not analysed)
+std::vector<int> channel_map(const importers::ImuReader& r) {
+  std::vector<int> map;
+  int k = 0;
+  for (const auto& ch : r.info().channels) map.push_back(ch.quantity == importers::Quantity::kTemperature ? -1 : k++);
+  return map;
+}
+
+void finish_meta(Loaded& m, const InputArgs& a, const importers::ImuReader& r, importers::StampMonitor& mon,
+                 std::size_t nan_rows) {
+  m.stamps = mon.report();
+  if (nan_rows > 0) {
+    m.notes.push_back(fmt::format("{} missing values (empty or nan) left out{}", nan_rows,
+                                  a.gaps_ignore ? "" : ", each a segment break"));
+  }
+  add_stamp_notes(m.stamps, loc_word(r), a.gaps_ignore, m.notes);
+  m.rate_hz = resolve_rate(a.rate_hz, r.info().nominal_rate_hz, m.stamps, m.notes, a.source());
+}
+
+}  // namespace
+
+Loaded load_imported(const InputArgs& a) {
+  auto reader = importers::open_imu(a.source(), a.import_options());
+  Loaded out = start_meta(*reader);
+  const auto map = channel_map(*reader);
+  importers::StampMonitor mon;
+  importers::ImuBlock b;
+  bool first = true;
+  std::size_t nan_rows = 0;
+  std::vector<bool> pending(out.channels.size(), false);
+  while (reader->read(b, kBlockRows)) {
+    if (first && reader->info().has_time) mon.learn(b.t_s);
+    first = false;
+    const auto gaps = gap_rows(b, mon, reader->info().has_time, a.gaps_ignore);
+    for (std::size_t c = 0; c < map.size(); ++c) {
+      if (map[c] < 0) continue;
+      Channel& ch = out.channels[static_cast<std::size_t>(map[c])];
+      bool brk = pending[static_cast<std::size_t>(map[c])];
+      std::size_t g = 0;
+      for (std::size_t r = 0; r < b.rows(); ++r) {
+        while (g < gaps.size() && gaps[g] < r) ++g;
+        brk = brk || (g < gaps.size() && gaps[g] == r);
+        const double v = b.values[c][r];
+        if (!std::isfinite(v)) {
+          ++nan_rows;
+          brk = brk || !a.gaps_ignore;
+          continue;
+        }
+        if (brk && !ch.x.empty() && ch.segment_starts.back() != ch.x.size()) ch.segment_starts.push_back(ch.x.size());
+        brk = false;
+        ch.x.push_back(v);
+      }
+      pending[static_cast<std::size_t>(map[c])] = brk;
+    }
+  }
+  finish_meta(out, a, *reader, mon, nan_rows);
+  return out;
+}
+
+namespace {
+
+// one channel's accumulators (one per deviation), fed the finite runs between breaks
+struct ChannelSink {
+  std::vector<est::StreamingOctaveDeviation> acc;
+  bool pending_break = false;
+  std::size_t nan = 0;
+  void feed(const std::vector<double>& v, const std::vector<std::size_t>& gaps, bool ignore) {
+    std::size_t begin = 0, g = 0;
+    auto flush = [&](std::size_t end) {
+      if (end > begin) {
+        for (auto& x : acc) x.push(std::span<const double>(v.data() + begin, end - begin));
+      }
+    };
+    for (std::size_t r = 0; r < v.size(); ++r) {
+      const bool gap = g < gaps.size() && gaps[g] == r;
+      if (gap) ++g;
+      if (gap || pending_break) {
+        flush(r);
+        begin = r;
+        for (auto& x : acc) x.break_segment();
+        pending_break = false;
+      }
+      if (!std::isfinite(v[r])) {
+        flush(r);
+        begin = r + 1;
+        ++nan;
+        pending_break = !ignore;
+      }
+    }
+    flush(v.size());
+  }
+};
+
+}  // namespace
+
+Streamed stream_octaves(const InputArgs& a, const std::vector<est::Deviation>& devs, double confidence,
+                        std::size_t exact_up_to_m) {
+  auto reader = importers::open_imu(a.source(), a.import_options());
+  Streamed out;
+  out.meta = start_meta(*reader);
+  const auto map = channel_map(*reader);
+  std::vector<ChannelSink> sinks(out.meta.channels.size());
+  for (auto& s : sinks) {
+    for (const auto d : devs) {
+      est::StreamingOptions so;
+      so.deviation = d;
+      so.confidence = confidence;
+      so.exact_up_to_m = exact_up_to_m;
+      s.acc.emplace_back(so);
+    }
+  }
+  importers::StampMonitor mon;
+  importers::ImuBlock b;
+  bool first = true;
+  while (reader->read(b, kBlockRows)) {
+    if (first && reader->info().has_time) mon.learn(b.t_s);
+    first = false;
+    const auto gaps = gap_rows(b, mon, reader->info().has_time, a.gaps_ignore);
+    // the channels split between this thread and one more
+    auto work = [&](std::size_t from, std::size_t step) {
+      for (std::size_t c = from; c < map.size(); c += step) {
+        if (map[c] >= 0) sinks[static_cast<std::size_t>(map[c])].feed(b.values[c], gaps, a.gaps_ignore);
+      }
+    };
+    std::thread helper(work, 1, 2);
+    work(0, 2);
+    helper.join();
+  }
+  std::size_t nan = 0;
+  for (const auto& s : sinks) nan += s.nan;
+  finish_meta(out.meta, a, *reader, mon, nan);
+  for (auto& s : sinks) {
+    std::vector<est::AllanCurve> cs;
+    for (const auto& acc : s.acc) cs.push_back(acc.finish(out.meta.rate_hz));
+    out.curves.push_back(std::move(cs));
+  }
+  return out;
+}
+
+}  // namespace driftless::cli::allan

@@ -1,0 +1,174 @@
+#include "cli/allan_input.hpp"
+
+#include <algorithm>
+#include <fstream>
+#include <memory>
+#include <thread>
+
+#include <fmt/core.h>
+
+#include "estimator/allan_stream.hpp"
+#include "estimator/box_geometry.hpp"
+#include "estimator/filter.hpp"
+#include "estimator/log.hpp"
+
+namespace driftless::cli::allan {
+
+std::vector<std::string> split_list(const std::string& s) {
+  std::vector<std::string> out;
+  std::size_t b = 0;
+  while (b <= s.size() && !s.empty()) {
+    const auto e = s.find(',', b);
+    std::string f = s.substr(b, e == std::string::npos ? std::string::npos : e - b);
+    f.erase(0, f.find_first_not_of(" \t"));
+    f.erase(f.find_last_not_of(" \t") + 1);
+    if (!f.empty()) out.push_back(f);
+    if (e == std::string::npos) break;
+    b = e + 1;
+  }
+  return out;
+}
+
+double resolve_rate(double given, double nominal, const importers::StampReport& st, std::vector<std::string>& notes,
+                    const std::string& source) {
+  if (given > 0.0) {
+    notes.push_back(fmt::format("rate {:.6g} Hz from --rate", given));
+    return given;
+  }
+  if (nominal > 0.0) {
+    notes.push_back(fmt::format("rate {:.6g} Hz from the file", nominal));
+    return nominal;
+  }
+  if (st.rows >= 2 && st.bursty && std::isfinite(st.mean_rate_hz())) {
+    notes.push_back(fmt::format("rate {:.6g} Hz = (samples - 1) / time span (bursty stamps)", st.mean_rate_hz()));
+    return st.mean_rate_hz();
+  }
+  if (st.rows >= 2 && st.step_s > 0.0) {
+    notes.push_back(fmt::format("rate {:.6g} Hz from the median stamp step", 1.0 / st.step_s));
+    return 1.0 / st.step_s;
+  }
+  throw std::invalid_argument(source + ": no timestamps and no rate in the file: give --rate HZ");
+}
+
+void add_stamp_notes(const importers::StampReport& st, const std::string& loc_word, bool ignore, std::vector<std::string>& notes) {
+  for (auto& s : st.describe(loc_word)) notes.push_back(s);
+  if (st.gaps > 0) {
+    notes.push_back(ignore ? "--gaps ignore: the samples are taken as contiguous across the gaps"
+                           : "gap-aware: no difference spans a gap (the record is split into segments; --gaps ignore to join)");
+  }
+}
+
+namespace {
+
+// ---- a driftless log: raw channels, and the DriftLess-corrected ones beside them ----
+
+int corrected_slot(const std::string& n) {
+  if (n.size() == 7 && n.rfind("gyro", 0) == 0 && (n[4] == '1' || n[4] == '2') && n[5] == '_' && n[6] >= 'x' && n[6] <= 'z') {
+    return (n[4] - '1') * 3 + (n[6] - 'x');
+  }
+  return -1;
+}
+
+std::unique_ptr<est::DriftlessFilter> make_filter(const InputArgs& a, const log::Metadata& meta) {
+  est::EstimatorConfig cfg;
+  if (!a.config.empty()) {
+    std::ifstream in(a.config);
+    if (!in) throw std::runtime_error("cannot read --config " + a.config);
+    cfg = est::parse_estimator_config(in, a.config);
+  }
+  if (!a.mode.empty()) est::set_config_value(cfg, "mode", a.mode);
+  return std::make_unique<est::DriftlessFilter>(cfg, est::box_geometry_from_metadata(meta));
+}
+
+Loaded load_log(const InputArgs& a) {
+  log::LogReader reader(a.log);
+  Loaded out;
+  out.format = "log";
+  const auto names = split_list(a.columns.empty() ? "gyro1_x,gyro1_y,gyro1_z,gyro2_x,gyro2_y,gyro2_z" : a.columns);
+  std::vector<int> idx;
+  for (const auto& n : names) {
+    const int i = reader.column_index(n);
+    if (i < 0) throw std::invalid_argument(fmt::format("{}: no column '{}' in the log", a.log, n));
+    idx.push_back(i);
+    const bool accel = n.rfind("accel", 0) == 0;
+    out.channels.push_back({n, accel ? importers::Quantity::kAccel : importers::Quantity::kRate, n.back() - 'x', {}, {0}});
+  }
+  std::unique_ptr<est::DriftlessFilter> filter = a.corrected ? make_filter(a, reader.metadata()) : nullptr;
+  std::vector<int> corr_of;
+  for (const auto& n : names) {
+    corr_of.push_back(filter ? corrected_slot(n) : -1);
+    if (corr_of.back() >= 0) out.channels.push_back({"corrected_" + n, importers::Quantity::kRate, n.back() - 'x', {}, {0}});
+  }
+  importers::StampMonitor mon;
+  std::vector<double> first_t;
+  std::size_t skipped = 0;
+  Sample s;
+  bool pending_break = false;
+  while (reader.next(s)) {
+    if (filter) filter->push(s);
+    if (first_t.size() < 4096) {
+      first_t.push_back(s.t_s);
+      if (first_t.size() == 4096) mon.learn(first_t);
+    }
+    bool ok = !filter || s.gyros_finite();
+    for (const int i : idx) ok = ok && std::isfinite(reader.value(i));
+    if (!ok) {
+      ++skipped;
+      pending_break = !a.gaps_ignore;
+      continue;
+    }
+    if (pending_break) {
+      for (auto& c : out.channels) {
+        if (!c.x.empty()) c.segment_starts.push_back(c.x.size());
+      }
+      pending_break = false;
+    }
+    for (std::size_t c = 0; c < idx.size(); ++c) out.channels[c].x.push_back(reader.value(idx[c]));
+    std::size_t extra = idx.size();
+    for (std::size_t c = 0; c < idx.size(); ++c) {
+      if (corr_of[c] < 0) continue;
+      const auto& o = filter->output();
+      out.channels[extra++].x.push_back(corr_of[c] < 3 ? o.y1c_dps[corr_of[c]] : o.y2c_dps[corr_of[c] - 3]);
+    }
+  }
+  if (first_t.size() < 4096) mon.learn(first_t);
+  if (!reader.metadata().complete()) out.notes.push_back("the log says 'complete: false'; using the rows present");
+  if (skipped > 0) out.notes.push_back(fmt::format("{} rows with a missing value were left out (a segment break each)", skipped));
+  if (filter && filter->counters().updates == 0) {
+    out.notes.push_back("--corrected: the filter made no update (no standstill found); corrected = raw");
+  }
+  out.rate_hz = resolve_rate(a.rate_hz, reader.metadata().sample_rate_hz(), mon.report(), out.notes, a.log);
+  return out;
+}
+
+}  // namespace
+
+importers::ImportOptions InputArgs::import_options() const {
+  importers::ImportOptions o = import;
+  o.format = importers::parse_format(csv.empty() ? format : "text");
+  o.columns = split_list(columns);
+  o.accel_columns = split_list(accel_columns);
+  return o;
+}
+
+Loaded load(const InputArgs& a) {
+  if ((a.log.empty() ? 0 : 1) + (a.in.empty() ? 0 : 1) + (a.csv.empty() ? 0 : 1) != 1) {
+    throw std::invalid_argument("give exactly one of --log, --in or --csv");
+  }
+  if (!is_imported(a)) {
+    InputArgs b = a;
+    if (b.log.empty()) b.log = a.in;
+    return load_log(b);
+  }
+  return load_imported(a);
+}
+
+bool is_imported(const InputArgs& a) {
+  if (!a.log.empty()) return false;
+  if (!a.csv.empty()) return true;
+  const auto f = importers::parse_format(a.format);
+  return f != importers::Format::kDriftlessLog &&
+         (f != importers::Format::kAuto || importers::detect_format(a.in) != importers::Format::kDriftlessLog);
+}
+
+}  // namespace driftless::cli::allan

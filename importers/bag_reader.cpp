@@ -1,0 +1,137 @@
+// ROS 1 bags with sensor_msgs/Imu messages, through Debian's librosbag-dev (rosbag_storage).
+// Built only when the configure step found it (DRIFTLESS_HAVE_ROSBAG); docs/import.md, bags.
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "importers/imu_reader.hpp"
+#include "importers/reader_factories.hpp"
+#include "importers/units.hpp"
+
+#ifdef DRIFTLESS_HAVE_ROSBAG
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+#include <sensor_msgs/Imu.h>
+#endif
+
+namespace driftless::importers {
+
+#ifdef DRIFTLESS_HAVE_ROSBAG
+namespace {
+
+constexpr double kDegPerRad = 57.295779513082320876798;
+
+class BagReader : public ImuReader {
+ public:
+  BagReader(const std::filesystem::path& path, const ImportOptions& opt);
+  bool read(ImuBlock& out, std::size_t max_rows) override;
+  std::string where(std::uint64_t loc) const override {
+    return info_.source + ": message " + std::to_string(loc) + " on " + topic_;
+  }
+
+ private:
+  std::string choose_topic(const ImportOptions& opt);
+  rosbag::Bag bag_;
+  std::string topic_;
+  std::unique_ptr<rosbag::View> view_;
+  rosbag::View::iterator it_;
+  std::uint64_t index_ = 0;
+  double rate_scale_ = kDegPerRad;
+  bool receive_time_ = false;
+};
+
+std::string BagReader::choose_topic(const ImportOptions& opt) {
+  rosbag::View all(bag_);
+  std::vector<std::string> imu, every;
+  for (const rosbag::ConnectionInfo* c : all.getConnections()) {
+    every.push_back(c->topic + " (" + c->datatype + ")");
+    if (c->datatype == "sensor_msgs/Imu") imu.push_back(c->topic);
+  }
+  std::string list;
+  for (const auto& t : every) list += (list.empty() ? "" : ", ") + t;
+  if (!opt.topic.empty()) {
+    for (const auto& t : imu) {
+      if (t == opt.topic) return t;
+    }
+    throw ImportError(info_.source + ": --topic " + opt.topic + ": no sensor_msgs/Imu topic of that name (the bag has: " +
+                      (list.empty() ? std::string("no topics") : list) + ")");
+  }
+  if (imu.size() == 1) {
+    info_.assumptions.push_back("topic " + imu[0] + " (the bag's only sensor_msgs/Imu topic)");
+    return imu[0];
+  }
+  throw ImportError(info_.source + (imu.empty() ? ": no sensor_msgs/Imu topic (the bag has: " + list + ")"
+                                                : ": several sensor_msgs/Imu topics: give --topic (the bag has: " + list + ")"));
+}
+
+BagReader::BagReader(const std::filesystem::path& path, const ImportOptions& opt) {
+  info_.source = path.string();
+  info_.format = Format::kBag;
+  try {
+    bag_.open(path.string(), rosbag::bagmode::Read);
+  } catch (const std::exception& e) {
+    throw ImportError(info_.source + ": not a readable ROS 1 bag (" + e.what() + ")");
+  }
+  topic_ = choose_topic(opt);
+  view_ = std::make_unique<rosbag::View>(bag_, rosbag::TopicQuery(topic_));
+  it_ = view_->begin();
+  info_.has_time = true;
+  if (!opt.units.empty()) {
+    rate_scale_ = parse_rate_unit(opt.units, "--units").scale;
+    info_.assumptions.push_back("angular_velocity in " + opt.units + " (as given; sensor_msgs/Imu defines rad/s)");
+  } else {
+    info_.assumptions.push_back("angular_velocity in rad/s, linear_acceleration in m/s^2 (sensor_msgs/Imu)");
+  }
+  for (int k = 0; k < 3; ++k) info_.channels.push_back({std::string("angular_velocity.") + "xyz"[k], Quantity::kRate, k});
+  for (int k = 0; k < 3; ++k) info_.channels.push_back({std::string("linear_acceleration.") + "xyz"[k], Quantity::kAccel, k});
+}
+
+bool BagReader::read(ImuBlock& out, std::size_t max_rows) {
+  out.clear();
+  out.values.resize(6);
+  try {
+    for (; it_ != view_->end() && out.rows() < max_rows; ++it_) {
+      ++index_;
+      const auto m = it_->instantiate<sensor_msgs::Imu>();
+      if (!m) throw ImportError(where(index_) + ": not a sensor_msgs/Imu message");
+      if (index_ == 1 && m->header.stamp.isZero()) {
+        receive_time_ = true;
+        info_.assumptions.push_back("header stamps are zero: the bag's receive times are used");
+      }
+      out.t_s.push_back(receive_time_ ? it_->getTime().toSec() : m->header.stamp.toSec());
+      const double w[3] = {m->angular_velocity.x, m->angular_velocity.y, m->angular_velocity.z};
+      const double a[3] = {m->linear_acceleration.x, m->linear_acceleration.y, m->linear_acceleration.z};
+      for (int k = 0; k < 3; ++k) {
+        out.values[static_cast<std::size_t>(k)].push_back(w[k] * rate_scale_);
+        out.values[static_cast<std::size_t>(3 + k)].push_back(a[k]);
+      }
+      out.loc.push_back(index_);
+    }
+  } catch (const ImportError&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw ImportError(where(index_) + ": cannot read (" + e.what() + ")");
+  }
+  return out.rows() > 0;
+}
+
+}  // namespace
+
+bool bag_support() { return true; }
+
+std::unique_ptr<ImuReader> make_bag_reader(const std::filesystem::path& path, const ImportOptions& opt) {
+  return std::make_unique<BagReader>(path, opt);
+}
+
+#else
+
+bool bag_support() { return false; }
+
+std::unique_ptr<ImuReader> make_bag_reader(const std::filesystem::path& path, const ImportOptions&) {
+  throw ImportError(path.string() + ": this build reads no ROS bags: install librosbag-dev (scripts/setup.sh does) "
+                    "and configure again");
+}
+
+#endif
+
+}  // namespace driftless::importers

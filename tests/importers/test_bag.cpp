@@ -1,0 +1,116 @@
+// ROS 1 bags: written in the test with librosbag from the real recording, read back through the
+// importer; topic choice, receive times, and files that are no bag. C++17 (ROS 1 headers).
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "import_fixture.hpp"
+
+#ifdef DRIFTLESS_HAVE_ROSBAG
+#include <rosbag/bag.h>
+#include <sensor_msgs/Imu.h>
+#endif
+
+namespace driftless::importers::test {
+namespace {
+
+constexpr double kDegPerRad = 57.295779513082320876798;
+constexpr double kG = 9.80665;
+
+#ifdef DRIFTLESS_HAVE_ROSBAG
+
+sensor_msgs::Imu message(const std::vector<double>& r, double t_s, bool zero_stamp) {
+  sensor_msgs::Imu m;
+  m.header.stamp = zero_stamp ? ros::Time() : ros::Time(1000.0 + t_s);
+  m.header.frame_id = "imu";
+  m.angular_velocity.x = r[4] / kDegPerRad;
+  m.angular_velocity.y = r[5] / kDegPerRad;
+  m.angular_velocity.z = r[6] / kDegPerRad;
+  m.linear_acceleration.x = r[1] * kG;
+  m.linear_acceleration.y = r[2] * kG;
+  m.linear_acceleration.z = r[3] * kG;
+  return m;
+}
+
+TEST(BagImport, RealRecordingWrittenAsImuMessagesReadsBack) {
+  DRIFTLESS_NEED_REALDATA();
+  ASSERT_TRUE(bag_support());
+  // GIVEN the sunsided recording as sensor_msgs/Imu on /imu0, plus a camera-info-like other topic
+  const Csv csv = plain_csv(sunsided_10min());
+  const auto dir = scratch("bag");
+  {
+    rosbag::Bag bag((dir / "imu.bag").string(), rosbag::bagmode::Write);
+    for (const auto& r : csv.rows) bag.write("/imu0", ros::Time(1000.0 + r[0]), message(r, r[0], false));
+  }
+  // WHEN it is opened with detection
+  auto rd = open_imu(dir / "imu.bag", {});
+  const Table t = read_all(*rd, 10000);
+  // THEN the only Imu topic is taken, rates come back in deg/s, stamps from the headers
+  EXPECT_EQ(rd->info().format, Format::kBag);
+  ASSERT_EQ(t.t.size(), csv.rows.size());
+  for (std::size_t i = 0; i < csv.rows.size(); i += 1013) {
+    EXPECT_NEAR(t.t[i], 1000.0 + csv.rows[i][0], 1e-6);
+    EXPECT_NEAR(t.ch[0][i], csv.rows[i][4], 1e-12);
+    EXPECT_NEAR(t.ch[5][i], csv.rows[i][3] * kG, 1e-12);
+    EXPECT_EQ(t.loc[i], i + 1);
+  }
+}
+
+TEST(BagImport, TopicsAreChosenOrListed) {
+  const auto dir = scratch("bag_topics");
+  std::vector<double> r = {0, 0, 0, 1, 0.1, 0.2, 0.3, 25};
+  {
+    rosbag::Bag bag((dir / "two.bag").string(), rosbag::bagmode::Write);
+    for (int i = 0; i < 50; ++i) {
+      bag.write("/imu0", ros::Time(10.0 + 0.01 * i), message(r, 0.01 * i, false));
+      bag.write("/imu1", ros::Time(10.0 + 0.01 * i), message(r, 0.01 * i, true));
+    }
+  }
+  // two Imu topics: refused with both named
+  try {
+    open_imu(dir / "two.bag", {});
+    FAIL();
+  } catch (const ImportError& e) {
+    EXPECT_NE(std::string(e.what()).find("/imu0 (sensor_msgs/Imu)"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("give --topic"), std::string::npos);
+  }
+  // --topic picks one; zero header stamps fall back to the receive times, and say so
+  ImportOptions o;
+  o.topic = "/imu1";
+  auto rd = open_imu(dir / "two.bag", o);
+  const Table t = read_all(*rd);
+  ASSERT_EQ(t.t.size(), 50u);
+  EXPECT_NEAR(t.t[3], 10.03, 1e-9);
+  bool said = false;
+  for (const auto& a : rd->info().assumptions) said = said || a.find("receive times") != std::string::npos;
+  EXPECT_TRUE(said);
+  o.topic = "/camera";
+  EXPECT_THROW(open_imu(dir / "two.bag", o), ImportError);
+  // a file that only claims to be a bag
+  write_text(dir / "fake.bag", "#ROSBAG V2.0\nnot really");
+  try {
+    open_imu(dir / "fake.bag", {});
+    FAIL();
+  } catch (const ImportError& e) {
+    EXPECT_NE(std::string(e.what()).find("fake.bag: not a readable ROS 1 bag"), std::string::npos) << e.what();
+  }
+}
+
+#else
+
+TEST(BagImport, BuildWithoutRosbagSaysSo) {
+  const auto dir = scratch("nobag");
+  write_text(dir / "x.bag", "#ROSBAG V2.0\n");
+  EXPECT_FALSE(bag_support());
+  try {
+    open_imu(dir / "x.bag", {});
+    FAIL();
+  } catch (const ImportError& e) {
+    EXPECT_NE(std::string(e.what()).find("librosbag-dev"), std::string::npos);
+  }
+}
+
+#endif
+
+}  // namespace
+}  // namespace driftless::importers::test

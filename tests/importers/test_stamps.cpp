@@ -1,0 +1,54 @@
+// Stamps made by others: a regular step with gaps, stamps that go backwards or repeat, and bursty
+// arrival stamps (the real sunsided recording).
+#include <gtest/gtest.h>
+
+#include "import_fixture.hpp"
+#include "importers/stamps.hpp"
+
+namespace driftless::importers::test {
+namespace {
+
+TEST(Stamps, GapsBackwardsAndRepeatsAreCountedWithTheirPlace) {
+  // GIVEN 100 Hz stamps with 5 samples missing after row 50, one stamp going back, one repeated
+  std::vector<double> t;
+  for (int i = 0; i < 200; ++i) t.push_back(0.01 * (i < 50 ? i : i + 5));
+  t[120] = t[119] - 0.003;
+  t[150] = t[149];
+  StampMonitor m;
+  m.learn(t);
+  for (std::size_t i = 0; i < t.size(); ++i) m.push(t[i], i + 1);
+  const auto& r = m.report();
+  // THEN the gap of five samples at row 51, one backwards at 121, one repeat at 151; the stamps
+  // after those two jump 2.3 and 2 steps forward again (one sample each as the monitor counts)
+  EXPECT_NEAR(r.step_s, 0.01, 1e-12);
+  EXPECT_FALSE(r.bursty);
+  EXPECT_EQ(r.gaps, 3u);
+  EXPECT_EQ(r.first_gap_loc, 51u);
+  EXPECT_EQ(r.missing, 7u);
+  EXPECT_EQ(r.backwards, 1u);
+  EXPECT_EQ(r.first_backwards_loc, 121u);
+  EXPECT_EQ(r.repeated, 1u);
+  EXPECT_EQ(r.first_repeated_loc, 151u);
+  const auto text = r.describe("line");
+  ASSERT_GE(text.size(), 3u);
+  EXPECT_NE(text[0].find("the first at line 51"), std::string::npos) << text[0];
+}
+
+TEST(Stamps, RealBurstyArrivalStampsAreNotGaps) {
+  DRIFTLESS_NEED_REALDATA();
+  const Csv csv = plain_csv(sunsided_10min());
+  std::vector<double> t;
+  for (const auto& r : csv.rows) t.push_back(r[0]);
+  StampMonitor m;
+  m.learn(std::span<const double>(t.data(), 4096));
+  for (std::size_t i = 0; i < t.size(); ++i) m.push(t[i], i + 2);
+  const auto& r = m.report();
+  // THEN bursty (median 2 ms against a mean of ~10 ms), no gaps, the mean rate ~99.3 Hz (README)
+  EXPECT_TRUE(r.bursty);
+  EXPECT_EQ(r.gaps, 0u);
+  EXPECT_NEAR(r.mean_rate_hz(), 99.3, 0.3);
+  EXPECT_GT(r.largest_step_s, 0.3);
+}
+
+}  // namespace
+}  // namespace driftless::importers::test

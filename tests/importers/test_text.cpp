@@ -1,0 +1,180 @@
+// Delimited text: the real recordings of both folders, headers or none, separators, units and time
+// bases detected, columns by name or index, and bad files named by file:line.
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "import_fixture.hpp"
+
+namespace driftless::importers::test {
+namespace {
+
+constexpr double kDegPerRad = 57.295779513082320876798;
+constexpr double kG = 9.80665;
+
+bool says(const ImuReader& r, const std::string& what) {
+  for (const auto& a : r.info().assumptions) {
+    if (a.find(what) != std::string::npos) return true;
+  }
+  return false;
+}
+
+int channel(const ImuReader& r, const std::string& name) {
+  for (std::size_t c = 0; c < r.info().channels.size(); ++c) {
+    if (r.info().channels[c].name == name) return static_cast<int>(c);
+  }
+  return -1;
+}
+
+TEST(TextImport, SunsidedRecordingIsReadWithItsHeaderUnitsAndTime) {
+  DRIFTLESS_NEED_REALDATA();
+  // GIVEN the real 10-min MPU6050 recording (header sec,acc_*,gyro_*,temp; deg/s and g)
+  const Csv csv = plain_csv(sunsided_10min());
+  // WHEN it is opened with everything detected
+  auto r = open_imu(sunsided_10min(), {});
+  const Table t = read_all(*r, 4096);
+  // THEN it is text with time, three gyro, three accel and one temperature channel
+  EXPECT_EQ(r->info().format, Format::kText);
+  EXPECT_TRUE(r->info().has_time);
+  ASSERT_EQ(t.t.size(), csv.rows.size());
+  const int gx = channel(*r, "gyro_x"), az = channel(*r, "acc_z"), temp = channel(*r, "temp");
+  ASSERT_GE(gx, 0);
+  ASSERT_GE(az, 0);
+  ASSERT_GE(temp, 0);
+  EXPECT_EQ(r->info().channels[static_cast<std::size_t>(temp)].quantity, Quantity::kTemperature);
+  EXPECT_TRUE(says(*r, "rates in deg/s"));
+  EXPECT_TRUE(says(*r, "accelerations in g"));
+  for (std::size_t i = 0; i < csv.rows.size(); i += 997) {
+    EXPECT_DOUBLE_EQ(t.t[i], csv.rows[i][0]);
+    EXPECT_DOUBLE_EQ(t.ch[static_cast<std::size_t>(gx)][i], csv.rows[i][4]);
+    EXPECT_NEAR(t.ch[static_cast<std::size_t>(az)][i], csv.rows[i][3] * kG, 1e-12);
+    EXPECT_EQ(t.loc[i], i + 2);  // line numbers: the header is line 1
+  }
+}
+
+TEST(TextImport, TomisuarezRawCountsWithRatePreambleAreDetected) {
+  DRIFTLESS_NEED_REALDATA();
+  // GIVEN 'Fs,100', settings lines, a header ax..gz and raw counts (131 LSB per deg/s)
+  auto r = open_imu(tomisuarez_static(), {});
+  const Table t = read_all(*r);
+  // THEN the rate comes from the preamble, the counts are scaled, and there is no time column
+  EXPECT_DOUBLE_EQ(r->info().nominal_rate_hz, 100.0);
+  EXPECT_FALSE(r->info().has_time);
+  EXPECT_TRUE(says(*r, "131 LSB per deg/s"));
+  const int gx = channel(*r, "gx");
+  ASSERT_GE(gx, 0);
+  EXPECT_DOUBLE_EQ(t.ch[static_cast<std::size_t>(gx)][0], -480.0 / 131.0);  // the first data row's gx
+  EXPECT_EQ(t.loc[0], 6u);
+  // the static bias about -3.34 deg/s (the folder's README)
+  double mean = 0.0;
+  for (double v : t.ch[static_cast<std::size_t>(gx)]) mean += v;
+  EXPECT_NEAR(mean / static_cast<double>(t.t.size()), -3.34, 0.1);
+}
+
+TEST(TextImport, HeaderlessBlankSeparatedSiFileTakesTimeGyroAccel) {
+  DRIFTLESS_NEED_REALDATA();
+  // GIVEN the real data rewritten as "time wx wy wz ax ay az", blank-separated, rad/s and m/s^2
+  const Csv csv = plain_csv(sunsided_10min());
+  const auto dir = scratch("headerless");
+  std::string s;
+  for (std::size_t i = 0; i < 2000; ++i) {
+    const auto& r = csv.rows[i];
+    s += std::to_string(r[0]) + "  " + std::to_string(r[4] / kDegPerRad) + " " + std::to_string(r[5] / kDegPerRad) + "\t" +
+         std::to_string(r[6] / kDegPerRad) + " " + std::to_string(r[1] * kG) + " " + std::to_string(r[2] * kG) + " " +
+         std::to_string(r[3] * kG) + "\n";
+  }
+  write_text(dir / "imu.txt", s);
+  auto r = open_imu(dir / "imu.txt", {});
+  const Table t = read_all(*r);
+  // THEN column 1 is time, 2-4 gyro in rad/s (an SI file: the accelerometer reads g in m/s^2)
+  EXPECT_TRUE(says(*r, "no header"));
+  EXPECT_TRUE(says(*r, "SI file"));
+  ASSERT_EQ(r->info().channels.size(), 6u);
+  EXPECT_EQ(r->info().channels[0].quantity, Quantity::kRate);
+  EXPECT_EQ(r->info().channels[3].quantity, Quantity::kAccel);
+  EXPECT_NEAR(t.ch[0][10], csv.rows[10][4], 1e-4);  // deg/s again (6 printed digits)
+}
+
+TEST(TextImport, AccelerometerFirstIsRecognisedByGravity) {
+  // GIVEN "t ax ay az gx gy gz" without header, accel in m/s^2 reading gravity on z
+  const auto dir = scratch("accel_first");
+  std::string s;
+  for (int i = 0; i < 300; ++i) {
+    s += std::to_string(0.01 * i) + " 0.01 -0.02 9.81 " + std::to_string(0.001 * (i % 7)) + " 0.002 -0.001\n";
+  }
+  write_text(dir / "imu.txt", s);
+  auto r = open_imu(dir / "imu.txt", {});
+  // THEN the first triad is taken as the accelerometer and the reader says so
+  EXPECT_TRUE(says(*r, "accelerometer first"));
+  EXPECT_EQ(r->info().channels[0].quantity, Quantity::kAccel);
+  EXPECT_EQ(r->info().channels[3].quantity, Quantity::kRate);
+}
+
+TEST(TextImport, ColumnsByIndexSeparatorAndTimeUnitsFromTheStep) {
+  // GIVEN ';'-separated rows with millisecond stamps and no header
+  const auto dir = scratch("ms");
+  std::string s;
+  for (int i = 0; i < 500; ++i) s += std::to_string(1000 + 10 * i) + ";1.5;" + std::to_string(i) + ";0.25\n";
+  write_text(dir / "a.csv", s);
+  ImportOptions o;
+  o.columns = {"2", "4"};
+  o.time_column = "1";
+  auto r = open_imu(dir / "a.csv", o);
+  const Table t = read_all(*r);
+  // THEN the step of 10 is read as milliseconds (100 Hz), and only columns 2 and 4 are channels
+  EXPECT_TRUE(says(*r, "time in ms"));
+  ASSERT_EQ(t.ch.size(), 2u);
+  EXPECT_NEAR(t.t[1] - t.t[0], 0.01, 1e-12);
+  EXPECT_DOUBLE_EQ(t.ch[1][3], 0.25);
+  // and nanosecond stamps (EuRoC-like epoch values) are read as such when the name says so
+  std::string n = "time_ns,gx,gy,gz\n";
+  for (int i = 0; i < 100; ++i) n += std::to_string(1403636579758555392LL + 5000000LL * i) + ",0,0,0\n";
+  write_text(dir / "b.csv", n);
+  auto rb = open_imu(dir / "b.csv", {});
+  const Table tb = read_all(*rb);
+  EXPECT_NEAR(tb.t[1] - tb.t[0], 0.005, 1e-6);
+}
+
+TEST(TextImport, MissingValuesAreNaNAndBadRowsNameFileAndLine) {
+  const auto dir = scratch("bad");
+  write_text(dir / "ok.csv", "t,gx,gy,gz\n0,1,2,3\n0.01,,2,3\n0.02,nan,2,3\n0.03,1,2,3\n0.04,1,2,3\n0.05,1,2,3\n0.06,1,2,3\n");
+  auto r = open_imu(dir / "ok.csv", {});
+  const Table t = read_all(*r);
+  EXPECT_TRUE(std::isnan(t.ch[0][1]));
+  EXPECT_TRUE(std::isnan(t.ch[0][2]));
+  // a junk value in a used column
+  write_text(dir / "junk.csv", "t,gx,gy,gz\n0,1,2,3\n0.01,1,2,3\n0.02,1,2,3\n0.03,1,2,3\n0.04,1,2,3\n0.05,1,abc,3\n");
+  try {
+    auto j = open_imu(dir / "junk.csv", {});
+    read_all(*j);
+    FAIL() << "junk accepted";
+  } catch (const ImportError& e) {
+    EXPECT_NE(std::string(e.what()).find("junk.csv:7: column 'gy' (3): expected a number, got 'abc'"), std::string::npos) << e.what();
+  }
+  // a row with fewer fields
+  write_text(dir / "short.csv", "t,gx,gy,gz\n0,1,2,3\n0.01,1,2,3\n0.02,1,2,3\n0.03,1,2,3\n0.04,1,2,3\n0.05,1,2\n");
+  try {
+    auto j = open_imu(dir / "short.csv", {});
+    read_all(*j);
+    FAIL() << "short row accepted";
+  } catch (const ImportError& e) {
+    EXPECT_NE(std::string(e.what()).find("short.csv:7: expected 4 fields as in line 2, got 3"), std::string::npos) << e.what();
+  }
+  // no numbers at all, an unknown column, an index out of range
+  write_text(dir / "words.csv", "hello\nworld\n");
+  EXPECT_THROW(open_imu(dir / "words.csv", {}), ImportError);
+  ImportOptions o;
+  o.columns = {"omega"};
+  try {
+    open_imu(dir / "ok.csv", o);
+    FAIL();
+  } catch (const ImportError& e) {
+    EXPECT_NE(std::string(e.what()).find("the header has: t, gx, gy, gz"), std::string::npos) << e.what();
+  }
+  o.columns = {"9"};
+  EXPECT_THROW(open_imu(dir / "ok.csv", o), ImportError);
+  EXPECT_THROW(open_imu(dir / "absent.csv", {}), ImportError);
+}
+
+}  // namespace
+}  // namespace driftless::importers::test
