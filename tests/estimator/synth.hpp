@@ -37,6 +37,8 @@ struct SynthParams {
   Eigen::Vector3d b2_extra_at_negative_plat2_dps = Eigen::Vector3d::Zero();
   // box rate relative to ENU in box axes (zero if empty); the sensors also see the Earth rate
   std::function<Eigen::Vector3d(double)> body_rate_dps;
+  // extra noise per sample (deg/s, sensor axes) from outside, e.g. a real recording's: (sensor 1|2, index)
+  std::function<Eigen::Vector3d(int, std::size_t)> extra_noise_dps;
   bool earth_rate = true;
   double latitude_deg = 52.0;
   std::uint64_t seed = 1;
@@ -126,6 +128,10 @@ inline void synth_samples(const SynthParams& p, const std::function<void(const S
         s.gyro1_dps[i] += p.noise_sigma_dps * g(rng);
         s.gyro2_dps[i] += p.noise_sigma_dps * g(rng);
       }
+    }
+    if (p.extra_noise_dps) {
+      s.gyro1_dps += p.extra_noise_dps(1, k);
+      s.gyro2_dps += p.extra_noise_dps(2, k);
     }
     const bool hide = p.nan_while_moving && moving;
     s.plat1_deg = hide && w1 != 0.0 ? kNaN : t1;
