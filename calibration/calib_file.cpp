@@ -8,6 +8,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "calibration/yaml_io.hpp"
+#include "estimator/output_file.hpp"
 
 namespace driftless::calib {
 namespace {
@@ -133,10 +134,7 @@ void save_calib(const std::filesystem::path& path, const est::CalibFit& fit,
     out << YAML::EndMap;
   }
   out << YAML::EndMap;
-  std::ofstream file(path);
-  if (!file) throw std::runtime_error("cannot write " + path.string());
-  file << out.c_str() << "\n";
-  if (!file) throw std::runtime_error("cannot write " + path.string());
+  io::write_file(path, std::string(out.c_str()) + "\n");
 }
 
 CalibFile load_calib(const std::filesystem::path& path) {

@@ -12,6 +12,7 @@
 
 #include "calibration/yaml_io.hpp"
 #include "estimator/geometry.hpp"
+#include "estimator/output_file.hpp"
 
 namespace driftless::calib {
 namespace {
@@ -224,10 +225,7 @@ void save_rig_plan(const std::filesystem::path& path, const RigPlan& plan) {
     out << YAML::EndMap;
   }
   out << YAML::EndSeq << YAML::EndMap;
-  std::ofstream f(path);
-  if (!f) throw std::runtime_error("cannot write rig plan " + path.string());
-  f << out.c_str() << "\n";
-  if (!f) throw std::runtime_error("cannot write rig plan " + path.string());
+  io::write_file(path, std::string(out.c_str()) + "\n");
 }
 
 namespace {

@@ -3,12 +3,12 @@
 // the inflation factor stated (docs/allan.md, exports).
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <stdexcept>
 
 #include <fmt/core.h>
 
 #include "cli/allan_result.hpp"
+#include "estimator/output_file.hpp"
 
 namespace driftless::cli::allan {
 namespace {
@@ -78,9 +78,7 @@ std::string kalibr_body(const Result& r, const Noise& n, const ExportOptions& o,
 }
 
 void write(const std::filesystem::path& p, const std::string& s, std::vector<std::filesystem::path>& written) {
-  std::ofstream f(p);
-  f << s;
-  if (!f) throw std::runtime_error(p.string() + ": write failed");
+  io::write_file(p, s);
   written.push_back(p);
 }
 

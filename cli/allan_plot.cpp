@@ -6,10 +6,10 @@
 #include <cmath>
 
 #include <fmt/core.h>
-#include <fmt/os.h>
 
 #include "cli/allan_result.hpp"
 #include "report/gnuplot.hpp"
+#include "report/text_file.hpp"
 
 namespace driftless::cli::allan {
 namespace {
@@ -38,7 +38,7 @@ std::string cell(double v) { return std::isfinite(v) && v > 0.0 ? fmt::format("{
 void write_model(const std::filesystem::path& p, const ChannelResult& c, const Datasheet& ds) {
   const auto& m = c.fit.model();
   const double lo = c.fit_curve.points.front().tau_s, hi = c.fit_curve.points.back().tau_s;
-  auto o = fmt::output_file(p.string());
+  report::TextFile o(p);
   o.print("tau_s,model,Q,N,B,K,R,GM,Q_region,N_region,B_region,K_region,R_region,GM_region,ds_N,ds_B,ds_K\n");
   const int steps = 40 * static_cast<int>(std::ceil(std::log10(hi / lo))) + 1;
   for (int i = 0; i <= steps; ++i) {
@@ -54,10 +54,11 @@ void write_model(const std::filesystem::path& p, const ChannelResult& c, const D
     const double dsN = ds.N > 0 ? ds.N / std::sqrt(tau) : 0.0, dsK = ds.K > 0 ? ds.K * std::sqrt(tau / 3.0) : 0.0;
     o.print("{}{},{},{},{}\n", row, region, cell(dsN), cell(ds.B), cell(dsK));
   }
+  o.commit();
 }
 
 void write_points(const std::filesystem::path& p, const ChannelResult& c) {
-  auto o = fmt::output_file(p.string());
+  report::TextFile o(p);
   o.print("tau_s,adev,lo,hi,band_lo,band_hi\n");
   for (std::size_t i = 0; i < c.fit_curve.points.size(); ++i) {
     const auto& pt = c.fit_curve.points[i];
@@ -69,6 +70,7 @@ void write_points(const std::filesystem::path& p, const ChannelResult& c) {
     }
     o.print("{:.6e},{:.6e},{:.6e},{:.6e},{}\n", pt.tau_s, pt.adev, pt.adev_lo, pt.adev_hi, band);
   }
+  o.commit();
 }
 
 std::string term_label(const ChannelResult& c, est::NoiseTerm t, const char* name) {

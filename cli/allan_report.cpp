@@ -1,15 +1,14 @@
 // `driftless allan` outputs: the tables, allan_fit.json and the console summary (docs/allan.md).
 #include <cmath>
-#include <fstream>
 #include <stdexcept>
 
 #include <fmt/core.h>
-#include <fmt/os.h>
 
 #include "cli/allan_result.hpp"
 #include "estimator/numbers.hpp"
 #include "report/json.hpp"
 #include "report/plot_table.hpp"
+#include "report/text_file.hpp"
 
 namespace driftless::cli::allan {
 namespace {
@@ -114,7 +113,7 @@ void write_tables(const std::filesystem::path& dir, const Result& r) {
     const bool adev = r.deviations[d] == est::Deviation::kAllan;
     write_wide(dir / (adev ? std::string("allan.csv") : std::string(est::to_string(r.deviations[d])) + ".csv"), r, d);
   }
-  auto o = fmt::output_file((dir / "allan_points.csv").string());
+  report::TextFile o(dir / "allan_points.csv");
   o.print("channel,deviation,tau_s,m,value,lo,hi,edf,noise,noise_inherited,phase_scale_m,terms\n");
   for (const auto& ch : r.channels) {
     for (const auto& c : ch.curves) {
@@ -124,6 +123,7 @@ void write_tables(const std::filesystem::path& dir, const Result& r) {
       }
     }
   }
+  o.commit();
 }
 
 void write_fit_json(const std::filesystem::path& dir, const Result& r) {
@@ -140,9 +140,7 @@ void write_fit_json(const std::filesystem::path& dir, const Result& r) {
     s += "    " + str(r.channels[c].name) + ": " + channel_json(r.channels[c]) + (c + 1 < r.channels.size() ? ",\n" : "\n");
   }
   s += "  }\n}\n";
-  std::ofstream out(dir / "allan_fit.json");
-  out << s;
-  if (!out) throw std::runtime_error((dir / "allan_fit.json").string() + ": write failed");
+  io::write_file(dir / "allan_fit.json", s);
 }
 
 void print_summary(const Result& r) {

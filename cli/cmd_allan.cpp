@@ -175,7 +175,7 @@ void add_input_options(CLI::App* cmd, AllanArgs& a) {
   cmd->add_option("--separator", in.import.separator, "Text separator: one character, tab or space (default: detected)");
   cmd->add_flag("--no-header", in.import.no_header, "Text: the first row is data");
   cmd->add_option("--topic", in.import.topic, "Bag: the sensor_msgs/Imu topic (default: the only one)");
-  cmd->add_option("--rate", in.rate_hz, "Sample rate in Hz (overrides the file's and the stamps')")->check(CLI::PositiveNumber);
+  cmd->add_option("--rate", in.rate_hz, "Sample rate in Hz (overrides the file's and the stamps')")->check(positive_number("Hz"));
   cmd->add_option("--gaps", a.gaps, "At gaps in the stamps or missing values: split (gap-aware, default) or ignore")
       ->check(CLI::IsMember({"split", "ignore"}));
 }
@@ -207,7 +207,7 @@ const bool registered = register_command(40, [](CLI::App& app) {
       ->check(CLI::Range(1.0, 1000.0));
   cmd->add_option("--export-topic", a->exports.topic, "rostopic written into the noise files (default /imu0)");
   cmd->add_option("--validate", a->validate, "Simulate N records from the fit with the twin's sensor model; 95 % band and verdict");
-  cmd->add_option("--seed", a->seed, "Seed of --validate (default 1)");
+  cmd->add_option("--seed", a->seed, "Seed of --validate, 0 .. 2^64-1 (default 1)")->check(seed_number());
   cmd->add_flag("--plot", a->plot, "Also write allan.png/svg and allan_<channel>.png/svg with their gnuplot scripts");
   return [a] { return run_allan(*a); };
 });

@@ -9,6 +9,7 @@
 #include <fmt/core.h>
 
 #include "cli/command.hpp"
+#include "estimator/output_file.hpp"
 #include "estimator/calibration.hpp"
 #include "estimator/log.hpp"
 #include "calibration/calib_file.hpp"
@@ -62,9 +63,7 @@ void print_summary(const est::CalibFit& fit, const calib::RigConditions& rig,
 void write_prior(const Options& o) {
   if (o.prior_out.empty()) return;
   const calib::CalibFile c = calib::load_calib(o.out);
-  std::ofstream f(o.prior_out);
-  f << calib::model_prior_yaml(c);
-  if (!f) throw std::runtime_error("cannot write --prior-out " + o.prior_out);
+  io::write_file(o.prior_out, calib::model_prior_yaml(c));
   fmt::print("wrote {} (model prior)\n", o.prior_out);
 }
 
@@ -105,6 +104,11 @@ int run_from_scenario(const Options& o) {
       return !stop_requested().load();
     });
     progress.done();
+  }
+  if (stop_requested().load()) {
+    // interrupted: the rig run is partial, so no fit and no calibration file that would look whole
+    fmt::print(stderr, "driftless calibrate: stopped before the rig run finished; nothing written\n");
+    return interrupted_exit_code();
   }
   if (!o.save_log.empty()) {
     log::LogWriter w(o.save_log, run.meta,
@@ -186,7 +190,7 @@ const bool registered = register_command(40, [](CLI::App& app) {
       throw std::invalid_argument("calibrate: give --scenario FILE, or --log FILE --plan FILE");
     return o->scenario.empty() ? run_from_log(*o) : run_from_scenario(*o);
   };
-});
+}, Interrupt::kPolls);
 
 }  // namespace
 }  // namespace driftless::cli

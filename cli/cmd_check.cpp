@@ -1,4 +1,6 @@
-// driftless check: validate a measurement log and summarise what it holds.
+// driftless check: validate a measurement log (the same validation every reader applies,
+// docs/log-format.md "Validation") and summarise what it holds.
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -11,52 +13,85 @@
 namespace driftless::cli {
 namespace {
 
-int run_check(const std::string& path) {
-  log::LogReader reader(path);
-  Sample s;
+struct Span {
   double t0 = kNaN, t1 = kNaN;
   double min_dt = std::numeric_limits<double>::infinity(), max_dt = 0.0;
-  double prev = kNaN;
-  while (reader.next(s)) {
-    if (std::isnan(t0)) t0 = s.t_s;
-    if (!std::isnan(prev)) {
-      min_dt = std::min(min_dt, s.t_s - prev);
-      max_dt = std::max(max_dt, s.t_s - prev);
-    }
-    prev = t1 = s.t_s;
+};
+
+std::string groups_text(std::uint32_t fields) {
+  static constexpr std::pair<std::uint32_t, const char*> kGroups[] = {
+      {kFieldRefQ, "ref_q"},         {kFieldRefP, "ref_p"},         {kFieldAccel, "accel"},
+      {kFieldTemp, "temp"},          {kFieldTrueBias, "true_bias"}, {kFieldTrueRate, "true_rate"},
+      {kFieldTruePlat, "true_plat"},
+  };
+  std::string out;
+  for (const auto& [bit, name] : kGroups) {
+    if ((fields & bit) != 0) out += std::string(" ") + name;
   }
-  const auto& meta = reader.metadata();
-  fmt::print("{}: driftless log, {} rows", path, reader.rows_read());
-  if (reader.rows_read() > 0) fmt::print(", t = {:.3f} .. {:.3f} s", t0, t1);
-  fmt::print("\n");
-  for (const auto& [k, v] : meta.entries()) fmt::print("  {}: {}\n", k, v);
-  if (reader.rows_read() > 1) fmt::print("  sample interval: {:.6f} .. {:.6f} s\n", min_dt, max_dt);
-  fmt::print("  columns: {}\n", reader.columns().size());
-  fmt::print("  optional groups:{}{}{}{}{}{}{}\n", (reader.fields() & kFieldRefQ) ? " ref_q" : "",
-             (reader.fields() & kFieldRefP) ? " ref_p" : "",
-             (reader.fields() & kFieldAccel) ? " accel" : "",
-             (reader.fields() & kFieldTemp) ? " temp" : "",
-             (reader.fields() & kFieldTrueBias) ? " true_bias" : "",
-             (reader.fields() & kFieldTrueRate) ? " true_rate" : "",
-             (reader.fields() & kFieldTruePlat) ? " true_plat" : "");
+  return out.empty() ? " none" : out;
+}
+
+void print_findings(const log::LogReader& reader) {
   for (const auto& e : reader.events()) fmt::print("  event (line {}): {}\n", e.line, e.text);
+  if (reader.gap_count() > 0) {
+    const auto& g = reader.gaps();
+    const auto largest = std::max_element(g.begin(), g.end(), [](const auto& a, const auto& b) {
+      return a.length_s < b.length_s;
+    });
+    fmt::print("  warning: {} time gap(s) longer than {:g} s; the largest {:g} s after t = {:.6f} s (line {})\n",
+               reader.gap_count(), reader.gap_threshold_s(), largest->length_s, largest->t_before_s,
+               largest->line);
+    for (std::size_t i = 0; i < std::min<std::size_t>(g.size(), 5); ++i) {
+      fmt::print("    gap of {:g} s after t = {:.6f} s (line {})\n", g[i].length_s, g[i].t_before_s, g[i].line);
+    }
+  }
+  if (reader.rows_saturated() > 0) {
+    fmt::print("  warning: {} rows have a gyro value at the full scale of {} deg/s (saturated)\n",
+               reader.rows_saturated(), reader.metadata().gyro_full_scale_dps());
+  }
   if (reader.rows_with_missing_gyro() > 0) {
-    fmt::print("  warning: {} rows have a missing or NaN gyro value\n",
-               reader.rows_with_missing_gyro());
+    fmt::print("  warning: {} rows have a missing or NaN gyro value\n", reader.rows_with_missing_gyro());
   }
   if (reader.dropped_truncated_row()) fmt::print("  warning: last row was cut off and dropped\n");
+  const auto& meta = reader.metadata();
   if (!meta.complete()) {
     fmt::print("  warning: the log says 'complete: false' ({})\n",
                meta.get("incomplete_reason").value_or("no reason given"));
   }
+}
+
+int run_check(const std::string& path) {
+  log::ReaderOptions opts;
+  opts.accept_single_sensor = true;
+  log::LogReader reader(path, opts);
+  Sample s;
+  Span span;
+  double prev = kNaN;
+  while (reader.next(s)) {
+    if (std::isnan(span.t0)) span.t0 = s.t_s;
+    if (!std::isnan(prev)) {
+      span.min_dt = std::min(span.min_dt, s.t_s - prev);
+      span.max_dt = std::max(span.max_dt, s.t_s - prev);
+    }
+    prev = span.t1 = s.t_s;
+  }
+  fmt::print("{}: driftless log{}, {} rows", path, reader.sensors() == 1 ? " (single-sensor form)" : "",
+             reader.rows_read());
+  if (reader.rows_read() > 0) fmt::print(", t = {:.3f} .. {:.3f} s", span.t0, span.t1);
+  fmt::print("\n");
+  for (const auto& [k, v] : reader.metadata().entries()) fmt::print("  {}: {}\n", k, v);
+  if (reader.rows_read() > 1) fmt::print("  sample interval: {:.6f} .. {:.6f} s\n", span.min_dt, span.max_dt);
+  fmt::print("  columns: {}\n", reader.columns().size());
+  fmt::print("  optional groups:{}\n", groups_text(reader.fields()));
+  print_findings(reader);
   return 0;
 }
 
 const bool registered = register_command(90, [](CLI::App& app) {
-  auto* cmd = app.add_subcommand("check", "Validate a measurement log (docs/log-format.md) and "
-                                          "summarise it; exits non-zero on a malformed log");
+  auto* cmd = app.add_subcommand("check", "Validate a measurement log (docs/log-format.md, the same validation "
+                                          "every command applies) and summarise it; exit 1 on a refused log");
   auto path = std::make_shared<std::string>();
-  cmd->add_option("--log", *path, "Measurement log (CSV, driftless-log 1)")
+  cmd->add_option("--log", *path, "Measurement log (CSV, driftless-log 1; also the single-sensor form)")
       ->required()
       ->check(CLI::ExistingFile);
   return [path] { return run_check(*path); };

@@ -64,7 +64,7 @@ const bool registered = register_command(50, [](CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--out", a->out, "Output directory (report.html, diagnosis.json, plots/)")->required();
   cmd->add_flag("--resample", a->resample, "Resample a log whose rate differs from the model's (else it is refused)");
-  cmd->add_option("--block", a->block_s, "Block length of the residual fits, s (default 0.1)")->check(CLI::PositiveNumber);
+  cmd->add_option("--block", a->block_s, "Block length of the residual fits, s (default 0.1)")->check(positive_number("s"));
   cmd->add_option("--threshold", a->threshold, "Evidence (2 ln L gain - ln(n) per parameter) above which an effect is missing (default 10)");
   return [a] { return run_compare(*a); };
 });

@@ -16,6 +16,7 @@
 #include <fmt/core.h>
 
 #include "cli/command.hpp"
+#include "estimator/output_file.hpp"
 #include "cli/demo_checks.hpp"
 #include "twin/scenario.hpp"
 #include "twin/simulator.hpp"
@@ -44,10 +45,7 @@ constexpr double kVideoFps = 30.0;
 bool step_simulate(DemoContext& c) {
   std::filesystem::create_directories(c.dir / "sim");
   const auto resolved = c.dir / "sim" / "scenario.resolved.yaml";
-  {
-    std::ofstream y(resolved, std::ios::binary);
-    y << twin::emit_scenario(c.scenario);
-  }
+  io::write_file(resolved, twin::emit_scenario(c.scenario));
   Progress progress("demo: simulate");
   const double dur = c.scenario.duration_s;
   const auto r = twin::simulate_to_log(c.scenario, c.dir / "sim" / "log.csv", [&](double f) {
@@ -173,10 +171,10 @@ const bool registered = register_command(0, [](CLI::App& app) {
   auto args = std::make_shared<DemoArgs>();
   cmd->add_option("--out", args->out_dir, "Output directory (default out/demo)");
   cmd->add_option("--duration", args->duration_s, "Simulated duration in s (default 600)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number("s"));
   cmd->add_flag("!--no-video", args->video, "Skip the rendered video step");
   return [args] { return run_demo(*args); };
-});
+}, Interrupt::kPolls);
 
 }  // namespace
 }  // namespace driftless::cli

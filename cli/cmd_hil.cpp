@@ -181,11 +181,13 @@ const bool registered = register_command(60, [](CLI::App& app) {
                   "twin: who flips the platforms: scenario (its flip_schedule, inside the simulator) or "
                   "bridge (the bridge's flip schedule commands the twin's servos, --standstill s hold)")
       ->default_val("scenario");
-  cmd->add_option("--seed", o->seed, "Seed of the emulators and the twin")->default_val(1);
+  cmd->add_option("--seed", o->seed, "Seed of the emulators and the twin, 0 .. 2^64-1")
+      ->check(seed_number())
+      ->default_val(1);
   cmd->add_option("--estimator-config", o->estimator_config, "Estimator configuration (key: value, docs/estimator.md)");
   cmd->add_option("--print-every", o->print_every_s, "Terminal line every this much session time, s")->default_val(10.0);
   return [o] { return run_hil(*o); };
-});
+}, Interrupt::kPolls);
 
 }  // namespace
 }  // namespace driftless::cli

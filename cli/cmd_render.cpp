@@ -10,6 +10,7 @@
 #include <mujoco/mujoco.h>
 
 #include "cli/command.hpp"
+#include "estimator/output_file.hpp"
 #include "report/json.hpp"
 #include "renders/render_job.hpp"
 #include "renders/twin_source.hpp"
@@ -47,17 +48,15 @@ void write_sidecar(const RenderArgs& a, const render::RenderParams& p, const ren
   const std::filesystem::path path = std::filesystem::path(a.out).replace_extension(".json");
   using report::json_number;
   using report::json_string;
-  std::ofstream f(path);
-  f << fmt::format(
+  io::write_file(path, fmt::format(
       "{{\n  \"format\": \"driftless-video 1\",\n  \"output\": {},\n  \"png_fallback\": {},\n"
       "  \"complete\": {},\n  \"frames\": {},\n  \"width\": {},\n  \"height\": {},\n  \"fps\": {},\n"
       "  \"speed\": {},\n  \"first_frame_s\": {},\n  \"last_frame_s\": {},\n  \"realtime_flip_frames\": {},\n"
-      "  \"camera\": {},\n  \"wall_s\": {:.3f}\n}}\n",
+      "  \"camera\": {},\n  \"wall_s\": {:.3f},\n  \"stopped_at_t_s\": {}\n}}\n",
       json_string(st.output), st.png_fallback, complete, st.frames, p.scene.width_px, p.scene.height_px,
       json_number(p.timeline.fps), json_number(p.timeline.speed), json_number(st.first_frame_s),
       json_number(st.last_frame_s), st.realtime_flip_frames, json_string(p.scene.camera.empty() ? "auto" : p.scene.camera),
-      st.wall_s);
-  if (!f.flush()) throw std::runtime_error("cannot write " + path.string());
+      st.wall_s, complete ? std::string("null") : json_number(st.last_frame_s)));
 }
 
 int run_render(const RenderArgs& a) {
@@ -130,9 +129,9 @@ int run_render(const RenderArgs& a) {
   if (stop_requested().load()) {
     fmt::print(stderr, "driftless render: stopped early (Ctrl-C); the video ends at t = {:.2f} s\n",
                stats.last_frame_s);
-    return 130;
+    return interrupted_exit_code();
   }
-  return 0;
+  return kExitOk;
 }
 
 const bool registered = register_command(60, [](CLI::App& app) {
@@ -201,7 +200,7 @@ const bool registered = register_command(60, [](CLI::App& app) {
     (void)cmd;
     return run_render(*a);
   };
-});
+}, Interrupt::kPolls);
 
 }  // namespace
 }  // namespace driftless::cli

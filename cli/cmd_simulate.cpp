@@ -1,7 +1,6 @@
 // driftless simulate: run a scenario in the MuJoCo twin and write DIR/log.csv and
 // DIR/scenario.resolved.yaml.
 #include <filesystem>
-#include <fstream>
 #include <memory>
 #include <optional>
 #include <string>
@@ -9,6 +8,8 @@
 #include <fmt/core.h>
 
 #include "cli/command.hpp"
+#include "estimator/log.hpp"
+#include "estimator/output_file.hpp"
 #include "twin/scenario.hpp"
 #include "twin/simulator.hpp"
 
@@ -30,11 +31,10 @@ int run_simulate(const SimulateArgs& a) {
 
   const std::filesystem::path dir(a.out_dir);
   std::filesystem::create_directories(dir);
-  {
-    std::ofstream y(dir / "scenario.resolved.yaml", std::ios::binary);
-    y << twin::emit_scenario(sc);
-    if (!y) throw std::runtime_error((dir / "scenario.resolved.yaml").string() + ": cannot write");
-  }
+  warn_if_disk_too_small("simulate", dir,
+                         static_cast<double>(sc.total_samples()) * log::estimated_row_bytes(twin::Simulator::fields()),
+                         "log.csv");
+  io::write_file(dir / "scenario.resolved.yaml", twin::emit_scenario(sc));
   Progress progress(fmt::format("simulate {}", sc.name));
   const double dur = sc.duration_s;
   const auto r = twin::simulate_to_log(sc, dir / "log.csv", [&](double f) {
@@ -47,7 +47,7 @@ int run_simulate(const SimulateArgs& a) {
   fmt::print("{}: {} rows{}; {}\n", (dir / "log.csv").string(), r.rows,
              r.complete ? "" : " (stopped: log marked complete: false)",
              (dir / "scenario.resolved.yaml").string());
-  return r.complete ? 0 : 130;
+  return r.complete ? kExitOk : interrupted_exit_code();
 }
 
 const bool registered = register_command(10, [](CLI::App& app) {
@@ -62,12 +62,13 @@ const bool registered = register_command(10, [](CLI::App& app) {
   cmd->add_option_function<double>(
          "--duration", [args](double v) { args->duration_s = v; },
          "Simulated duration in s (overrides the scenario's duration_s)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number("s"));
   cmd->add_option_function<std::uint64_t>(
       "--seed", [args](std::uint64_t v) { args->seed = v; },
-      "Random seed (overrides the scenario's seed); the same seed gives a byte-identical log");
+      "Random seed 0 .. 2^64-1 (overrides the scenario's seed); the same seed gives a byte-identical log")
+      ->check(seed_number());
   return [args] { return run_simulate(*args); };
-});
+}, Interrupt::kPolls);
 
 }  // namespace
 }  // namespace driftless::cli

@@ -16,6 +16,7 @@
 #endif
 
 #include "cli/command.hpp"
+#include "estimator/output_file.hpp"
 #include "studies/jobs.hpp"
 #include "studies/sweep.hpp"
 
@@ -185,11 +186,12 @@ int run_sweep(const Options& opt) {
   for (const auto& w : plot_warnings) fmt::print(stderr, "driftless sweep: warning: {}\n", w);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   {
-    std::ofstream t(std::filesystem::path(opt.out) / "timing.txt");
+    std::ostringstream t;
     t << "# wall time is not part of the table (not reproducible)\n"
       << "ranks: " << size << "\nthreads_per_rank: " << threads << "\nwall_s: " << wall
       << "\nsum_of_run_times_s: " << serial_s << "\nspeedup: " << (wall > 0 ? serial_s / wall : 0)
       << "\n";
+    io::write_file(std::filesystem::path(opt.out) / "timing.txt", t.str());
   }
   fmt::print("{} runs, {} failed; wall {:.1f} s, sum of run times {:.1f} s (speed-up {:.2f}x); "
              "table: {}/runs.csv, {}/summary.csv\n",
@@ -215,7 +217,7 @@ const bool registered = register_command(60, [](CLI::App& app) {
   cmd->add_flag("--save-logs", opt->save_logs,
                 "Also write every run's samples to OUT/logs/run_<index>.csv (driftless-log 1)");
   return [opt] { return run_sweep(*opt); };
-});
+}, Interrupt::kPolls);
 
 }  // namespace
 }  // namespace driftless::cli

@@ -211,7 +211,7 @@ FigureOutcome fig9_attitude(const fs::path& dir, const EstimateFigureInputs& in)
   std::string body = fmt::format(
       "  set xlabel 't [s]'; set ylabel 'attitude error [deg]'; set offsets 0, 0, graph 0.05, graph 0.05\n"
       "  set title \"Fig. 9: attitude error, integrated from ref_q at lock (t = {0:.1f} s)\\n"
-      "bias fixed at lock (red) against DriftLess (blue)\"\n  set key below maxrows 3\n{1}",
+      "bias fixed at lock (red) against DriftLess (blue)\"\n  set key below maxrows 3 height 1.5\n{1}",
       in.lock_s, lock_marker(in.lock_s));
   if (std::isfinite(t_end) && t_end > in.lock_s) {
     body += fmt::format("  set xrange [{:.3f}:{:.3f}]\n", in.lock_s - 0.02 * (t_end - in.lock_s), t_end);

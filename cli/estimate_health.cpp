@@ -115,6 +115,16 @@ std::string health_json(const est::HealthReport& h, const est::EstimatorConfig& 
       json_number(h.nis_mean_band_hi), h.relocks, unobs, findings);
 }
 
+std::string tune_json(const est::TuneResult* t) {
+  if (t == nullptr) return "null";
+  return fmt::format("{{\"block_s\": {}, \"noise_block_pairs\": {}, \"noise_estimated\": {}, "
+                     "\"noise_density_dps_rthz\": {}, \"wander_pairs\": {}, \"q_estimated\": {}, "
+                     "\"q_dps2_per_s\": {}}}",
+                     json_number(t->block_s), t->noise_block_pairs, t->noise_estimated ? "true" : "false",
+                     json_number(t->noise_density_dps_rthz), t->wander_pairs, t->q_estimated ? "true" : "false",
+                     json_number(t->q_dps2_per_s));
+}
+
 std::vector<std::string> health_lines(const est::HealthReport& h, const est::EstimatorConfig& cfg) {
   std::vector<std::string> lines;
   lines.push_back(fmt::format(

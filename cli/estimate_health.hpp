@@ -8,6 +8,7 @@
 
 #include "estimator/config.hpp"
 #include "estimator/health.hpp"
+#include "estimator/tune.hpp"
 
 namespace driftless::cli {
 
@@ -17,6 +18,8 @@ std::string component_names(const std::vector<int>& components);
 std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cfg);
 /// The `"health": {...}` member of summary.json (no trailing comma), indented by two spaces.
 std::string health_json(const est::HealthReport& h, const est::EstimatorConfig& cfg);
+/// The `tune` value of summary.json: what --tune auto measured, or null.
+std::string tune_json(const est::TuneResult* t);
 /// The console lines: "health: ok|degraded|failed ..." then one line per finding.
 std::vector<std::string> health_lines(const est::HealthReport& h, const est::EstimatorConfig& cfg);
 

@@ -10,6 +10,7 @@
 
 #include "estimator/geometry.hpp"
 #include "estimator/input_error.hpp"
+#include "estimator/output_file.hpp"
 #include "twin/motion.hpp"
 #include "twin/world.hpp"
 #include "twin/yaml_doc.hpp"
@@ -94,10 +95,7 @@ void save_compare_model(const CompareModel& m, const std::filesystem::path& path
     top.add("model", model_node(sc.model));
     text = to_yaml(top);
   }
-  std::ofstream f(path);
-  if (!f) throw std::runtime_error(fmt::format("cannot write {}", path.string()));
-  f << "# written by driftless diagnose --apply (docs/compare.md)\n" << text << "\n";
-  if (!f) throw std::runtime_error(fmt::format("error writing {}", path.string()));
+  io::write_file(path, "# written by driftless diagnose --apply (docs/compare.md)\n" + text + "\n");
 }
 
 SensorParams deterministic_part(const SensorParams& p) {

@@ -9,6 +9,7 @@
 
 #include <fmt/core.h>
 
+#include "estimator/output_file.hpp"
 #include "report/gnuplot.hpp"
 #include "report/html.hpp"
 #include "report/json.hpp"
@@ -139,22 +140,20 @@ std::string diagnosis_json(const CompareResult& r, const ReportExtras& x) {
 void write_report(const CompareResult& r, const std::filesystem::path& dir, const ReportExtras& x) {
   std::filesystem::create_directories(dir);
   {
-    std::ofstream f(dir / "diagnosis.json");
-    if (!f) throw std::runtime_error(fmt::format("cannot write {}", (dir / "diagnosis.json").string()));
-    f << diagnosis_json(r, x);
+    io::write_file(dir / "diagnosis.json", diagnosis_json(r, x));
   }
   const auto plot_dir = dir / "plots";
   std::filesystem::create_directories(plot_dir);
   std::vector<std::pair<std::string, std::string>> plots;  // title, png bytes
   // 1: block residual and smoothed nuisance bias over time
   {
-    std::ofstream d(plot_dir / "residual.dat");
+    std::ostringstream d;
     for (std::size_t b = 0; b < r.block_t_s.size(); ++b) {
       d << fmt::format("{:.3f}", r.block_t_s[b]);
       for (int c = 0; c < 6; ++c) d << ' ' << json_number(r.block_residual_dps[c][b]) << ' ' << json_number(r.block_bias_dps[c][b]);
       d << '\n';
     }
-    d.close();  // flushed before gnuplot reads it (an open stream left the file empty)
+    io::write_file(plot_dir / "residual.dat", d.str());  // written before gnuplot reads it
     std::string s = "set multiplot layout 2,1\nset xlabel 't (s)'\nset ylabel 'residual (deg/s)'\nset key outside right\nset datafile missing 'null'\n";
     for (int sn = 0; sn < 2; ++sn) {
       s += fmt::format("set title 'sensor {}: block-mean residual after the nuisance fit (points) and smoothed bias (lines)'\nplot ", sn + 1);
@@ -169,13 +168,13 @@ void write_report(const CompareResult& r, const std::filesystem::path& dir, cons
   }
   // 2: windowed rms
   {
-    std::ofstream d(plot_dir / "windows.dat");
+    std::ostringstream d;
     for (const auto& w : r.windows) {
       d << fmt::format("{:.3f}", 0.5 * (w.t0_s + w.t1_s));
       for (int c = 0; c < 6; ++c) d << ' ' << json_number(w.rms_dps[c]);
       d << '\n';
     }
-    d.close();
+    io::write_file(plot_dir / "windows.dat", d.str());
     std::string s = "set xlabel 't (s)'\nset ylabel 'rms (deg/s)'\nset key outside right\nset title 'windowed residual rms'\nplot ";
     for (int c = 0; c < 6; ++c)
       s += fmt::format("'{}' u 1:{} w lp t '{}'{}", "windows.dat", 2 + c, channel_name(c), c < 5 ? ", " : "\n");
@@ -183,7 +182,7 @@ void write_report(const CompareResult& r, const std::filesystem::path& dir, cons
   }
   // 3: ADEV of the residual vs the model
   {
-    std::ofstream d(plot_dir / "adev.dat");
+    std::ostringstream d;
     std::size_t np = 0;
     for (const auto& ch : r.channels) np = std::max(np, ch.adev.points.size());
     for (std::size_t i = 0; i < np; ++i) {
@@ -194,7 +193,7 @@ void write_report(const CompareResult& r, const std::filesystem::path& dir, cons
       }
       d << '\n';
     }
-    d.close();
+    io::write_file(plot_dir / "adev.dat", d.str());
     std::string s = "set logscale xy\nset xlabel 'tau (s)'\nset ylabel 'ADEV (deg/s)'\nset key outside right\nset datafile missing 'null'\nset title 'Allan deviation of the residual (points) and of the model noise (lines)'\nplot ";
     for (int c = 0; c < 6; ++c)
       s += fmt::format("'{0}' u {1}:{2} w p t '{3}', '' u {1}:{4} w l dt 2 t '{3} model'{5}", "adev.dat", 1 + 3 * c,
@@ -203,13 +202,13 @@ void write_report(const CompareResult& r, const std::filesystem::path& dir, cons
   }
   // 4: regimes
   {
-    std::ofstream d(plot_dir / "regimes.dat");
+    std::ostringstream d;
     for (std::size_t i = 0; i < r.regimes.size(); ++i) {
       d << '"' << r.regimes[i].group << ": " << r.regimes[i].name << '"';
       for (int c = 0; c < 6; ++c) d << ' ' << json_number(r.regimes[i].rms_dps[c]);
       d << '\n';
     }
-    d.close();
+    io::write_file(plot_dir / "regimes.dat", d.str());
     std::string s = "set style data histograms\nset style fill solid 0.8\nset xtics rotate by -30\nset ylabel 'rms (deg/s)'\nset key outside right\nset title 'residual rms by regime'\nplot ";
     for (int c = 0; c < 6; ++c)
       s += fmt::format("'{}' u {}:xtic(1) t '{}'{}", "regimes.dat", 2 + c, channel_name(c), c < 5 ? ", " : "\n");
@@ -295,9 +294,7 @@ void write_report(const CompareResult& r, const std::filesystem::path& dir, cons
     else h << "<h3>" << html_escape(title) << "</h3><img alt='" << html_escape(title) << "' src='data:image/png;base64," << report::base64(png) << "'>\n";
   }
   h << "</body></html>\n";
-  std::ofstream f(dir / "report.html");
-  if (!f) throw std::runtime_error(fmt::format("cannot write {}", (dir / "report.html").string()));
-  f << h.str();
+  io::write_file(dir / "report.html", h.str());
 }
 
 }  // namespace driftless::diagnose

@@ -28,6 +28,9 @@ enum SampleField : std::uint32_t {
   kFieldTrueBias = 1u << 4,   // true_bias1_x..true_bias2_z, deg/s
   kFieldTrueRate = 1u << 5,   // true_rate_x..z, body inertial rate in body axes, deg/s
   kFieldTruePlat = 1u << 6,   // true_plat1_deg, true_plat2_deg
+  // layout, not a column group: the single-sensor log form (docs/log-format.md): one gyro triad,
+  // no gyro2_*, plat2_deg or sensor-2 columns; gyro2_dps and plat2_deg stay NaN
+  kLayoutSingleSensor = 1u << 7,
 };
 
 /// One sample. Missing values are NaN (e.g. plat*_deg while a hardware platform moves).

@@ -19,6 +19,8 @@
 #include <fmt/core.h>
 #include <png.h>
 
+#include "estimator/output_file.hpp"
+
 extern char** environ;
 
 namespace driftless::render {
@@ -91,7 +93,7 @@ class FfmpegSink final : public VideoSink {
  public:
   FfmpegSink(const std::filesystem::path& ffmpeg, const std::filesystem::path& out, int width,
              int height, double fps, const EncoderParams& enc)
-      : out_(out), frame_bytes_(static_cast<std::size_t>(width) * height * 3) {
+      : out_(out), out_file_(out), frame_bytes_(static_cast<std::size_t>(width) * height * 3) {
     enc.validate();
     if (width % 2 != 0 || height % 2 != 0 || width <= 0 || height <= 0) {
       throw std::invalid_argument(
@@ -104,7 +106,7 @@ class FfmpegSink final : public VideoSink {
         "-f", "rawvideo", "-pix_fmt", "rgb24", "-s", fmt::format("{}x{}", width, height),
         "-framerate", fmt::format("{}", fps), "-i", "pipe:0",
         "-c:v", "libx264", "-preset", enc.preset, "-crf", std::to_string(enc.crf),
-        "-pix_fmt", "yuv420p", "-movflags", "+faststart", out.string()};
+        "-pix_fmt", "yuv420p", "-movflags", "+faststart", out_file_.partial().string()};
     int in_pipe[2], err_pipe[2];
     if (::pipe2(in_pipe, O_CLOEXEC) != 0 || ::pipe2(err_pipe, O_CLOEXEC) != 0) {
       throw std::runtime_error(fmt::format("cannot create a pipe for ffmpeg: {}",
@@ -181,6 +183,9 @@ class FfmpegSink final : public VideoSink {
       throw std::runtime_error(fmt::format("ffmpeg failed writing {}: {}", out_.string(),
                                            error_tail()));
     }
+    // the video is renamed into place only after ffmpeg exited 0 (a failed or killed encoder
+    // leaves no file that looks playable)
+    out_file_.commit("ffmpeg");
   }
 
   std::string description() const override { return out_.string(); }
@@ -209,6 +214,7 @@ class FfmpegSink final : public VideoSink {
 
   SigpipeGuard sigpipe_;
   std::filesystem::path out_;
+  io::ExternalOutput out_file_;  // ffmpeg writes its partial name
   std::size_t frame_bytes_;
   pid_t pid_ = -1;
   int in_fd_ = -1, err_fd_ = -1;
@@ -236,19 +242,16 @@ class PngSink final : public VideoSink {
 
   void write(const std::uint8_t* rgb) override {
     const auto path = dir_ / fmt::format("frame_{:06d}.png", frames_);
-    std::FILE* f = std::fopen(path.c_str(), "wb");
-    if (f == nullptr) {
-      throw std::runtime_error(fmt::format("cannot write {}: {}", path.string(),
-                                           std::strerror(errno)));
-    }
+    // a frame is written under its partial name and renamed when libpng finished it
+    io::ExternalOutput out(path);
+    io::CheckedFile f(out.partial(), "wb", path.string());
     png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
     png_infop info = png != nullptr ? png_create_info_struct(png) : nullptr;
     if (png == nullptr || info == nullptr || setjmp(png_jmpbuf(png))) {
       png_destroy_write_struct(&png, &info);
-      std::fclose(f);
       throw std::runtime_error(fmt::format("libpng failed writing {}", path.string()));
     }
-    png_init_io(png, f);
+    png_init_io(png, f.get());
     png_set_compression_level(png, 1);  // speed over size: these are frames, not archives
     png_set_IHDR(png, info, static_cast<png_uint_32>(width_), static_cast<png_uint_32>(height_),
                  8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
@@ -259,10 +262,8 @@ class PngSink final : public VideoSink {
     }
     png_write_end(png, nullptr);
     png_destroy_write_struct(&png, &info);
-    if (std::fclose(f) != 0) {
-      throw std::runtime_error(fmt::format("cannot finish {}: {}", path.string(),
-                                           std::strerror(errno)));
-    }
+    f.close();  // throws io::OutputError "<frame>: <reason>" (a full disk)
+    out.commit("libpng");
     ++frames_;
   }
 

@@ -3,12 +3,13 @@
 #include <algorithm>
 
 #include <fmt/core.h>
-#include <fmt/os.h>
+
+#include "report/text_file.hpp"
 
 namespace driftless::report {
 
 void write_allan_table(const std::filesystem::path& path, const std::vector<AllanTableColumn>& cols) {
-  auto out = fmt::output_file(path.string());
+  TextFile out(path);
   std::size_t rows = 0;
   out.print("tau_s");
   for (const auto& c : cols) {
@@ -28,6 +29,7 @@ void write_allan_table(const std::filesystem::path& path, const std::vector<Alla
     }
     out.print("\n");
   }
+  out.commit();
 }
 
 }  // namespace driftless::report

@@ -6,6 +6,7 @@ packages=(
   libmujoco-dev libqhull-dev libeigen3-dev libyaml-cpp-dev libosmesa6-dev
   libpng-dev libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev libfmt-dev libfast-float-dev
   ffmpeg gnuplot-nox openmpi-bin libopenmpi-dev
+  clang libclang-rt-14-dev  # libFuzzer harnesses (tests/fuzz, CI)
   librosbag-dev libsensor-msgs-dev
   chromium  # the look test (tests/cli/look.sh) opens the report and the figures headless
 )

@@ -10,6 +10,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "estimator/numbers.hpp"
+#include "estimator/output_file.hpp"
 #include "estimator/attitude.hpp"
 #include "estimator/geometry.hpp"
 #include "estimator/random.hpp"
@@ -125,12 +126,10 @@ RunSetup SetupBuilder::build(const RunSpec& spec) const {
 
 Metrics evaluate_bias(const RunSetup& setup, const log::Metadata& meta, const SampleSource& source,
                       const std::filesystem::path& attitude_csv) {
-  std::ofstream att_out;
-  if (!attitude_csv.empty()) {
-    att_out.open(attitude_csv);
-    if (!att_out) throw std::runtime_error("sweep: cannot write " + attitude_csv.string());
-    att_out << "t_s,err_driftless_deg,err_zeroed_deg\n";
-  }
+  // attitude.csv: collected here, written through the output helper when the run is done
+  const bool att_file = !attitude_csv.empty();
+  std::ostringstream att_out;
+  if (att_file) att_out << "t_s,err_driftless_deg,err_zeroed_deg\n";
   double next_att_out_s = 0.0;
   est::DriftlessFilter filter(setup.estimator, est::box_geometry_from_metadata(meta));
   const double eval_start =
@@ -145,7 +144,6 @@ Metrics evaluate_bias(const RunSetup& setup, const log::Metadata& meta, const Sa
   // their bias zeroed once at the first sample (a perfect turn-on calibration, then drift: the
   // paper's "without DriftLess"); both start on the reference attitude
   est::AttitudeIntegrator att_dl(setup.scenario.latitude_deg), att_zero(setup.scenario.latitude_deg);
-  est::Vector6d bias_at_start = est::Vector6d::Constant(kNaN);
   Eigen::Quaterniond err_dl0 = Eigen::Quaterniond::Identity(), err_zero0 = Eigen::Quaterniond::Identity();
   bool att_window = false;
   double att_t0 = kNaN, att_t1 = kNaN;
@@ -155,23 +153,16 @@ Metrics evaluate_bias(const RunSetup& setup, const log::Metadata& meta, const Sa
     if (s.ref_q_wxyz.allFinite() && s.true_bias1_dps.allFinite() && s.true_bias2_dps.allFinite()) {
       const est::SampleOutput& out = filter.output();
       if (!att_dl.initialized()) {
+        // the true bias at the first sample, held: the filter fuses its rate with it
+        // (rate_body_fixed_dps), the same fusion as the corrected rate
+        est::Vector6d bias_at_start;
         bias_at_start << s.true_bias1_dps, s.true_bias2_dps;
+        filter.set_fixed_bias_dps(bias_at_start);
         att_dl.reset(s.q_enu_from_body(), s.t_s);
         att_zero.reset(s.q_enu_from_body(), s.t_s);
       } else {
-        // the same fusion as the filter's output: the sensors at rest, averaged
-        Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-        int k = 0;
-        if (std::isfinite(s.plat1_deg) && out.sensors_fused > 0) {
-          sum += filter.body_from_sensor(1, s.plat1_deg) * (s.gyro1_dps - bias_at_start.head<3>());
-          ++k;
-        }
-        if (std::isfinite(s.plat2_deg) && out.sensors_fused > 0) {
-          sum += filter.body_from_sensor(2, s.plat2_deg) * (s.gyro2_dps - bias_at_start.tail<3>());
-          ++k;
-        }
         att_dl.step(s.t_s, out.rate_body_dps);
-        att_zero.step(s.t_s, k > 0 ? Eigen::Vector3d(sum / k) : Eigen::Vector3d::Constant(kNaN));
+        att_zero.step(s.t_s, out.rate_body_fixed_dps);
       }
       const Eigen::Quaterniond q_ref = s.q_enu_from_body();
       const Eigen::Quaterniond e_dl = att_dl.q_enu_from_body() * q_ref.conjugate();
@@ -186,8 +177,8 @@ Metrics evaluate_bias(const RunSetup& setup, const log::Metadata& meta, const Sa
         att_zero.reset(q_ref, s.t_s);
         err_dl0 = err_zero0 = Eigen::Quaterniond::Identity();
         next_att_out_s = s.t_s;
-        if (att_out.is_open()) att_out << s.t_s << ",nan,nan\n";  // gnuplot: break the lines
-      } else if (att_out.is_open() && s.t_s >= next_att_out_s) {
+        if (att_file) att_out << s.t_s << ",nan,nan\n";  // gnuplot: break the lines
+      } else if (att_file && s.t_s >= next_att_out_s) {
         att_out << s.t_s << ',' << geo::rotvec_rad(e_dl).norm() * kDegPerRad << ','
                 << geo::rotvec_rad(e_zero).norm() * kDegPerRad << '\n';
         next_att_out_s += 1.0;
@@ -215,6 +206,7 @@ Metrics evaluate_bias(const RunSetup& setup, const log::Metadata& meta, const Sa
     last_err = e;
     ++n;
   }
+  if (att_file) io::write_file(attitude_csv, att_out.str());
   if (n == 0) throw std::runtime_error("sweep: no samples after eval start (duration too short?)");
   Metrics m;
   m.emplace_back("bias_err_rms_dph", std::sqrt(sum2 / (6.0 * n)) * kDphPerDps);

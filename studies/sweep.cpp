@@ -19,6 +19,7 @@
 
 #include "estimator/input_error.hpp"
 #include "estimator/numbers.hpp"
+#include "estimator/output_file.hpp"
 #include "report/gnuplot.hpp"
 
 namespace driftless::studies {
@@ -353,8 +354,7 @@ std::size_t write_outputs(const SweepConfig& cfg, const std::vector<RunSpec>& sp
   }
   std::size_t failed = 0;
   {
-    std::ofstream out(dir / "runs.csv");
-    if (!out) throw std::runtime_error((dir / "runs.csv").string() + ": cannot write");
+    std::ostringstream out;
     out << "# sweep: " << csv_text(cfg.name) << "\n# runner: " << cfg.runner
         << "\n# monte_carlo: " << cfg.monte_carlo << "\n# seed: " << cfg.seed << "\n";
     out << "run,point,mc,seed";
@@ -382,6 +382,7 @@ std::size_t write_outputs(const SweepConfig& cfg, const std::vector<RunSpec>& sp
       }
       out << '\n';
     }
+    io::write_file(dir / "runs.csv", out.str());
   }
   std::vector<RunResult> ok_results;
   for (const auto* r : by_index) {
@@ -389,7 +390,7 @@ std::size_t write_outputs(const SweepConfig& cfg, const std::vector<RunSpec>& sp
   }
   const auto agg = summarize(cfg, ok_results);
   {
-    std::ofstream out(dir / "summary.csv");
+    std::ostringstream out;
     out << "point";
     for (const auto& a : cfg.grid) out << ',' << a.name;
     out << ",n_ok";
@@ -417,6 +418,7 @@ std::size_t write_outputs(const SweepConfig& cfg, const std::vector<RunSpec>& sp
       }
       out << '\n';
     }
+    io::write_file(dir / "summary.csv", out.str());
   }
   // gnuplot: one script (and PNG) per plotted metric, mean with +-std error bars
   for (const auto& p : cfg.plots) {
@@ -460,7 +462,7 @@ std::size_t write_outputs(const SweepConfig& cfg, const std::vector<RunSpec>& sp
       fig.svg = false;
       fig.csv_defaults = false;
       if (!run_gnuplot) {
-        std::ofstream(dir / (stem + ".gp")) << report::gnuplot_script(fig);
+        io::write_file(dir / (stem + ".gp"), report::gnuplot_script(fig));
       } else if (const auto st = report::render(dir, fig); !st.ok && plot_warnings != nullptr) {
         plot_warnings->push_back(st.message);
       }

@@ -1,16 +1,12 @@
 #include "twin/simulator.hpp"
 
+#include "estimator/background_writer.hpp"
 #include "estimator/geometry.hpp"
 #include "estimator/random.hpp"
 
 #include <cmath>
-#include <condition_variable>
-#include <deque>
-#include <exception>
-#include <mutex>
 #include <stdexcept>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include <fmt/core.h>
@@ -369,81 +365,6 @@ bool Simulator::next(Sample& out) {
   return true;
 }
 
-namespace {
-
-// formats and writes the log on a second thread, so the simulation and the writing overlap; the
-// queue holds a few blocks of samples (constant memory), the file is the same as written inline
-class BackgroundLogWriter {
- public:
-  explicit BackgroundLogWriter(log::LogWriter& writer) : writer_(writer), thread_([this] { run(); }) {}
-  ~BackgroundLogWriter() {
-    close();
-    thread_.join();
-  }
-  BackgroundLogWriter(const BackgroundLogWriter&) = delete;
-  BackgroundLogWriter& operator=(const BackgroundLogWriter&) = delete;
-
-  /// Queues a block (waits while the queue is full); rethrows the writer's error, if any.
-  void push(std::vector<Sample>&& block) {
-    std::unique_lock lock(mutex_);
-    changed_.wait(lock, [&] { return queue_.size() < kMaxQueued || error_; });
-    if (error_) std::rethrow_exception(error_);
-    queue_.push_back(std::move(block));
-    changed_.notify_all();
-  }
-  /// Waits until every queued block is written; rethrows the writer's error, if any.
-  void drain() {
-    std::unique_lock lock(mutex_);
-    changed_.wait(lock, [&] { return (queue_.empty() && !busy_) || error_; });
-    if (error_) std::rethrow_exception(error_);
-  }
-
- private:
-  static constexpr std::size_t kMaxQueued = 4;
-
-  void close() {
-    std::lock_guard lock(mutex_);
-    closed_ = true;
-    changed_.notify_all();
-  }
-  void run() {
-    std::unique_lock lock(mutex_);
-    while (true) {
-      changed_.wait(lock, [&] { return !queue_.empty() || closed_; });
-      if (queue_.empty()) return;
-      std::vector<Sample> block = std::move(queue_.front());
-      queue_.pop_front();
-      busy_ = true;
-      changed_.notify_all();
-      lock.unlock();
-      std::exception_ptr error;
-      try {
-        for (const Sample& s : block) writer_.write(s);
-      } catch (...) {
-        error = std::current_exception();
-      }
-      lock.lock();
-      busy_ = false;
-      if (error) {
-        error_ = error;
-        queue_.clear();
-      }
-      changed_.notify_all();
-      if (error_) return;
-    }
-  }
-
-  log::LogWriter& writer_;
-  std::mutex mutex_;
-  std::condition_variable changed_;
-  std::deque<std::vector<Sample>> queue_;
-  bool busy_ = false, closed_ = false;
-  std::exception_ptr error_;
-  std::thread thread_;
-};
-
-}  // namespace
-
 SimulateResult simulate_to_log(const Scenario& scenario, const std::filesystem::path& log_path,
                                const std::function<bool(double)>& keep_going, SimOptions options) {
   Simulator sim(scenario, options);
@@ -452,25 +373,23 @@ SimulateResult simulate_to_log(const Scenario& scenario, const std::filesystem::
   constexpr std::size_t kBlock = 1024;
   bool stopped = false;
   {
-    BackgroundLogWriter background(writer);
-    std::vector<Sample> block;
-    block.reserve(kBlock);
+    // the log is formatted and written on a second thread while the simulation runs (same bytes as
+    // written inline; two blocks in memory at most)
+    io::BackgroundWriter<Sample> background(
+        [&writer](const std::vector<Sample>& block) {
+          for (const Sample& b : block) writer.write(b);
+        },
+        kBlock);
     Sample s;
     while (sim.next(s)) {
-      block.push_back(s);
-      if (block.size() == kBlock) {
-        background.push(std::move(block));
-        block = {};
-        block.reserve(kBlock);
-      }
+      background.push(s);
       if (keep_going && sim.samples_done() % poll == 0 &&
           !keep_going(static_cast<double>(sim.samples_done()) / static_cast<double>(sim.total_samples()))) {
         stopped = true;
         break;
       }
     }
-    if (!block.empty()) background.push(std::move(block));
-    background.drain();
+    background.finish();
   }
   SimulateResult r;
   r.rows = writer.rows_written();

@@ -179,7 +179,8 @@ TEST(LogTest, BadInputGetsClearMessages) {
         ":4: t = 1.000000 s is not greater");
   check("junk.csv", "# format: driftless-log 1\n" + header + "0,abc,0,0,0,0,0,90,90\n",
         "column 'gyro1_x': expected a number, got 'abc'");
-  check("format.csv", "# format: other-log 3\n" + header, "unsupported format 'other-log 3'");
+  check("format.csv", "# format: other-log 3\n" + header,
+        ":1: format: expected 'driftless-log 1', got 'other-log 3'");
   check("nofile.csv", "", "empty file");
   EXPECT_NE(message_of([] { LogReader r("/nonexistent/x.csv"); }).find("no such file"),
             std::string::npos);
@@ -197,6 +198,184 @@ TEST(LogTest, NanGyroRowsAreReturnedAndCounted) {
   while (r.next(s)) ++n;
   EXPECT_EQ(n, 3);
   EXPECT_EQ(r.rows_with_missing_gyro(), 2u);
+}
+
+// the one validation: each standard metadata key with a bad value is refused naming file, line, key
+TEST(LogValidation, BadMetadataValuesNameFileLineAndKey) {
+  const std::string header = "t,gyro1_x,gyro1_y,gyro1_z,gyro2_x,gyro2_y,gyro2_z,plat1_deg,plat2_deg\n";
+  const std::string row = "0,1,2,3,4,5,6,90,90\n";
+  struct Case {
+    const char* line;
+    const char* expect;
+  };
+  const Case cases[] = {
+      {"# sample_rate_hz: 0 0 1", "sample_rate_hz: expected a sample rate in Hz, > 0"},
+      {"# sample_rate_hz: 0", "sample_rate_hz: "},
+      {"# sample_rate_hz: -100", "sample_rate_hz: "},
+      {"# sample_rate_hz: inf", "sample_rate_hz: "},
+      {"# latitude_deg: 400", "latitude_deg: expected a latitude in deg within [-90, 90], got '400'"},
+      {"# latitude_deg: nan", "latitude_deg: "},
+      {"# hinge1_axis: nan", "hinge1_axis: expected three finite numbers 'x y z', not all zero"},
+      {"# hinge2_axis: 0 0 0", "hinge2_axis: expected three finite numbers"},
+      {"# hinge1_axis: 1 0", "hinge1_axis: "},
+      {"# hinge1_axis: 1 0 0 1", "hinge1_axis: "},
+      {"# gyro_full_scale_dps: 0", "gyro_full_scale_dps: "},
+      {"# sensors: 3", "sensors: expected 1 (single-sensor form) or 2"},
+      {"# complete: maybe", "complete: expected 'true' or 'false'"},
+      {"# duration_s: -5", "duration_s: "},
+  };
+  int n = 0;
+  for (const Case& c : cases) {
+    const auto path = temp_file("meta" + std::to_string(n++) + ".csv");
+    write_text(path, std::string("# format: driftless-log 1\n# source: test\n") + c.line + "\n" + header + row);
+    const std::string msg = message_of([&] { LogReader r(path); });
+    EXPECT_EQ(msg.rfind(path.string() + ":3: ", 0), 0u) << c.line << " -> " << msg;
+    EXPECT_NE(msg.find(c.expect), std::string::npos) << c.line << " -> " << msg;
+  }
+}
+
+TEST(LogValidation, RepeatedMetadataKeyNamesBothLines) {
+  const auto path = temp_file("repeat.csv");
+  write_text(path, "# format: driftless-log 1\n# latitude_deg: 52\n# source: a\n# latitude_deg: 10\n"
+                   "t,gyro1_x,gyro1_y,gyro1_z,gyro2_x,gyro2_y,gyro2_z,plat1_deg,plat2_deg\n");
+  EXPECT_EQ(message_of([&] { LogReader r(path); }),
+            path.string() + ":4: metadata key 'latitude_deg' repeats line 2 (each key once; see docs/log-format.md)");
+}
+
+TEST(LogValidation, GyroBeyondTheFullScaleIsRefusedWithItsLine) {
+  const std::string head = "# format: driftless-log 1\n# complete: true\n";
+  const std::string header = "t,gyro1_x,gyro1_y,gyro1_z,gyro2_x,gyro2_y,gyro2_z,plat1_deg,plat2_deg\n";
+  const auto path = temp_file("huge.csv");
+  write_text(path, head + header + "0,1,2,3,4,5,6,90,90\n0.01,1,2,3,4,1e308,6,90,90\n");
+  const std::string msg = message_of([&] {
+    LogReader r(path);
+    Sample s;
+    while (r.next(s)) {
+    }
+  });
+  EXPECT_EQ(msg.rfind(path.string() + ":5: column 'gyro2_y': 1e+308 deg/s is beyond 1.1 x the gyro full scale of "
+                                      "4000 deg/s assumed without a gyro_full_scale_dps key",
+                      0),
+            0u)
+      << msg;
+  // a stated full scale: +-250 deg/s; 260 is a saturated reading within the margin, 300 is not
+  const auto stated = temp_file("fs.csv");
+  write_text(stated, head + "# gyro_full_scale_dps: 250\n" + header + "0,250.1298,2,3,4,5,6,90,90\n" +
+                         "0.01,1,2,3,4,5,-260,90,90\n0.02,1,2,3,4,5,6,90,90\n");
+  LogReader r(stated);
+  Sample s;
+  while (r.next(s)) {
+  }
+  EXPECT_EQ(r.rows_saturated(), 2u);
+  write_text(stated, head + "# gyro_full_scale_dps: 250\n" + header + "0,300,2,3,4,5,6,90,90\n");
+  EXPECT_NE(message_of([&] {
+              LogReader r2(stated);
+              Sample s2;
+              r2.next(s2);
+            }).find(":5: column 'gyro1_x': 300 deg/s is beyond 1.1 x the gyro full scale of 250 deg/s stated"),
+            std::string::npos);
+}
+
+TEST(LogValidation, TimeGapsAreReportedWithTheirLines) {
+  const auto path = temp_file("gaps.csv");
+  std::string text = "# format: driftless-log 1\n# sample_rate_hz: 100\n"
+                     "t,gyro1_x,gyro1_y,gyro1_z,gyro2_x,gyro2_y,gyro2_z,plat1_deg,plat2_deg\n";
+  for (int i = 0; i < 5; ++i) text += std::to_string(0.01 * i) + ",0,0,0,0,0,0,90,90\n";
+  text += "1000000000,0,0,0,0,0,0,90,90\n1000000000.5,0,0,0,0,0,0,90,90\n";  // 0.5 s: below 1 s
+  write_text(path, text);
+  LogReader r(path);
+  Sample s;
+  while (r.next(s)) {
+  }
+  EXPECT_DOUBLE_EQ(r.gap_threshold_s(), 1.0);  // max(1 s, 10 / 100 Hz)
+  ASSERT_EQ(r.gap_count(), 1u);
+  EXPECT_EQ(r.gaps()[0].line, 9u);
+  EXPECT_NEAR(r.gaps()[0].t_before_s, 0.04, 1e-12);
+  EXPECT_NEAR(r.gaps()[0].length_s, 1e9 - 0.04, 1e-3);
+}
+
+TEST(LogValidation, ByteOrderMarkAndTextInUnknownColumnsAreAccepted) {
+  const auto path = temp_file("bom.csv");
+  write_text(path, "\xEF\xBB\xBFt,gyro1_x,gyro1_y,gyro1_z,gyro2_x,gyro2_y,gyro2_z,plat1_deg,plat2_deg,note\n"
+                   "0,1,2,3,4,5,6,90,90,standing still\n");
+  LogReader r(path);
+  Sample s;
+  ASSERT_TRUE(r.next(s));
+  EXPECT_EQ(s.gyro1_dps, Eigen::Vector3d(1, 2, 3));
+  EXPECT_TRUE(std::isnan(r.value(r.column_index("note"))));
+}
+
+TEST(LogValidation, WriterRefusesInvalidMetadata) {
+  Metadata meta;
+  meta.set("latitude_deg", "400");
+  const auto path = temp_file("writer_meta.csv");
+  EXPECT_NE(message_of([&] { LogWriter w(path, meta, 0); }).find("latitude_deg: "), std::string::npos);
+}
+
+// a log of one gyro triad: written, read back by readers that accept it, refused by the others
+TEST(LogSingleSensor, RoundTripAndRefusalByTwoSensorReaders) {
+  const auto path = temp_file("single.csv");
+  Metadata meta;
+  meta.set("sample_rate_hz", "100");
+  {
+    LogWriter w(path, meta, kLayoutSingleSensor | kFieldAccel | kFieldTemp | kFieldRefQ);
+    for (int i = 0; i < 3; ++i) w.write(make_sample(0.01 * i));
+    w.finish(true);
+  }
+  std::ifstream in(path);
+  std::string l1, l2, l3, l4, header;
+  std::getline(in, l1);
+  std::getline(in, l2);
+  std::getline(in, l3);
+  std::getline(in, l4);
+  std::getline(in, header);
+  EXPECT_EQ(l3, "# sensors: 1");
+  EXPECT_EQ(header, "t,gyro1_x,gyro1_y,gyro1_z,plat1_deg,ref_qw,ref_qx,ref_qy,ref_qz,accel1_x,accel1_y,accel1_z,temp1");
+  ReaderOptions single;
+  single.accept_single_sensor = true;
+  LogReader r(path, single);
+  EXPECT_EQ(r.sensors(), 1);
+  EXPECT_EQ(r.fields(), kLayoutSingleSensor | kFieldAccel | kFieldTemp | kFieldRefQ);
+  Sample s;
+  int n = 0;
+  while (r.next(s)) {
+    EXPECT_TRUE(s.gyro1_dps.allFinite());
+    EXPECT_TRUE(std::isnan(s.gyro2_dps.x()));
+    ++n;
+  }
+  EXPECT_EQ(n, 3);
+  EXPECT_EQ(r.rows_with_missing_gyro(), 0u);
+  EXPECT_NE(message_of([&] { LogReader two(path); })
+                .find(path.string() + ":3: sensors: a single-sensor log ('sensors: 1'); this command needs both gyro triads"),
+            std::string::npos);
+}
+
+TEST(LogSingleSensor, PlatformColumnIsOptionalAndSensorTwoColumnsAreRefused) {
+  const auto path = temp_file("single_min.csv");
+  write_text(path, "# sensors: 1\nt,gyro1_x,gyro1_y,gyro1_z\n0,1,2,3\n0.01,1,2,3\n");
+  ReaderOptions single;
+  single.accept_single_sensor = true;
+  LogReader r(path, single);
+  Sample s;
+  ASSERT_TRUE(r.next(s));
+  EXPECT_EQ(s.plat1_deg, 0.0);  // fixed to the box
+  write_text(path, "# sensors: 1\nt,gyro1_x,gyro1_y,gyro1_z,gyro2_x\n0,1,2,3,4\n");
+  EXPECT_NE(message_of([&] { LogReader r2(path, single); }).find(":2: column 'gyro2_x' in a single-sensor log"),
+            std::string::npos);
+}
+
+// RAII: a constructor that throws leaks no descriptor
+TEST(LogTest, RefusedHeadersLeakNoFileDescriptor) {
+  auto open_fds = [] {
+    std::size_t n = 0;
+    for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator("/proc/self/fd")) ++n;
+    return n;
+  };
+  const auto path = temp_file("leak.csv");
+  write_text(path, "# format: driftless-log 1\nt,gyro1_x\n0,1\n");
+  const std::size_t before = open_fds();
+  for (int i = 0; i < 100; ++i) EXPECT_FALSE(message_of([&] { LogReader r(path); }).empty());
+  EXPECT_EQ(open_fds(), before);
 }
 
 }  // namespace

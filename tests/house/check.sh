@@ -3,7 +3,8 @@
 #  1. dependencies point one way (estimator/ needs only Eigen and std; the simulation core knows
 #     nothing above it; nothing includes cli/);
 #  2. no function in the product is over 150 lines;
-#  3. each piece of shared physics is defined once: the old copies do not come back.
+#  3. each piece of shared physics is defined once: the old copies do not come back; every file
+#     the program writes goes through the one output helper (estimator/output_file.hpp).
 # Usage: check.sh SOURCE_DIR. Prints every violation with file:line and exits 1 if there is one.
 set -uo pipefail
 src=${1:?usage: check.sh SOURCE_DIR}
@@ -73,6 +74,7 @@ estimator/geometry.hpp|the Earth rate|Vector3d\(0(\.0)?, *-?std::(cos|sin)\(
 estimator/geometry.hpp|the eq. (5) flip cycle|\{ *\+1, *\+1, *-1, *-1 *\}|\{\{ *\+1, *\+1 *\}, *\{
 estimator/mpu6050.hpp|the MPU6050 DLPF table|13\.4e-3|0\.0134|18\.6e-3
 estimator/mpu6050.hpp|the MPU6050 sensitivities|131\.0, 65\.5|16384\.0|/ 340\.0|36\.53
+estimator/output_file.hpp estimator/output_file.cpp|writing a file (use the output helper: partial name, checked writes, rename)|std::ofstream|fmt::output_file|fopen\(.*"[wa]
 estimator/random.hpp estimator/random.cpp|the random generators|std::(normal|uniform_real)_distribution|std::mt19937|0x9E3779B97F4A7C15
 RULES
 exit $bad

@@ -29,8 +29,8 @@ check 'precision\(17\)|\{:\.17g\}|chars_format::general' 'estimator/numbers\.cpp
   'a second exact-number formatter (use exact_number)'
 # units: one table (estimator/units.cpp)
 check '\{"dps_rthz"|\{"dph", |"deg/s\^2", "deg/s2"' 'estimator/units\.cpp' 'a second unit table'
-# user input errors: one type (estimator/input_error.hpp)
-check 'class [A-Za-z]+ *: *public std::(runtime_error|invalid_argument)' 'estimator/input_error\.hpp|renders/gl_context\.hpp' \
+# user input errors: one type (estimator/input_error.hpp); a failed write (io::OutputError) is not input
+check 'class [A-Za-z]+ *: *public std::(runtime_error|invalid_argument)' 'estimator/input_error\.hpp|renders/gl_context\.hpp|estimator/output_file\.hpp' \
   'a new exception type for user input (use driftless::InputError)'
 
 # report plumbing (report/): one gnuplot runner, one JSON escaper and number, one HTML escaper

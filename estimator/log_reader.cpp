@@ -1,0 +1,355 @@
+// The log reader: metadata and header, then rows, each checked as it is read (docs/log-format.md,
+// "Validation"). Every command that reads a log goes through here.
+#include <algorithm>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <system_error>
+
+#include "estimator/fixed_decimal.hpp"
+#include "estimator/log.hpp"
+#include "estimator/log_columns.hpp"
+
+namespace driftless::log {
+namespace {
+
+constexpr std::size_t kChunkBytes = 1u << 20;
+constexpr std::string_view kUtf8Bom = "\xEF\xBB\xBF";
+
+std::string_view trim(std::string_view s) {
+  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
+  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
+  return s;
+}
+
+// parses a whole field as a double; empty or "nan" -> NaN. Returns false on junk.
+bool parse_field(const char* first, const char* last, double& out) {
+  while (first != last && (*first == ' ' || *first == '\t')) ++first;
+  while (last != first && (last[-1] == ' ' || last[-1] == '\t' || last[-1] == '\r')) --last;
+  if (first == last) {
+    out = kNaN;
+    return true;
+  }
+  return io::parse_decimal(first, last, out) == last;
+}
+
+std::string number_text(double v) {
+  char buf[64];
+  auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);
+  return ec == std::errc() ? std::string(buf, end) : std::string("?");
+}
+
+// a time as the log writes it (6 decimals), or the shortest form for absurd values
+std::string time_text(double t_s) {
+  if (!(std::fabs(t_s) < 1e15)) return number_text(t_s);
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.6f", t_s);
+  return buf;
+}
+
+}  // namespace
+
+LogReader::LogReader(const std::filesystem::path& path, ReaderOptions opts) : path_(path), opts_(opts) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) throw LogError(path.string(), 0, "", "no such file");
+  if (std::filesystem::is_directory(path, ec)) {
+    throw LogError(path.string(), 0, "", "is a directory, expected a driftless log (CSV)");
+  }
+  errno = 0;
+  file_.reset(std::fopen(path.c_str(), "rb"));
+  if (!file_) throw LogError(path.string(), 0, "", std::string("cannot open: ") + std::strerror(errno));
+  // chunks of 1 MiB, or the whole file when it is smaller
+  const auto size = std::filesystem::file_size(path, ec);
+  chunk_bytes_ = ec ? kChunkBytes : static_cast<std::size_t>(std::min<std::uintmax_t>(kChunkBytes, size + 1));
+  buf_.reserve(chunk_bytes_);
+  read_header();
+  map_columns();
+  validate_metadata(meta_, path_.string());
+  if (sensors() == 1 && !opts_.accept_single_sensor) {
+    throw LogError(path_.string(), meta_.line_of("sensors"), "sensors",
+                   "a single-sensor log ('sensors: 1'); this command needs both gyro triads "
+                   "(gyro1_*, gyro2_*; docs/log-format.md)");
+  }
+  const double rate = meta_.sample_rate_hz();
+  rate_stated_ = std::isfinite(rate);
+  gap_threshold_s_ = rate_stated_ ? std::max(kGapMinS, kGapIntervals / rate) : kGapMinS;
+  gyro_limit_dps_ = kFullScaleMargin * meta_.gyro_full_scale_dps();
+  if (meta_.has("gyro_full_scale_dps")) full_scale_dps_ = meta_.gyro_full_scale_dps();
+}
+
+LogReader::~LogReader() = default;
+
+std::string LogReader::where() const { return path_.string() + ":" + std::to_string(line_no_); }
+
+void LogReader::fail(std::string_view what) const { throw LogError(path_.string(), line_no_, "", std::string(what)); }
+
+int LogReader::column_index(std::string_view name) const {
+  for (std::size_t i = 0; i < columns_.size(); ++i) {
+    if (columns_[i] == name) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+// metadata lines, then the header row
+void LogReader::read_header() {
+  std::string_view line;
+  bool saw_any = false;
+  while (read_line(line)) {
+    if (line_no_ == 1 && line.substr(0, kUtf8Bom.size()) == kUtf8Bom) line.remove_prefix(kUtf8Bom.size());
+    saw_any = true;
+    const std::string_view t = trim(line);
+    if (t.empty()) continue;
+    if (t.front() == '#') {
+      parse_header_line(t);
+      continue;
+    }
+    std::size_t start = 0;
+    while (start <= t.size()) {
+      std::size_t comma = t.find(',', start);
+      if (comma == std::string_view::npos) comma = t.size();
+      columns_.emplace_back(trim(t.substr(start, comma - start)));
+      start = comma + 1;
+    }
+    return;
+  }
+  if (!saw_any) {
+    throw LogError(path_.string(), 0, "", "empty file; expected '# format: driftless-log 1' metadata "
+                   "and a header row (see docs/log-format.md)");
+  }
+  fail("no header row; expected a CSV header naming the columns (t, gyro1_x, ...)");
+}
+
+// columns -> places in a Sample; the required ones must be there, unknown ones are kept as values
+void LogReader::map_columns() {
+  const bool single = meta_.sensors() == 1;
+  target_.assign(columns_.size(), nullptr);
+  parse_.assign(columns_.size(), 2);
+  std::vector<bool> seen(detail::kColumns.size(), false);
+  for (std::size_t c = 0; c < columns_.size(); ++c) {
+    for (std::size_t k = 0; k < detail::kColumns.size(); ++k) {
+      if (columns_[c] != detail::kColumns[k].name) continue;
+      if (seen[k]) fail("column '" + columns_[c] + "' appears twice in the header");
+      if (single && detail::kColumns[k].sensor == 2) {
+        fail("column '" + columns_[c] + "' in a single-sensor log ('sensors: 1' has no sensor-2 columns)");
+      }
+      seen[k] = true;
+      const std::uint32_t group = detail::kColumns[k].field;
+      const bool wanted = group == 0 || (opts_.fields & group) != 0;
+      parse_[c] = wanted ? 1 : 0;
+      if (wanted) target_[c] = &detail::column_slot(row_sample_, k);
+    }
+  }
+  std::string missing;
+  for (std::size_t k = 0; k < detail::kColumns.size(); ++k) {
+    if (detail::column_required(k, single) && !seen[k]) {
+      missing += (missing.empty() ? "" : ", ") + std::string(detail::kColumns[k].name);
+    }
+  }
+  if (!missing.empty()) {
+    fail("header lacks required column(s) " + missing +
+         (single ? " (required in the single-sensor form: t, gyro1_x..gyro1_z"
+                 : " (required: t, gyro1_x..gyro2_z, plat1_deg, plat2_deg") +
+         "; see docs/log-format.md)");
+  }
+  if (single) {
+    fields_ |= kLayoutSingleSensor;
+    if (!seen[detail::kPlat1Column]) row_sample_.plat1_deg = 0.0;  // the sensor is fixed to the box
+  }
+  // an optional group counts only when all its columns (of the sensors present) are there
+  for (std::uint32_t bit = 1; bit <= kFieldTruePlat; bit <<= 1) {
+    bool all = true;
+    for (std::size_t k = 0; k < detail::kColumns.size(); ++k) {
+      if (detail::kColumns[k].field == bit && !seen[k] && !(single && detail::kColumns[k].sensor == 2)) all = false;
+    }
+    if (all && (opts_.fields & bit) != 0) fields_ |= bit;
+  }
+  row_.assign(columns_.size(), kNaN);
+}
+
+void LogReader::parse_header_line(std::string_view line) {
+  line.remove_prefix(1);  // '#'
+  const auto colon = line.find(':');
+  if (colon == std::string_view::npos) return;  // a plain comment
+  const std::string_view key = trim(line.substr(0, colon));
+  const std::string_view value = trim(line.substr(colon + 1));
+  if (key.empty() || key.find(' ') != std::string_view::npos) return;  // prose, not metadata
+  if (key == "event") {
+    events_.push_back(Event{rows_ ? last_t_ : kNaN, std::string(value), line_no_});
+  } else if (key == "incomplete") {
+    meta_.set("incomplete_reason", std::string(value), line_no_);
+  } else if (rows_ == 0) {
+    if (const std::size_t first = meta_.line_of(key); meta_.has(key)) {
+      fail("metadata key '" + std::string(key) + "' repeats line " + std::to_string(first) +
+           " (each key once; see docs/log-format.md)");
+    }
+    meta_.set(std::string(key), std::string(value), line_no_);
+  }
+}
+
+bool LogReader::read_line(std::string_view& line) {
+  for (;;) {
+    const std::size_t nl = buf_.find('\n', buf_pos_);
+    if (nl != std::string::npos) {
+      line = std::string_view(buf_).substr(buf_pos_, nl - buf_pos_);
+      buf_pos_ = nl + 1;
+      ++line_no_;
+      return true;
+    }
+    if (eof_) {
+      if (buf_pos_ < buf_.size()) {
+        line = std::string_view(buf_).substr(buf_pos_);
+        buf_pos_ = buf_.size();
+        ++line_no_;
+        last_line_unterminated_ = true;
+        return true;
+      }
+      return false;
+    }
+    // refill: keep the unread tail, append a new chunk
+    buf_.erase(0, buf_pos_);
+    buf_pos_ = 0;
+    const std::size_t old = buf_.size();
+    buf_.resize(old + chunk_bytes_);
+    errno = 0;
+    const std::size_t got = std::fread(buf_.data() + old, 1, chunk_bytes_, file_.get());
+    buf_.resize(old + got);
+    if (got == 0) {
+      if (std::ferror(file_.get())) fail(std::string("read error: ") + std::strerror(errno));
+      eof_ = true;
+    }
+  }
+}
+
+// splits a row into row_ (every column); false with `problem` set on a malformed row
+bool LogReader::split_row(std::string_view line, std::string& problem) {
+  const char* p = line.data();
+  const char* const end = line.data() + line.size();
+  std::size_t col = 0;
+  for (;;) {
+    if (col < columns_.size() && parse_[col] == 0) {
+      // a column the caller does not use: skipped unparsed
+      const char* comma = static_cast<const char*>(std::memchr(p, ',', static_cast<std::size_t>(end - p)));
+      ++col;
+      if (comma == nullptr) break;
+      p = comma + 1;
+      continue;
+    }
+    if (col < columns_.size()) {
+      // the common case: a plain number right up to the comma
+      const char* q = io::parse_decimal(p, end, row_[col]);
+      if (q != nullptr && q != end && *q == ',') {
+        ++col;
+        p = q + 1;
+        continue;
+      }
+    }
+    const char* comma = static_cast<const char*>(std::memchr(p, ',', static_cast<std::size_t>(end - p)));
+    const char* field_end = comma != nullptr ? comma : end;
+    if (col >= columns_.size()) {
+      problem = "expected " + std::to_string(columns_.size()) + " fields as in the header, got more";
+      return false;
+    }
+    if (!parse_field(p, field_end, row_[col])) {
+      if (parse_[col] == 1) {
+        problem = "column '" + columns_[col] + "': expected a number, got '" + std::string(p, field_end) + "'";
+        return false;
+      }
+      row_[col] = kNaN;  // an unknown column may hold text: ignored
+    }
+    ++col;
+    if (comma == nullptr) break;
+    p = comma + 1;
+  }
+  if (col != columns_.size()) {
+    problem = "expected " + std::to_string(columns_.size()) + " fields as in the header, got " + std::to_string(col);
+    return false;
+  }
+  return true;
+}
+
+// the per-row checks: time, gaps, gyro plausibility against the full scale
+void LogReader::check_row(const Sample& s) {
+  if (!std::isfinite(s.t_s)) fail("column 't': expected a time in seconds, got an empty or non-finite value");
+  if (!(s.t_s > last_t_)) {
+    fail("t = " + time_text(s.t_s) + " s is not greater than the previous t = " + time_text(last_t_) +
+         " s (time must increase strictly)");
+  }
+  if (rows_ > 0) {
+    const double dt = s.t_s - last_t_;
+    if (!rate_stated_ && dt < min_dt_s_) {
+      // no stated rate: the shortest interval so far stands for the sample interval
+      min_dt_s_ = dt;
+      gap_threshold_s_ = std::max(kGapMinS, kGapIntervals * min_dt_s_);
+    }
+    if (dt > gap_threshold_s_) {
+      ++gap_count_;
+      if (gaps_.size() < kMaxGapsKept) gaps_.push_back(Gap{last_t_, dt, line_no_});
+    }
+  }
+  const int n = sensors() == 1 ? 3 : 6;
+  bool missing = false, saturated = false;
+  for (int i = 0; i < n; ++i) {
+    const double v = i < 3 ? s.gyro1_dps[i] : s.gyro2_dps[i - 3];
+    if (std::isnan(v)) {
+      missing = true;
+      continue;
+    }
+    const double a = std::fabs(v);
+    if (!(a <= gyro_limit_dps_)) {
+      fail(std::string("column '") + (i < 3 ? "gyro1_" : "gyro2_") + "xyz"[i % 3] + "': " + number_text(v) +
+           " deg/s is beyond " + number_text(kFullScaleMargin) + " x the gyro full scale of " +
+           number_text(meta_.gyro_full_scale_dps()) + " deg/s" +
+           (meta_.has("gyro_full_scale_dps") ? " stated in gyro_full_scale_dps"
+                                              : " assumed without a gyro_full_scale_dps key") +
+           "; not a reading a gyro can give (see docs/log-format.md)");
+    }
+    saturated = saturated || a >= full_scale_dps_;
+  }
+  missing_gyro_rows_ += missing ? 1 : 0;
+  saturated_rows_ += saturated ? 1 : 0;
+}
+
+bool LogReader::next(Sample& out) {
+  std::string_view line;
+  for (;;) {
+    if (!read_line(line)) return false;
+    const std::string_view t = trim(line);
+    if (t.empty()) continue;
+    if (t.front() == '#') {
+      parse_header_line(t);
+      continue;
+    }
+    break;
+  }
+  std::string problem;
+  const bool ok = split_row(line, problem);
+  // the writer ends every row with a newline: an unterminated last line of an incomplete log
+  // was cut mid-write, even when what is left happens to parse
+  if (last_line_unterminated_ && !meta_.complete() && opts_.tolerate_truncated_tail) {
+    dropped_truncated_ = true;
+    return false;
+  }
+  if (!ok) fail(problem);
+  for (std::size_t c = 0; c < columns_.size(); ++c) {
+    if (target_[c] != nullptr) *target_[c] = row_[c];
+  }
+  check_row(row_sample_);
+  out = row_sample_;
+  last_t_ = out.t_s;
+  ++rows_;
+  return true;
+}
+
+std::vector<Sample> read_all(const std::filesystem::path& path, Metadata* meta, std::uint32_t* fields,
+                             ReaderOptions opts) {
+  LogReader reader(path, opts);
+  std::vector<Sample> out;
+  Sample s;
+  while (reader.next(s)) out.push_back(s);
+  if (meta != nullptr) *meta = reader.metadata();
+  if (fields != nullptr) *fields = reader.fields();
+  return out;
+}
+
+}  // namespace driftless::log
