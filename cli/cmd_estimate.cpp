@@ -32,7 +32,7 @@ struct EstimateArgs {
   std::string config;
   std::string calib;  // calib.yaml from driftless calibrate (docs/calibration.md)
   bool plot = false;
-  bool corrected = true;  // write corrected.csv
+  bool corrected = false;  // write corrected.csv (--corrected)
   bool strict = false;    // exit 1 on a degraded health verdict too (failed always exits 1)
   std::string tune;       // "auto": noise density and bias wander from the log (docs/estimator.md section 6.2)
   double attitude_start_sigma_dps = est::EstimateRunOptions{}.attitude_start_sigma_dps;
@@ -199,7 +199,7 @@ const bool registered = register_command(30, [](CLI::App& app) {
   cmd->add_option("--log", a->log, "Measurement log (CSV, driftless-log 1; docs/log-format.md)")
       ->required()
       ->check(CLI::ExistingFile);
-  cmd->add_option("--out", a->out, "Output folder (created): estimate.csv, corrected.csv, summary.json")
+  cmd->add_option("--out", a->out, "Output folder (created): estimate.csv, attitude.csv, summary.json [, corrected.csv]")
       ->required();
   cmd->add_option("--mode", a->mode,
                   "paper: eq. (5) switching with 6-dim stacked residuals, printed recursion; "
@@ -214,9 +214,10 @@ const bool registered = register_command(30, [](CLI::App& app) {
                   "sensor and end stop (deg/s in, deg/s out) replace the hinge rotations; "
                   "docs/calibration.md")
       ->check(CLI::ExistingFile);
-  cmd->add_flag("!--no-corrected", a->corrected,
-                "Skip corrected.csv (one row per log row, about 110 bytes each: 0.6 GB for a 14 h log at "
-                "100 Hz); the bias estimates are in estimate.csv either way");
+  cmd->add_flag("--corrected", a->corrected,
+                "Also write corrected.csv: the corrected gyro and fused rates per log row (deg/s), about "
+                "110 bytes a row (0.6 GB for a 14 h log at 100 Hz); the bias estimates are in estimate.csv "
+                "either way");
   cmd->add_flag("--plot", a->plot,
                 "Also write Fig. 4 (bias vs truth, deg/s), Fig. 5 (Allan deviation, deg/s vs s) and "
                 "Fig. 9 (attitude error, deg vs s) as PNG + SVG with their gnuplot scripts");

@@ -118,7 +118,8 @@ int run_sweep(const Options& opt) {
   }
   try {
     const SweepJob job =
-        make_job(cfg, opt.save_logs ? std::filesystem::path(opt.out) / "logs" : std::filesystem::path());
+        make_job(cfg, opt.save_logs ? std::filesystem::path(opt.out) / "logs" : std::filesystem::path(),
+                 &stop_requested());
     Progress progress(fmt::format("sweep {} (rank 0 share)", cfg.name));
     mine.results = run_parallel(
         specs, indices, job, threads,

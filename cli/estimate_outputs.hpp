@@ -21,7 +21,7 @@ namespace driftless::cli {
 /// What the per-sample outputs hold.
 struct EstimateFilesOptions {
   bool truth = false;         // estimate.csv gets the true_bias columns
-  bool corrected = true;      // write corrected.csv (--no-corrected skips it)
+  bool corrected = false;     // write corrected.csv (--corrected)
   bool keep_series = false;   // collect the Fig. 5 series (--plot)
   double t_end_s = kNaN;      // s, for the progress display (the log's duration_s)
 };

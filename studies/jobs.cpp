@@ -307,11 +307,11 @@ Metrics evaluate_fdi(const RunSetup& setup, const log::Metadata& meta, const Sam
   return m;
 }
 
-SweepJob make_job(const SweepConfig& cfg, const std::filesystem::path& log_dir) {
+SweepJob make_job(const SweepConfig& cfg, const std::filesystem::path& log_dir, const std::atomic<bool>* stop) {
   auto builder = std::make_shared<SetupBuilder>(cfg);
   if (!log_dir.empty()) std::filesystem::create_directories(log_dir);
   const std::string runner = cfg.runner;
-  return [builder, runner, log_dir](const RunSpec& spec) {
+  return [builder, runner, log_dir, stop](const RunSpec& spec) {
     const RunSetup setup = builder->build(spec);
     std::unique_ptr<Simulator> sim;
     std::unique_ptr<twin::FastBox> box;
@@ -325,6 +325,13 @@ SweepJob make_job(const SweepConfig& cfg, const std::filesystem::path& log_dir) 
       box = std::make_unique<twin::FastBox>(setup.scenario);
       meta = box->metadata();
       next = [&](Sample& s) { return box->next(s); };
+    }
+    // a stop request ends the run in progress at its next sample (a 14 h run would otherwise finish first)
+    if (stop != nullptr) {
+      next = [inner = std::move(next), stop](Sample& s) {
+        if (stop->load(std::memory_order_relaxed)) throw std::runtime_error("stopped");
+        return inner(s);
+      };
     }
     std::unique_ptr<log::LogWriter> writer;
     SampleSource source = next;

@@ -3,6 +3,7 @@
 // (and the fault detector), and score it against the truth. Metrics: docs/sweep.md.
 #pragma once
 
+#include <atomic>
 #include <functional>
 #include <string>
 
@@ -56,7 +57,9 @@ Metrics evaluate_fdi(const RunSetup& setup, const log::Metadata& meta, const Sam
 
 /// The job of a sweep's runner (fast | twin | fdi | fdi_twin). With `log_dir` set, every run also writes its
 /// samples to log_dir/run_<index>.csv (driftless-log 1) for `driftless estimate` / `allan`, and
-/// (runners fast, twin) its attitude errors to log_dir/attitude_<index>.csv.
-SweepJob make_job(const SweepConfig& cfg, const std::filesystem::path& log_dir = {});
+/// (runners fast, twin) its attitude errors to log_dir/attitude_<index>.csv. When `stop` becomes true
+/// (Ctrl-C) a run in progress ends at its next sample and throws "stopped" (the runner marks it failed).
+SweepJob make_job(const SweepConfig& cfg, const std::filesystem::path& log_dir = {},
+                  const std::atomic<bool>* stop = nullptr);
 
 }  // namespace driftless::studies

@@ -5,7 +5,7 @@ set -euo pipefail
 bin=$1; src=$2
 golden=$src/tests/data/estimator_golden
 out=$(mktemp -d); trap 'rm -rf "$out"' EXIT
-"$bin" estimate --log "$golden/log.csv" --out "$out" > "$out/stdout.txt"
+"$bin" estimate --log "$golden/log.csv" --out "$out" --corrected > "$out/stdout.txt"
 if [[ -n "${DRIFTLESS_UPDATE_GOLDEN:-}" ]]; then
   cp "$out/estimate.csv" "$golden/estimate.csv"
   echo "updated $golden/estimate.csv"
@@ -24,6 +24,6 @@ done
 jq -e '.truth.bias_error_rms_second_half_dps < 0.01 and .updates > 10 and .rejected == 0' \
   "$out/summary.json" > /dev/null || { echo "FAIL: golden run did not converge"; cat "$out/summary.json"; exit 1; }
 # a second run is byte-identical (determinism)
-"$bin" estimate --log "$golden/log.csv" --out "$out/again" > /dev/null
+"$bin" estimate --log "$golden/log.csv" --out "$out/again" --corrected > /dev/null
 cmp -s "$out/corrected.csv" "$out/again/corrected.csv" || { echo "FAIL: rerun differs"; exit 1; }
 echo "ok"

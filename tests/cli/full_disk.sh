@@ -35,7 +35,7 @@ expect_full() {
 expect_full simulate "$bin" simulate --scenario default --duration 120 --seed 3 --out "$disk/sim"
 grep -q "^# complete: false" "$disk/sim/log.csv" || fail "simulate: the log on the full disk does not say complete: false"
 
-expect_full estimate "$bin" estimate --log "$t/sim/log.csv" --out "$disk/est"
+expect_full estimate "$bin" estimate --log "$t/sim/log.csv" --out "$disk/est" --corrected
 for f in corrected.csv estimate.csv attitude.csv summary.json; do
   [[ ! -e $disk/est/$f ]] || fail "estimate: $f looks complete on a full disk"
 done

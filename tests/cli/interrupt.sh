@@ -41,7 +41,7 @@ awk 'BEGIN { print "# format: driftless-log 1"; print "# complete: false"; print
              print "t,gyro1_x,gyro1_y,gyro1_z,gyro2_x,gyro2_y,gyro2_z,plat1_deg,plat2_deg";
              for (i = 0; ; i++) printf "%.2f,0.5,-0.3,0.8,-0.6,0.4,0.2,90,90\n", i * 0.01 }' > "$t/stream.csv" 2>/dev/null &
 pids+=("$!")
-"$bin" estimate --log "$t/stream.csv" --out "$t/est" > /dev/null 2> "$t/est.err" &
+"$bin" estimate --log "$t/stream.csv" --out "$t/est" --corrected > /dev/null 2> "$t/est.err" &
 pid=$!; pids+=("$pid")
 wait_for "$t/est/config_used.txt"; sleep 1
 stop "$pid" TERM 143 est
@@ -71,4 +71,32 @@ pid=$!; pids+=("$pid")
 sleep 2
 stop "$pid" TERM 143 r
 no_partials "$t/r" render
+# sweep of long runs: SIGINT -> 130 within seconds (the run in progress stops too), the table is
+# written with the unfinished runs marked failed
+cat > "$t/sweep.yaml" <<YAML
+name: interrupt_test
+runner: fast
+scenario: static
+duration_s: 200000
+monte_carlo: 2
+seed: 3
+grid:
+  flip_angle_deg: {set: flip_schedule.flip_angle_deg, values: [90]}
+YAML
+"$bin" sweep --config "$t/sweep.yaml" --out "$t/sw" --jobs 1 --no-plots > /dev/null 2> "$t/sw.err" &
+pid=$!; pids+=("$pid")
+sleep 2
+started=$SECONDS
+stop "$pid" INT 130 sw
+(( SECONDS - started <= 5 )) || fail "sweep: took $(( SECONDS - started )) s to stop"
+[[ $(grep -c ",failed: stopped" "$t/sw/runs.csv") -eq 2 ]] || { cat "$t/sw/runs.csv"; fail "sweep: runs.csv does not mark the stopped runs"; }
+no_partials "$t/sw" sweep
+
+# demo: SIGTERM while it simulates -> 143, the log says complete: false
+"$bin" demo --out "$t/demo" --duration 100000 --no-video > /dev/null 2> "$t/demo.err" &
+pid=$!; pids+=("$pid")
+wait_for "$t/demo/sim/log.csv"; sleep 0.5
+stop "$pid" TERM 143 demo
+grep -q "^# complete: false" "$t/demo/sim/log.csv" || fail "demo: the stopped simulation's log does not say complete: false"
+no_partials "$t/demo" demo
 echo "interrupt: ok"
