@@ -1,77 +1,93 @@
-// driftless diagnose: find the effect the model misses and (with --apply) write the model with it.
-#include <cmath>
+// driftless diagnose: find the effects the model misses and (with --apply) write the model with
+// all of them, then compare again (docs/compare.md).
+#include <cstdio>
 #include <memory>
-#include <stdexcept>
 #include <string>
 
 #include <fmt/core.h>
 
 #include "cli/command.hpp"
-#include "diagnose/compare.hpp"
+#include "cli/compare_run.hpp"
+#include "diagnose/apply.hpp"
 #include "diagnose/report.hpp"
 
 namespace driftless::cli {
 namespace {
 
-struct DiagnoseArgs {
-  std::string log, model, out, apply;
-  bool resample = false;
-  double threshold = 10.0;
+struct Args {
+  CompareArgs common;
+  std::string apply;
 };
 
-int run_diagnose(const DiagnoseArgs& a) {
-  Progress progress("diagnose");
-  diagnose::CompareModel model = a.model.empty() ? diagnose::default_compare_model() : diagnose::load_compare_model(a.model);
-  diagnose::CompareOptions opt;
-  opt.evidence_threshold = a.threshold;
-  opt.replay.model_sample_rate_hz = model.sample_rate_hz;
-  opt.replay.resample = a.resample;
-  if (std::isfinite(model.latitude_deg)) opt.replay.default_latitude_deg = model.latitude_deg;
-  const diagnose::Replay replay = diagnose::replay_log(a.log, opt.replay);
-  for (const auto& n : replay.notes) fmt::print("note: {}\n", n);
-  const diagnose::CompareResult r = diagnose::compare(replay, model, opt);
-  progress.update(0.5, "compared");
-  fmt::print("{}: {}\n", r.verdict, r.statement);
-  int top = 0;
-  for (const auto& c : r.ranking) {
-    if (++top > 5) break;
-    fmt::print("  {}. {:<22} sensor {:<4} axis {:<14} evidence {:>12.1f}  explains {:5.1f} %\n", top, c.effect, c.sensor, c.axis,
-               c.evidence, 100.0 * c.explained_fraction);
+// writes the selected set into a copy of the model, saves it, compares again; the exit code
+// says whether the written model explains the log
+int apply_and_check(const Args& a, const CompareSetup& s, const diagnose::CompareResult& r, diagnose::ReportExtras& x) {
+  diagnose::CompareModel updated = s.model;
+  const diagnose::ApplyReport rep = diagnose::apply_result(updated, r);
+  diagnose::save_compare_model(updated, a.apply);
+  updated.source = a.apply;
+  const diagnose::CompareResult after = diagnose::compare(s.replay, updated, s.opt);
+  x.after = &after;
+  x.after_model = a.apply;
+  x.applied = rep.written;
+  x.skipped = rep.skipped;
+  diagnose::write_report(r, a.common.out, x);
+  if (rep.written.empty()) fmt::print("nothing to apply; wrote {} unchanged\n", a.apply);
+  for (const auto& w : rep.written) fmt::print("wrote {}\n", w);
+  for (const auto& w : rep.skipped) fmt::print(stderr, "not written: {}\n", w);
+  fmt::print("{}: after --apply: {}: {}\n", a.apply, diagnose::verdict_id(after.verdict), after.statement);
+  if (!rep.complete()) {
+    fmt::print(stderr, "driftless diagnose: {} holds only part of the selected effects (see above)\n", a.apply);
+    return 1;
   }
-  if (!a.apply.empty()) {
-    if (r.verdict != "missing_effect") {
-      diagnose::write_report(r, a.out);
-      throw std::runtime_error(fmt::format("--apply: nothing to apply ({}); {} not written", r.verdict, a.apply));
-    }
-    const diagnose::Candidate& best = r.ranking.front();
-    diagnose::CompareModel updated = model;
-    diagnose::apply_candidate(updated, best);
-    diagnose::save_compare_model(updated, a.apply);
-    updated.source = a.apply;
-    const diagnose::CompareResult after = diagnose::compare(replay, updated, opt);
-    diagnose::ReportExtras x{&after, a.apply, fmt::format("{} on sensor {} axis {}", best.effect, best.sensor, best.axis)};
-    diagnose::write_report(r, a.out, x);
-    fmt::print("wrote {} with {} added; after: {}: {}\n", a.apply, best.effect, after.verdict, after.statement);
-  } else {
-    diagnose::write_report(r, a.out);
+  if (after.verdict != diagnose::Verdict::kConsistent) {
+    fmt::print(stderr, "driftless diagnose: the model written to {} does not yet explain the log ({}); run diagnose "
+               "again with --model {}\n", a.apply, diagnose::verdict_id(after.verdict), a.apply);
+    return 1;
   }
-  progress.done();
-  fmt::print("wrote {}/report.html and {}/diagnosis.json\n", a.out, a.out);
   return 0;
 }
 
+int run_diagnose(const Args& a) {
+  Progress progress("diagnose");
+  const CompareSetup s = setup_compare(a.common);
+  const diagnose::CompareResult r = diagnose::compare(s.replay, s.model, s.opt);
+  progress.update(0.5, "compared");
+  print_result(r);
+  diagnose::ReportExtras x;
+  x.command = "diagnose";
+  int code = 0;
+  if (!a.apply.empty()) {
+    code = apply_and_check(a, s, r, x);
+  } else {
+    diagnose::write_report(r, a.common.out, x);
+  }
+  progress.done();
+  fmt::print("wrote {}/report.html and {}/diagnosis.json\n", a.common.out, a.common.out);
+  if (const std::string why = doubt(r); !why.empty()) {
+    fmt::print(stderr, "driftless diagnose: {}; see {}/report.html\n", why, a.common.out);
+    return 1;
+  }
+  return code;
+}
+
 const bool registered = register_command(51, [](CLI::App& app) {
-  auto* cmd = app.add_subcommand("diagnose", "Find the physical effect the model misses (ranked by evidence) and, with "
-                                             "--apply, write the model with the winner added (docs/compare.md)");
-  auto a = std::make_shared<DiagnoseArgs>();
-  cmd->add_option("--log", a->log, "Measurement log (CSV, driftless-log 1; gyro in deg/s)")->required()->check(CLI::ExistingFile);
-  cmd->add_option("--model", a->model, "Model or scenario YAML; default: embedded nominal MPU6050 at 100 Hz (datasheet "
-                  "noise, bias instability, turn-on bias; scale, cross-axis, g-sensitivity, "
-                  "temperature coefficients at zero; docs/compare.md)")->check(CLI::ExistingFile);
-  cmd->add_option("--out", a->out, "Output directory (report.html, diagnosis.json, plots/)")->required();
-  cmd->add_option("--apply", a->apply, "Write the model with the best candidate's fitted parameters added to this YAML file");
-  cmd->add_flag("--resample", a->resample, "Resample a log whose rate differs from the model's (else it is refused)");
-  cmd->add_option("--threshold", a->threshold, "Evidence above which an effect is missing (default 10)");
+  auto* cmd = app.add_subcommand("diagnose", "Find the effects the model misses (forward selection: physical and signal-chain "
+                                             "effects first, then the noise model) and, with --apply, write the model with "
+                                             "all of them and compare again (docs/compare.md)");
+  auto a = std::make_shared<Args>();
+  cmd->add_option("--log", a->common.log, "Measurement log (CSV, driftless-log 1; gyro in deg/s)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--model", a->common.model, "Model or scenario YAML; default: embedded nominal MPU6050 (datasheet noise, "
+                  "bias instability, turn-on bias, DLPF_CFG 3; scale, cross-axis, g-sensitivity, temperature coefficients "
+                  "at zero; docs/compare.md). The model runs at the log's rate")->check(CLI::ExistingFile);
+  cmd->add_option("--out", a->common.out, "Output directory (report.html, diagnosis.json, plots/)")->required();
+  cmd->add_option("--apply", a->apply, "Write the model with every selected effect and noise-model change to this YAML "
+                  "file, then compare again; exit 1 unless the new model is consistent with the log");
+  cmd->add_flag("--resample", a->common.resample, "Resample the log to the sample_rate_hz the model file states (default: "
+                "the model runs at the log's rate)");
+  cmd->add_option("--block", a->common.block_s, "Block length of the residual fits, s (default 0.1)")->check(positive_number("s"));
+  cmd->add_option("--threshold", a->common.threshold, "Evidence above which an effect is selected (default 10)")
+      ->check(CLI::NonNegativeNumber);
   return [a] { return run_diagnose(*a); };
 });
 

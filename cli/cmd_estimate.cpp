@@ -13,9 +13,11 @@
 
 #include "cli/command.hpp"
 #include "cli/estimate_figures.hpp"
+#include "cli/estimate_health.hpp"
 #include "cli/estimate_outputs.hpp"
 #include "estimator/calibration.hpp"
 #include "estimator/pipeline.hpp"
+#include "estimator/tune.hpp"
 #include "calibration/calib_file.hpp"
 
 namespace driftless::cli {
@@ -31,10 +33,43 @@ struct EstimateArgs {
   std::string calib;  // calib.yaml from driftless calibrate (docs/calibration.md)
   bool plot = false;
   bool corrected = false;  // write corrected.csv (--corrected)
+  bool strict = false;    // exit 1 on a degraded health verdict too (failed always exits 1)
+  std::string tune;       // "auto": noise density and bias wander from the log (docs/estimator.md section 6.2)
   double attitude_start_sigma_dps = est::EstimateRunOptions{}.attitude_start_sigma_dps;
 };
 
 bool stop_polled() { return stop_requested().load(); }
+
+// --tune auto: a first pass over the log measures N and K (docs/estimator.md section 6.2)
+est::TuneResult tune_config(const EstimateArgs& a, est::EstimatorConfig& cfg) {
+  log::LogReader first(a.log);
+  const est::TuneResult t = est::tune_from_log(first, cfg);
+  est::apply_tune(t, cfg);
+  cfg.validate();
+  fmt::print("tune auto: noise density {} ({} block pairs of {:g} s), bias random walk Q {} ({} revisits)\n",
+             t.noise_estimated ? fmt::format("{:.4g} deg/s/sqrt(Hz)", t.noise_density_dps_rthz)
+                               : "not measured, configured value kept",
+             t.noise_block_pairs, t.block_s,
+             t.q_estimated ? fmt::format("{:.4g} (deg/s)^2/s", t.q_dps2_per_s) : "not measured, configured value kept",
+             t.wander_pairs);
+  return t;
+}
+
+// the health verdict on the console; the exit code: failed always 1, degraded 1 with --strict
+int report_health(const EstimateArgs& a, const est::EstimatorConfig& cfg, const est::HealthReport& h) {
+  const auto lines = health_lines(h, cfg);
+  const bool bad = h.verdict != est::HealthVerdict::kOk;
+  for (const auto& l : lines) fmt::print(bad ? stderr : stdout, "{}{}\n", bad ? "driftless estimate: " : "  ", l);
+  if (h.verdict == est::HealthVerdict::kFailed) {
+    fmt::print(stderr, "driftless estimate: the filter never locked: the estimates are not usable (exit 1)\n");
+    return kExitFailed;
+  }
+  if (h.verdict == est::HealthVerdict::kDegraded && a.strict) {
+    fmt::print(stderr, "driftless estimate: health degraded and --strict given (exit 1)\n");
+    return kExitFailed;
+  }
+  return kExitOk;
+}
 
 int run_estimate_cmd(const EstimateArgs& a) {
   est::EstimatorConfig cfg;
@@ -69,6 +104,8 @@ int run_estimate_cmd(const EstimateArgs& a) {
     if (c.has_g_sensitivity) cfg.calibration.G_dps_per_g = c.G_dps_per_g;
   }
   cfg.validate();
+  est::TuneResult tune;
+  if (a.tune == "auto") tune = tune_config(a, cfg);
 
   const bool truth = (reader.fields() & kFieldTrueBias) != 0;
   const bool attitude = (reader.fields() & kFieldRefQ) != 0;
@@ -120,6 +157,8 @@ int run_estimate_cmd(const EstimateArgs& a) {
   ctx.complete = !interrupted;
   ctx.stopped_at_t_s = summary.t_last_s;
   ctx.figures = &figures;
+  ctx.config = &cfg;
+  ctx.tune = a.tune == "auto" ? &tune : nullptr;
   write_estimate_summary(dir / "summary.json", ctx, final_summary);
 
   for (const auto& w : warnings) fmt::print(stderr, "driftless estimate: warning: {}\n", w);
@@ -147,7 +186,9 @@ int run_estimate_cmd(const EstimateArgs& a) {
              interrupted ? fmt::format(" (interrupted at t = {:.3f} s: summary.json says complete: false)",
                                        summary.t_last_s)
                          : "");
-  return interrupted ? interrupted_exit_code() : kExitOk;
+  if (interrupted) return interrupted_exit_code();
+  std::fflush(stdout);
+  return report_health(a, cfg, summary.health);
 }
 
 const bool registered = register_command(30, [](CLI::App& app) {
@@ -180,6 +221,14 @@ const bool registered = register_command(30, [](CLI::App& app) {
   cmd->add_flag("--plot", a->plot,
                 "Also write Fig. 4 (bias vs truth, deg/s), Fig. 5 (Allan deviation, deg/s vs s) and "
                 "Fig. 9 (attitude error, deg vs s) as PNG + SVG with their gnuplot scripts");
+  cmd->add_flag("--strict", a->strict,
+                "Exit 1 when the health verdict is 'degraded' too (gate rejections, NIS outside its "
+                "band, unobservable components, re-locks); 'failed' (never locked) always exits 1");
+  cmd->add_option("--tune", a->tune,
+                  "auto: measure the noise density (deg/s/sqrt(Hz)) and the bias random walk "
+                  "((deg/s)^2/s) from the log's standstills in a first pass and use them instead of "
+                  "the configured ones; docs/estimator.md section 6.2")
+      ->check(CLI::IsMember({"auto"}));
   cmd->add_option("--attitude-start-sigma", a->attitude_start_sigma_dps,
                   "deg/s: the attitude comparison (attitude.csv, Fig. 9, drift in deg/h) starts once "
                   "every bias sigma is below this, i.e. once the filter has locked on; there the "

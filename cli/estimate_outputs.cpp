@@ -7,6 +7,7 @@
 #include <fmt/core.h>
 #include <fmt/format.h>
 
+#include "cli/estimate_health.hpp"
 #include "estimator/fixed_decimal.hpp"
 #include "report/json.hpp"
 
@@ -214,6 +215,8 @@ void write_estimate_summary(const fs::path& path, const SummaryContext& ctx, con
     o += "  },\n";
   }
   add("  \"bias_error_rms_dps\": {},\n", json_number(s.truth.bias_error_rms_dps));
+  if (ctx.config != nullptr) add("{},\n", health_json(s.health, *ctx.config));
+  add("  \"tune\": {},\n", tune_json(ctx.tune));
   if (ctx.figures != nullptr) add("  \"figures\": {},\n", json_figures(*ctx.figures));
   o += "  \"warnings\": [";
   for (std::size_t i = 0; i < s.warnings.size(); ++i) add("{}{}", i ? ", " : "", json_string(s.warnings[i]));

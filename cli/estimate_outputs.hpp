@@ -14,6 +14,7 @@
 #include "estimator/background_writer.hpp"
 #include "estimator/output_file.hpp"
 #include "estimator/pipeline.hpp"
+#include "estimator/tune.hpp"
 
 namespace driftless::cli {
 
@@ -62,6 +63,8 @@ struct SummaryContext {
   bool complete = true;             // false: the run was interrupted
   double stopped_at_t_s = kNaN;     // s, the last row processed when interrupted
   const std::vector<FigureOutcome>* figures = nullptr;  // what --plot drew (nullptr: no "figures")
+  const est::EstimatorConfig* config = nullptr;  // the configuration used (nullptr: no "health" text)
+  const est::TuneResult* tune = nullptr;         // what --tune auto measured (nullptr: "tune": null)
 };
 
 /// Writes summary.json (docs/estimator.md): "complete" and "stopped_at_t_s" first, then the

@@ -51,7 +51,6 @@ SensorParams nominal_mpu6050() {
 CompareModel default_compare_model() {
   CompareModel m;
   m.sensor = {nominal_mpu6050(), nominal_mpu6050()};
-  m.sample_rate_hz = 100.0;
   m.source = "embedded nominal MPU6050";
   return m;
 }
@@ -111,46 +110,6 @@ SensorParams deterministic_part(const SensorParams& p) {
   return d;
 }
 
-namespace {
-
-// the DLPF as the sensor model runs it: first-order IIR, then a fractional delay
-struct LowpassRun {
-  LowpassDesign d;
-  std::vector<Eigen::Vector3d> hist;
-  Eigen::Vector3d u = Eigen::Vector3d::Zero();
-  int head = 0;
-  bool primed = false;
-  Eigen::Vector3d apply(const Eigen::Vector3d& x) {
-    const int n = d.delay_whole_samples;
-    const int size = n + 2;
-    if (!primed) {
-      u = x;
-      hist.assign(static_cast<std::size_t>(size), x);
-      head = 0;
-      primed = true;
-    } else {
-      u = d.pole * u + (1.0 - d.pole) * x;
-      head = (head + 1) % size;
-      hist[static_cast<std::size_t>(head)] = u;
-    }
-    const auto& a = hist[static_cast<std::size_t>((head - n + size) % size)];
-    const auto& b = hist[static_cast<std::size_t>((head - n - 1 + 2 * size) % size)];
-    return (1.0 - d.delay_frac) * a + d.delay_frac * b;
-  }
-};
-
-std::vector<double> dlpf_impulse(const SensorParams& p, double fs) {
-  std::vector<double> h;
-  if (!p.lowpass_latency.enabled) return {1.0};
-  const DlpfSetting set = lowpass_setting(p.lowpass_latency);
-  LowpassRun lp;
-  lp.d = design_lowpass(set.gyro_bandwidth_hz, set.gyro_delay_s, fs);
-  lp.apply(Eigen::Vector3d::Zero());
-  for (int k = 0; k < 400; ++k) h.push_back(lp.apply(Eigen::Vector3d::Constant(k == 0 ? 1.0 : 0.0))[0]);
-  return h;
-}
-
-}  // namespace
 
 Eigen::Matrix2d settled_stop_offsets_deg(const BoxParams& box) {
   // the servo's reference runs past the stop by the overtravel (twin/flip_schedule.cpp), so the
@@ -195,10 +154,11 @@ SensorPrediction predict_sensor(const Replay& r, int s, const SensorParams& p, c
   out.gyro_dps.resize(n);
   out.temp_c.resize(n);
   out.temp_from_log = r.has_temp;
-  LowpassRun lp;
+  // the DLPF exactly as the sensor model runs it
+  LowpassFilter lp;
   if (d.lowpass_latency.enabled) {
     const DlpfSetting set = lowpass_setting(d.lowpass_latency);
-    lp.d = design_lowpass(set.gyro_bandwidth_hz, set.gyro_delay_s, r.sample_rate_hz);
+    lp = LowpassFilter(design_lowpass(set.gyro_bandwidth_hz, set.gyro_delay_s, r.sample_rate_hz));
   }
   // end-stop errors: the platform rests at nominal + error, so the sensor frame is turned by
   // the error about the hinge axis relative to the logged angle (twin/world.hpp stop_rad)
@@ -245,33 +205,41 @@ SensorPrediction predict_sensor(const Replay& r, int s, const SensorParams& p, c
   return out;
 }
 
+WhiteNoiseShape white_noise_shape(const SensorParams& p, double fs, int lags) {
+  WhiteNoiseShape out;
+  out.rho.assign(static_cast<std::size_t>(std::max(lags, 0) + 1), 0.0);
+  out.rho[0] = 1.0;
+  out.variance_hz = fs;
+  if (!p.lowpass_latency.enabled) return out;
+  // as the sensor model: noise up to a bandwidth at or above fs/2 aliases into white noise of
+  // variance N^2 2B added after the filter; below fs/2 it is added before the filter
+  const double bw = lowpass_setting(p.lowpass_latency).gyro_bandwidth_hz;
+  if (2.0 * bw >= fs) {
+    out.variance_hz = 2.0 * bw;
+    return out;
+  }
+  // the DLPF's pole colours it (its delay does not): a first-order autoregression
+  const double a = design_lowpass(bw, lowpass_setting(p.lowpass_latency).gyro_delay_s, fs).pole;
+  out.variance_hz = fs * (1.0 - a) / (1.0 + a);
+  for (std::size_t l = 1; l < out.rho.size(); ++l) out.rho[l] = out.rho[l - 1] * a;
+  return out;
+}
+
 double white_noise_floor_dps(const SensorParams& p, int axis, double fs) {
   if (!p.white_noise.enabled) return 0.0;
-  double g = 0.0;
-  for (double h : dlpf_impulse(p, fs)) g += h * h;
-  return p.white_noise.density_dps_rthz[axis] * std::sqrt(fs * g);
+  return p.white_noise.density_dps_rthz[axis] * std::sqrt(white_noise_shape(p, fs, 0).variance_hz);
 }
 
 double block_mean_variance_ratio(const SensorParams& p, double fs, std::size_t block_len) {
-  // var of a block mean of DLPF-filtered white noise relative to unfiltered white noise
-  const auto h = dlpf_impulse(p, fs);
-  const auto L = static_cast<long>(block_len);
-  std::vector<double> g(static_cast<std::size_t>(L), 0.0);
-  for (long l = 0; l < L; ++l)
-    for (std::size_t k = 0; k + static_cast<std::size_t>(l) < h.size(); ++k) g[static_cast<std::size_t>(l)] += h[k] * h[k + static_cast<std::size_t>(l)];
-  double v = static_cast<double>(L) * g[0];
-  for (long l = 1; l < L; ++l) v += 2.0 * static_cast<double>(L - l) * g[static_cast<std::size_t>(l)];
-  return v / static_cast<double>(L);
+  // var of a block mean of the output noise relative to that of white noise of density N
+  // (N^2 fs / L): var_1 (1 + 2 sum_l (1 - l/L) rho_l) / fs
+  const auto L = static_cast<int>(block_len);
+  const WhiteNoiseShape w = white_noise_shape(p, fs, L);
+  double v = 1.0;
+  for (int l = 1; l < L; ++l) v += 2.0 * (1.0 - static_cast<double>(l) / L) * w.rho[static_cast<std::size_t>(l)];
+  return w.variance_hz * v / fs;
 }
 
-double dlpf_lag1_autocorrelation(const SensorParams& p, double fs) {
-  const auto h = dlpf_impulse(p, fs);
-  double g0 = 0.0, g1 = 0.0;
-  for (std::size_t k = 0; k < h.size(); ++k) {
-    g0 += h[k] * h[k];
-    if (k + 1 < h.size()) g1 += h[k] * h[k + 1];
-  }
-  return g0 > 0 ? g1 / g0 : 0.0;
-}
+double dlpf_lag1_autocorrelation(const SensorParams& p, double fs) { return white_noise_shape(p, fs, 1).rho[1]; }
 
 }  // namespace driftless::diagnose

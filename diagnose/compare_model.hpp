@@ -23,7 +23,8 @@ struct CompareModel {
   std::array<twin::SensorParams, 2> sensor;  // sensor1, sensor2 (the working copy of config.sensor1/2)
   twin::BoxParams box;                       // hinge axes, end stops and their errors, motors
   double time_offset_s = 0.0;          // s; the sensors sample this long before the log's stamp
-  double sample_rate_hz = kNaN;        // Hz, the scenario's rate when the file is a scenario
+  double sample_rate_hz = kNaN;        // Hz, the scenario's rate when the file is a scenario (the
+                                       // model runs at the log's rate; --resample uses this one)
   double latitude_deg = kNaN;          // deg, the scenario's latitude when the file is a scenario
   std::string source;                  // file name, or "embedded MPU6050 defaults"
   bool is_scenario = false;            // the file is a whole scenario (else a `model:`-only file)
@@ -37,7 +38,8 @@ struct CompareModel {
 /// calibration-type effects (scale, cross-axis, g-sensitivity, temperature coefficients,
 /// mounting): they sit at their nominal zero, so a unit's own values are findings, not nuisance.
 twin::SensorParams nominal_mpu6050();
-/// The embedded default: both sensors nominal_mpu6050(), the default box, no time offset.
+/// The embedded default: both sensors nominal_mpu6050(), the default box, no time offset, no
+/// stated rate (it runs at the log's rate, like a model file).
 CompareModel default_compare_model();
 /// Reads a scenario file or a file with only `model:` through twin-core's parser
 /// (parse_scenario / load_model_config): every key of the model block is honoured.
@@ -75,6 +77,16 @@ Eigen::Matrix2d settled_stop_offsets_deg(const twin::BoxParams& box);
 /// True when platform s (0 or 1) rests on one of its end stops at sample k and the log reports
 /// the nominal stop angle there (end-stop switches), so the box's stop errors apply.
 int on_stop_side(const Replay& r, int s, std::size_t k, const twin::BoxParams& box);
+
+/// The model's white noise at the output, per unit density: its per-sample variance (Hz, i.e.
+/// (deg/s)^2 per (deg/s/rtHz)^2) and normalised autocorrelation at lags 0..lags. Without a DLPF,
+/// or when its bandwidth reaches fs/2, the noise is white (variance fs, or 2B when it aliases);
+/// otherwise it passes the DLPF, which colours it (docs/effects.md, 4 white_noise).
+struct WhiteNoiseShape {
+  double variance_hz = 0.0;
+  std::vector<double> rho;  // rho[0] = 1
+};
+WhiteNoiseShape white_noise_shape(const twin::SensorParams& p, double sample_rate_hz, int lags);
 
 /// Per-sample standard deviation of the model's white noise after its DLPF, deg/s.
 double white_noise_floor_dps(const twin::SensorParams& p, int axis, double sample_rate_hz);

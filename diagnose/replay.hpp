@@ -18,8 +18,7 @@ namespace driftless::diagnose {
 
 /// How a log is replayed. Units: Hz, deg, deg/s, s.
 struct ReplayOptions {
-  double model_sample_rate_hz = kNaN;   // Hz; the model's rate, NaN = accept the log's rate
-  bool resample = false;                // a log at another rate is resampled (else refused)
+  double resample_hz = kNaN;            // Hz; resample the log to this rate (NaN: replay it at its own rate)
   double default_latitude_deg = 52.0;   // deg; used (and stated) when the log has no latitude_deg
   double flip_rate_threshold_dps = 0.5; // deg/s; a platform turning faster than this is flipping
   double flip_guard_s = 0.05;           // s; samples this close to a flip count as flipping
@@ -71,7 +70,7 @@ struct Replay {
 };
 
 /// Replays a log file. Throws std::runtime_error with an actionable message when the log
-/// cannot be replayed (moving box without ref_q, rate mismatch without resampling, ...).
+/// cannot be replayed (moving box without ref_q, a ref_q that is not a rotation, ...).
 Replay replay_log(const std::filesystem::path& path, const ReplayOptions& opt);
 
 /// Replays samples already in memory (tests, bridges); `where` names the source in messages.

@@ -4,16 +4,20 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "diagnose/compare.hpp"
 
 namespace driftless::diagnose {
 
-/// Optional second comparison of the same log (e.g. with the model after --apply).
+/// What the report says besides the comparison: the command that made it, and optionally a
+/// second comparison of the same log (with the model after --apply, or compare --model --before).
 struct ReportExtras {
+  std::string command = "compare";       // "compare" or "diagnose": the page title names it
   const CompareResult* after = nullptr;  // the same log against the updated model
   std::string after_model;               // its source
-  std::string applied;                   // what was applied, one line
+  std::vector<std::string> applied;      // what was written, one line each
+  std::vector<std::string> skipped;      // what could not be written, and why
 };
 
 /// diagnosis.json text (deterministic: same input, same bytes).

@@ -110,11 +110,13 @@ EstimateSummary run_estimate(log::LogReader& reader, const EstimatorConfig& cfg,
   sum.truth.available = have_truth;
   AttitudeComparison att(meta.latitude_deg(), opt.attitude_start_sigma_dps, opt.attitude_interval_s);
   TruthScore score(sum.truth, opt.nees_band_probability);
+  HealthMonitor health(opt.health);
 
   // an update (accepted or rejected) reaches the sink, the truth score and the re-lock list
   auto on_update = [&](PushStatus st, const Sample& s) {
     if (st != PushStatus::kUpdated && st != PushStatus::kRejected) return;
     if (sink != nullptr) sink->on_update(filter.last_update(), filter.covariance_dps2(), s);
+    health.on_update(filter.last_update(), filter);
     if (filter.last_update().relocked) sum.relocks.push_back({filter.last_update().t_s, filter.last_update().nis});
     if (have_truth && st == PushStatus::kUpdated) score.add(filter, s);
   };
@@ -165,6 +167,7 @@ EstimateSummary run_estimate(log::LogReader& reader, const EstimatorConfig& cfg,
         " deg/s); an attitude start sigma of 0 compares from the log's start");
   }
   score.finish();
+  sum.health = health.finish(filter, sum.rows > 0 ? sum.t_last_s - sum.t_first_s : 0.0);
   return sum;
 }
 

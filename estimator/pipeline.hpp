@@ -10,6 +10,7 @@
 #include "estimator/attitude.hpp"
 #include "estimator/attitude_comparison.hpp"
 #include "estimator/filter.hpp"
+#include "estimator/health.hpp"
 #include "estimator/log.hpp"
 
 namespace driftless::est {
@@ -32,6 +33,7 @@ struct EstimateRunOptions {
   // (the filter has locked on); <= 0 starts it at the log's first ref_q
   double attitude_start_sigma_dps = 0.05;
   double nees_band_probability = 0.95;  // two-sided chi-square band for the NEES statistics
+  HealthLimits health;                  // limits of the health verdict (docs/estimator.md section 6.1)
 };
 
 /// Statistics against the log's truth (filled when the log has true_bias columns).
@@ -73,6 +75,7 @@ struct EstimateSummary {
   TruthStats truth;
   bool log_complete = true;
   std::vector<RelockEvent> relocks;
+  HealthReport health;  // the verdict: lock, gate rejections, NIS against its band, observability
   std::vector<std::string> warnings;
 };
 

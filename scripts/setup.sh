@@ -9,6 +9,7 @@ packages=(
   clang libclang-rt-14-dev  # libFuzzer harnesses (tests/fuzz, CI)
   librosbag-dev libsensor-msgs-dev
   chromium  # the look test (tests/cli/look.sh) opens the report and the figures headless
+  python3-numpy  # the independent log generator of the diagnose tests (tests/diagnose/independent_log.py)
 )
 missing=()
 for p in "${packages[@]}"; do

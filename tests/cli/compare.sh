@@ -37,7 +37,7 @@ grep -q "data:image/png;base64," "$t/c0/report.html" || fail "report.html embeds
 # 2. diagnose --apply: scale_factor on sensor 1 ranks first and is written to the model
 "$bin" diagnose --log "$log" --model "$t/model.yaml" --out "$t/d0" --apply "$t/new.yaml" > "$t/d0.out" ||
   { cat "$t/d0.out"; fail "diagnose --apply"; }
-grep -q "^missing_effect: missing effect: scale_factor on sensor 1" "$t/d0.out" || { cat "$t/d0.out"; fail "diagnose: wrong winner"; }
+grep -q "^missing_effect: 1 missing effect (evidence > [0-9.]*): scale_factor on sensor 1 (x)" "$t/d0.out" || { cat "$t/d0.out"; fail "diagnose: wrong winner"; }
 grep -q "value_pct" "$t/new.yaml" || fail "new.yaml lacks the fitted scale factor"
 "$bin" simulate --scenario "$t/new.yaml" --duration 1 --out "$t/sim_new" > /dev/null || fail "simulate cannot read new.yaml"
 
@@ -48,7 +48,7 @@ read -r before after < <(grep '"gyro1_x": {"before"' "$t/c1/diagnosis.json" |
   sed 's/.*"systematic": \([^,}]*\).*"systematic_after_apply": \([^,}]*\).*/\1 \2/')
 awk -v b="$before" -v a="$after" 'BEGIN { exit !(a * 5 <= b || a < 0.002) }' ||
   fail "gyro1_x systematic residual did not fall: $before -> $after deg/s"
-grep -q "after  (.*new.yaml): consistent with the noise model" "$t/c1.out" || { cat "$t/c1.out"; fail "after: not consistent"; }
+grep -q "after  (.*new.yaml): consistent_with_noise: consistent with the noise model" "$t/c1.out" || { cat "$t/c1.out"; fail "after: not consistent"; }
 echo "gyro1_x systematic residual: $before -> $after deg/s"
 
 # helpers for bad inputs
@@ -74,17 +74,23 @@ expect_error noref "noref.csv: the log has no reference motion (ref_qw, ref_qx, 
 # 5. a static log without ref_q: accepted, with the assumption stated
 "$bin" simulate --scenario static --duration 60 --out "$t/static" > /dev/null || fail "simulate static"
 drop_columns "$t/static/log.csv" "$t/static_noref.csv" '^ref_'
-"$bin" compare --log "$t/static_noref.csv" --out "$t/c_static" > "$t/static.out" 2>&1 || { cat "$t/static.out"; fail "static log without ref_q refused"; }
+# (accepted: it is compared and reported; the verdict may still be non-zero, because the twin's
+# static box is yawed 30 deg and so not what the identity-attitude assumption says)
+"$bin" compare --log "$t/static_noref.csv" --out "$t/c_static" > "$t/static.out" 2>&1
+grep -q "no reference motion" "$t/static.out" && { cat "$t/static.out"; fail "static log without ref_q refused"; }
+[[ -s "$t/c_static/diagnosis.json" ]] || { cat "$t/static.out"; fail "static log without ref_q: no diagnosis.json"; }
 grep -q "assumed static and level" "$t/static.out" || { cat "$t/static.out"; fail "static: assumption not stated"; }
 grep -q "assumed static and level" "$t/c_static/diagnosis.json" || fail "static: assumption not in diagnosis.json"
 
-# 6. a log at another rate than the model's: refused (saying so), or resampled with --resample
+# 6. a log at another rate than the model's: the model runs at the log's rate (saying so), as the
+# embedded model does (one rate policy), or the log is resampled with --resample
 sed 's/^sample_rate_hz: 100$/sample_rate_hz: 200/' "$t/model.yaml" > "$t/model200.yaml"
-expect_error rate "sampled at 100.000 Hz but the model at 200.000 Hz; refused" \
-  "$bin" compare --log "$log" --model "$t/model200.yaml" --out "$t/c_rate"
+"$bin" compare --log "$log" --model "$t/model200.yaml" --out "$t/c_rate" > "$t/rate.out" 2>&1
+grep -q "states sample_rate_hz 200.000; it runs at the log's 100.000 Hz" "$t/rate.out" || { cat "$t/rate.out"; fail "rate: not said"; }
+grep -q "^missing_effect: .*scale_factor on sensor 1 (x)" "$t/rate.out" || { cat "$t/rate.out"; fail "rate: wrong result"; }
 "$bin" compare --log "$log" --model "$t/model200.yaml" --resample --out "$t/c_res" > "$t/res.out" 2>&1 ||
   { cat "$t/res.out"; fail "--resample"; }
-grep -q "resampled to the model's 200.000 Hz" "$t/res.out" || { cat "$t/res.out"; fail "resampling not said"; }
+grep -q "resampled to 200.000 Hz" "$t/res.out" || { cat "$t/res.out"; fail "resampling not said"; }
 grep -q '"resampled": true' "$t/c_res/diagnosis.json" || fail "diagnosis.json does not say resampled"
 
 # 7. a malformed line: file:line and a non-zero exit

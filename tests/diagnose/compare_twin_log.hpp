@@ -64,17 +64,7 @@ inline CompareModel model_of(const Scenario& sc) {
   return m;
 }
 
-/// Replays a log file for a model (rate checked against the model's).
-inline Replay replay(const std::filesystem::path& log, const CompareModel& m) {
-  ReplayOptions ro;
-  ro.model_sample_rate_hz = m.sample_rate_hz;
-  return replay_log(log, ro);
-}
-
-inline const FittedParam* find_param(const Candidate& c, const std::string& name) {
-  for (const auto& p : c.params)
-    if (p.name == name) return &p;
-  return nullptr;
-}
+/// Replays a log file (the model runs at the log's rate, as the commands do).
+inline Replay replay(const std::filesystem::path& log, const CompareModel&) { return replay_log(log, ReplayOptions{}); }
 
 }  // namespace driftless::diagnose::twinlog

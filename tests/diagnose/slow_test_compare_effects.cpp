@@ -3,12 +3,16 @@
 // WHEN compared, THEN it ranks first and its parameter is within 20 % of the truth.
 #include <gtest/gtest.h>
 
+#include "tests/diagnose/diagnosis_checks.hpp"
+
 #include <cmath>
 #include <cstdio>
 #include <string>
 
 #include "tests/diagnose/compare_test_log.hpp"
+#include "diagnose/apply.hpp"
 #include "diagnose/compare.hpp"
+#include "diagnose/signal_chain.hpp"
 
 namespace driftless::diagnose {
 
@@ -39,16 +43,11 @@ CompareResult run(const Case& c, std::uint64_t seed) {
   return compare(rp, m, CompareOptions{});
 }
 
-double param(const Candidate& c, const std::string& name) {
-  for (const auto& p : c.params)
-    if (p.name == name) return p.value;
-  ADD_FAILURE() << "no parameter " << name << " in " << c.effect;
-  return std::nan("");
-}
+double param(const Candidate& c, const std::string& name) { return check::param(c, name); }
 
 void expect_top(const CompareResult& r, const std::string& effect) {
-  ASSERT_EQ(r.verdict, "missing_effect") << r.statement;
-  ASSERT_EQ(r.ranking.front().effect, effect) << r.statement;
+  ASSERT_TRUE(r.verdict == Verdict::kMissingEffect || !r.noise_model.empty()) << r.statement;
+  ASSERT_EQ(check::top_effect(r), effect) << r.statement;
 }
 
 TEST(CompareEffects, MountingMisalignment) {
@@ -58,8 +57,8 @@ TEST(CompareEffects, MountingMisalignment) {
   c.model1.mounting_misalignment.enabled = false;
   const auto r = run(c, 31);
   expect_top(r, "mounting_misalignment");
-  EXPECT_NEAR(param(r.ranking.front(), "s1.angles_deg[x]"), 0.8, 0.16);
-  EXPECT_NEAR(param(r.ranking.front(), "s1.angles_deg[y]"), -0.6, 0.12);
+  EXPECT_NEAR(param(check::top(r), "s1.angles_deg[x]"), 0.8, 0.16);
+  EXPECT_NEAR(param(check::top(r), "s1.angles_deg[y]"), -0.6, 0.12);
 }
 
 TEST(CompareEffects, LowpassLatency) {
@@ -68,12 +67,13 @@ TEST(CompareEffects, LowpassLatency) {
   c.log2.lowpass_latency.dlpf_cfg = 5;
   const auto r = run(c, 32);
   expect_top(r, "lowpass_latency");
-  const double want = mpu6050::dlpf_setting(5).gyro_delay_s - mpu6050::dlpf_setting(3).gyro_delay_s;
-  EXPECT_NEAR(param(r.ranking.front(), "s1.delay_s"), want, 0.2 * want);
+  // both sensors run the same filter: one shared delay, the new value near cfg 5's 13.4 ms
+  const double want = mpu6050::dlpf_setting(5).gyro_delay_s;
+  EXPECT_NEAR(param(check::top(r), "delay_s"), want, 0.2 * (want - mpu6050::dlpf_setting(3).gyro_delay_s));
   CompareModel m = default_compare_model();
   m.sensor = {c.model1, c.model2};
-  apply_candidate(m, r.ranking.front());
-  EXPECT_EQ(m.sensor[0].lowpass_latency.dlpf_cfg, 5);
+  apply_candidate(m, check::top(r));
+  for (int s = 0; s < 2; ++s) EXPECT_NEAR(lowpass_delay_s(m.sensor[s]), want, 0.002) << s;
 }
 
 TEST(CompareEffects, TimeOffset) {
@@ -81,7 +81,7 @@ TEST(CompareEffects, TimeOffset) {
   c.planted.time_offset_s = 0.02;
   const auto r = run(c, 33);
   expect_top(r, "time_offset");
-  EXPECT_NEAR(param(r.ranking.front(), "offset_s"), 0.02, 0.004);
+  EXPECT_NEAR(param(check::top(r), "offset_s"), 0.02, 0.004);
 }
 
 TEST(CompareEffects, EndStopError) {
@@ -89,7 +89,7 @@ TEST(CompareEffects, EndStopError) {
   c.planted.stop_error_deg[0][0] = 1.5;
   const auto r = run(c, 34);
   expect_top(r, "end_stop_error");
-  EXPECT_NEAR(param(r.ranking.front(), "s1.plus_stop_deg"), 1.5, 0.3);
+  EXPECT_NEAR(param(check::top(r), "s1.plus_stop_deg"), 1.5, 0.3);
 }
 
 TEST(CompareEffects, ConstantBias) {
@@ -97,7 +97,7 @@ TEST(CompareEffects, ConstantBias) {
   c.log2.constant_bias.value_dps = Eigen::Vector3d(0.0, 2.0, 0.0);
   const auto r = run(c, 35);
   expect_top(r, "constant_bias");
-  EXPECT_NEAR(param(r.ranking.front(), "s2.y.value_dps"), 2.0, 0.4);
+  EXPECT_NEAR(param(check::top(r), "s2.y.value_dps"), 2.0, 0.4);
 }
 
 TEST(CompareEffects, WhiteNoiseLevel) {
@@ -105,7 +105,7 @@ TEST(CompareEffects, WhiteNoiseLevel) {
   c.log1.white_noise.density_dps_rthz = Eigen::Vector3d::Constant(0.01);
   const auto r = run(c, 36);
   expect_top(r, "white_noise");
-  EXPECT_NEAR(param(r.ranking.front(), "s1.x.density_dps_rthz"), 0.01, 0.002);
+  EXPECT_NEAR(param(check::top(r), "s1.x.density_dps_rthz"), 0.01, 0.002);
 }
 
 TEST(CompareEffects, RateRandomWalk) {
@@ -113,9 +113,17 @@ TEST(CompareEffects, RateRandomWalk) {
   c.log1.rate_random_walk.k_dps_rts = Eigen::Vector3d::Constant(0.01);
   c.duration_s = 600.0;
   const auto r = run(c, 37);
-  ASSERT_EQ(r.verdict, "missing_effect") << r.statement;
-  const std::string e = r.ranking.front().effect;
-  EXPECT_TRUE(e == "rate_random_walk" || e == "bias_instability") << r.statement;
+  ASSERT_TRUE(r.verdict == Verdict::kMissingEffect || !r.noise_model.empty()) << r.statement;
+  // the drift is a noise-model change, reported after the effects (the selection may also take
+  // small slow effects that this strong drift mimics: docs/compare.md "Known limits")
+  const Candidate* drift = nullptr;
+  for (const auto& c : r.noise_model)
+    if (!drift && (c.effect == Effect::kRateRandomWalk || c.effect == Effect::kBiasInstability)) drift = &c;
+  ASSERT_NE(drift, nullptr) << r.statement;
+  if (drift->effect == Effect::kRateRandomWalk) {
+    EXPECT_NEAR(check::param(*drift, "s1.x.k_dps_rts"), 0.01, 0.003) << r.statement;
+  }
+  for (const auto& c : r.selected) EXPECT_FALSE(c.absurd) << r.statement;
 }
 
 TEST(CompareEffects, QuantizationStep) {
@@ -124,7 +132,7 @@ TEST(CompareEffects, QuantizationStep) {
   c.log2.quantization.sensitivity_lsb_per_dps = 65.5;
   const auto r = run(c, 38);
   expect_top(r, "quantization");
-  EXPECT_NEAR(param(r.ranking.front(), "s1.x.sensitivity_lsb_per_dps"), 65.5, 1.0);
+  EXPECT_NEAR(param(check::top(r), "s1.x.sensitivity_lsb_per_dps"), 65.5, 1.0);
 }
 
 TEST(CompareEffects, Saturation) {
@@ -133,9 +141,9 @@ TEST(CompareEffects, Saturation) {
   c.amp_dps = 45.0;
   const auto r = run(c, 39);
   expect_top(r, "saturation");
-  const auto& best = r.ranking.front();
+  const auto& best = check::top(r);
   ASSERT_FALSE(best.params.empty());
-  EXPECT_NEAR(best.params.front().value, 30.0, 0.5);
+  EXPECT_NEAR(best.params.front().new_value(), 30.0, 0.5);
 }
 
 TEST(CompareEffects, SampleJitter) {
@@ -144,9 +152,8 @@ TEST(CompareEffects, SampleJitter) {
   c.log1.sample_jitter.sigma_s = 0.002;
   c.amp_dps = 50.0;
   const auto r = run(c, 40);
-  ASSERT_EQ(r.verdict, "missing_effect") << r.statement;
   bool found = false;
-  for (std::size_t i = 0; i < std::min<std::size_t>(2, r.ranking.size()); ++i) found = found || r.ranking[i].effect == "sample_jitter";
+  for (const auto& c : r.noise_model) found = found || c.effect == Effect::kSampleJitter;
   EXPECT_TRUE(found) << r.statement;
 }
 
@@ -159,7 +166,7 @@ TEST(CompareEffects, ScaleTemperatureCoefficient) {
   c.log1.temperature.scale_tc_pct_per_degc = Eigen::Vector3d(0.0, 0.0, 0.3);
   const auto r = run(c, 41);
   expect_top(r, "temperature");
-  EXPECT_NEAR(param(r.ranking.front(), "s1.z.scale_tc_pct_per_degc"), 0.3, 0.06);
+  EXPECT_NEAR(param(check::top(r), "s1.z.scale_tc_pct_per_degc"), 0.3, 0.06);
 }
 
 TEST(CompareEffects, CleanLogsFalseAlarmRate) {
@@ -169,7 +176,7 @@ TEST(CompareEffects, CleanLogsFalseAlarmRate) {
     Case c;
     c.duration_s = 90.0;
     const auto r = run(c, static_cast<std::uint64_t>(seed));
-    if (r.verdict == "consistent_with_noise") ++ok;
+    if (r.verdict == Verdict::kConsistent) ++ok;
     else std::printf("seed %d: %s\n", seed, r.statement.c_str());
   }
   EXPECT_GE(ok, 19);
@@ -185,7 +192,7 @@ TEST(CompareEffects, WhitenessFalseAlarmRateOnLongLogs) {
     Case c;
     c.duration_s = 1800.0;
     const auto r = run(c, static_cast<std::uint64_t>(seed));
-    if (r.verdict == "consistent_with_noise") ++ok;
+    if (r.verdict == Verdict::kConsistent) ++ok;
     else std::printf("seed %d: %s\n", seed, r.statement.c_str());
     for (const auto& ch : r.channels) {
       ++channels;

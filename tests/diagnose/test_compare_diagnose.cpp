@@ -3,6 +3,8 @@
 // systematic residual. Logs: closed-form pan/tilt kinematics + the SensorModel (seeded).
 #include <gtest/gtest.h>
 
+#include "tests/diagnose/diagnosis_checks.hpp"
+
 #include <cmath>
 #include <cstdio>
 #include <set>
@@ -10,6 +12,7 @@
 
 #include "tests/diagnose/compare_test_log.hpp"
 #include "tests/diagnose/compare_twin_log.hpp"
+#include "diagnose/apply.hpp"
 #include "diagnose/compare.hpp"
 
 namespace driftless::diagnose {
@@ -32,11 +35,6 @@ CompareResult run(const SensorParams& log1, const SensorParams& log2, const Sens
   return compare(rp, m, CompareOptions{});
 }
 
-const FittedParam* find_param(const Candidate& c, const std::string& name) {
-  for (const auto& p : c.params)
-    if (p.name == name) return &p;
-  return nullptr;
-}
 
 TEST(CompareDiagnose, CleanLogIsConsistentWithNoise) {
   // GIVEN logs whose sensors match the model exactly (noise only)
@@ -46,7 +44,7 @@ TEST(CompareDiagnose, CleanLogIsConsistentWithNoise) {
     const SensorParams p = base_sensor();
     // WHEN compared
     const CompareResult res = run(p, p, p, p, static_cast<std::uint64_t>(seed));
-    if (res.verdict == "consistent_with_noise") ++consistent;
+    if (res.verdict == Verdict::kConsistent) ++consistent;
     else ADD_FAILURE() << "seed " << seed << ": " << res.statement;
   }
   // THEN every seed is consistent with the noise model
@@ -61,15 +59,15 @@ TEST(CompareDiagnose, ScaleFactorFoundAndApplied) {
   // WHEN diagnosed
   const CompareResult res = run(truth, model, model, model, 11);
   // THEN scale_factor ranks first, within 20 % of the truth
-  ASSERT_EQ(res.verdict, "missing_effect") << res.statement;
-  const Candidate& best = res.ranking.front();
-  EXPECT_EQ(best.effect, "scale_factor") << res.statement;
-  EXPECT_EQ(best.sensor, "1");
+  ASSERT_EQ(res.verdict, Verdict::kMissingEffect) << res.statement;
+  const Candidate& best = check::top(res);
+  EXPECT_EQ(std::string(effect_id(best.effect)), "scale_factor") << res.statement;
+  EXPECT_EQ(sensor_text(best), "1");
   const auto* px = find_param(best, "s1.x.value_pct");
   const auto* pz = find_param(best, "s1.z.value_pct");
   ASSERT_TRUE(px && pz) << res.statement;
-  EXPECT_NEAR(px->value, 3.0, 0.6);
-  EXPECT_NEAR(pz->value, -2.0, 0.4);
+  EXPECT_NEAR(px->new_value(), 3.0, 0.6);
+  EXPECT_NEAR(pz->new_value(), -2.0, 0.4);
   // AND after applying it the systematic residual falls >= 5x or to within 10 % of the floor
   CompareModel m = default_compare_model();
   m.sensor = {model, model};
@@ -84,7 +82,7 @@ TEST(CompareDiagnose, ScaleFactorFoundAndApplied) {
                 after.rms_dps <= 1.1 * after.noise_floor_dps)
         << channel_name(c) << " systematic " << before.systematic_rms_dps << " -> " << after.systematic_rms_dps;
   }
-  EXPECT_EQ(again.verdict, "consistent_with_noise") << again.statement;
+  EXPECT_EQ(again.verdict, Verdict::kConsistent) << again.statement;
 }
 
 TEST(CompareDiagnose, GSensitivityFound) {
@@ -94,12 +92,12 @@ TEST(CompareDiagnose, GSensitivityFound) {
   truth.g_sensitivity.matrix_dps_per_g(0, 0) = -0.1;
   const SensorParams model = base_sensor();
   const CompareResult res = run(model, truth, model, model, 5);
-  ASSERT_EQ(res.verdict, "missing_effect") << res.statement;
-  const Candidate& best = res.ranking.front();
-  EXPECT_EQ(best.effect, "g_sensitivity") << res.statement;
+  ASSERT_EQ(res.verdict, Verdict::kMissingEffect) << res.statement;
+  const Candidate& best = check::top(res);
+  EXPECT_EQ(std::string(effect_id(best.effect)), "g_sensitivity") << res.statement;
   const auto* p = find_param(best, "s2.matrix_dps_per_g[y][z]");
   ASSERT_NE(p, nullptr) << res.statement;
-  EXPECT_NEAR(p->value, 0.1, 0.02);
+  EXPECT_NEAR(p->new_value(), 0.1, 0.02);
 }
 
 TEST(CompareDiagnose, TemperatureBiasCoefficientFound) {
@@ -110,12 +108,12 @@ TEST(CompareDiagnose, TemperatureBiasCoefficientFound) {
   SensorParams truth = model;
   truth.temperature.bias_tc_dps_per_degc = Eigen::Vector3d(0.1, 0.0, 0.0);
   const CompareResult res = run(truth, model, model, model, 7);
-  ASSERT_EQ(res.verdict, "missing_effect") << res.statement;
-  const Candidate& best = res.ranking.front();
-  EXPECT_EQ(best.effect, "temperature") << res.statement;
+  ASSERT_EQ(res.verdict, Verdict::kMissingEffect) << res.statement;
+  const Candidate& best = check::top(res);
+  EXPECT_EQ(std::string(effect_id(best.effect)), "temperature") << res.statement;
   const auto* p = find_param(best, "s1.x.bias_tc_dps_per_degc");
   ASSERT_NE(p, nullptr) << res.statement;
-  EXPECT_NEAR(p->value, 0.1, 0.02);
+  EXPECT_NEAR(p->new_value(), 0.1, 0.02);
 }
 
 TEST(CompareDiagnose, MisalignmentFound) {
@@ -125,15 +123,15 @@ TEST(CompareDiagnose, MisalignmentFound) {
   truth.misalignment.matrix_pct(2, 0) = 1.5;
   const SensorParams model = base_sensor();
   const CompareResult res = run(truth, model, model, model, 9);
-  ASSERT_EQ(res.verdict, "missing_effect") << res.statement;
-  const Candidate& best = res.ranking.front();
-  EXPECT_EQ(best.effect, "misalignment") << res.statement;
+  ASSERT_EQ(res.verdict, Verdict::kMissingEffect) << res.statement;
+  const Candidate& best = check::top(res);
+  EXPECT_EQ(std::string(effect_id(best.effect)), "misalignment") << res.statement;
   const auto* p = find_param(best, "s1.matrix_pct[x][y]");
   ASSERT_NE(p, nullptr) << res.statement;
-  EXPECT_NEAR(p->value, 2.0, 0.4);
+  EXPECT_NEAR(p->new_value(), 2.0, 0.4);
 }
 
-TEST(CompareDiagnose, TwoHiddenEffectsOnePerRound) {
+TEST(CompareDiagnose, TwoHiddenEffectsInOneRun) {
   // GIVEN a scale error on sensor 1 and a g-sensitivity on sensor 2, model lacking both
   SensorParams t1 = base_sensor(), t2 = base_sensor();
   t1.scale_factor.value_pct = Eigen::Vector3d(0.0, 3.0, 0.0);
@@ -143,19 +141,25 @@ TEST(CompareDiagnose, TwoHiddenEffectsOnePerRound) {
   const Replay rp = replay_samples(lg.samples, lg.meta, lg.fields, ReplayOptions{}, "test.csv");
   CompareModel m = default_compare_model();
   m.sensor = {model, model};
-  // WHEN diagnosed twice, applying the winner in between
+  // WHEN diagnosed once
   const CompareResult r1 = compare(rp, m, CompareOptions{});
-  ASSERT_EQ(r1.verdict, "missing_effect") << r1.statement;
-  apply_candidate(m, r1.ranking.front());
+  // THEN both effects are selected with their values, and nothing else
+  ASSERT_EQ(r1.verdict, Verdict::kMissingEffect) << r1.statement;
+  std::set<std::string> found;
+  for (const auto& c : r1.selected) found.insert(effect_id(c.effect));
+  EXPECT_EQ(found, (std::set<std::string>{"scale_factor", "g_sensitivity"})) << r1.statement;
+  for (const auto& c : r1.selected) {
+    if (c.effect == Effect::kScaleFactor) {
+      EXPECT_NEAR(check::param(c, "s1.y.value_pct"), 3.0, 0.6);
+    }
+    if (c.effect == Effect::kGSensitivity) {
+      EXPECT_NEAR(check::param(c, "s2.matrix_dps_per_g[y][z]"), 0.1, 0.02);
+    }
+  }
+  // AND after --apply of the whole set the comparison is consistent
+  apply_result(m, r1);
   const CompareResult r2 = compare(rp, m, CompareOptions{});
-  ASSERT_EQ(r2.verdict, "missing_effect") << r2.statement;
-  apply_candidate(m, r2.ranking.front());
-  const CompareResult r3 = compare(rp, m, CompareOptions{});
-  // THEN the two rounds found the two effects, and the third finds nothing
-  std::set<std::string> found{r1.ranking.front().effect, r2.ranking.front().effect};
-  EXPECT_TRUE(found.count("scale_factor")) << r1.statement << " / " << r2.statement;
-  EXPECT_TRUE(found.count("g_sensitivity")) << r1.statement << " / " << r2.statement;
-  EXPECT_EQ(r3.verdict, "consistent_with_noise") << r3.statement;
+  EXPECT_EQ(r2.verdict, Verdict::kConsistent) << r2.statement;
 }
 
 }  // namespace

@@ -2,6 +2,8 @@
 // bad-input rules (no ref_q, other sample rate).
 #include <gtest/gtest.h>
 
+#include "tests/diagnose/diagnosis_checks.hpp"
+
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -61,20 +63,16 @@ TEST(CompareReplay, MovingLogWithoutRefQIsRefused) {
   }
 }
 
-TEST(CompareReplay, OtherSampleRateIsRefusedOrResampled) {
-  // GIVEN a 200 Hz log and a 100 Hz model
+TEST(CompareReplay, OtherSampleRateRunsNativelyOrIsResampled) {
+  // GIVEN a 200 Hz log
   const auto lg = testlog::make_log(ideal(), ideal(), 20.0, 4, 30.0, 200.0);
+  // WHEN replayed with no model rate THEN it runs at its own rate (one policy for every model)
+  const Replay native = replay_samples(lg.samples, lg.meta, lg.fields, ReplayOptions{}, "fast.csv");
+  EXPECT_FALSE(native.resampled);
+  EXPECT_NEAR(native.sample_rate_hz, 200.0, 1e-9);
+  // AND asked to resample to 100 Hz it does and says so
   ReplayOptions opt;
-  opt.model_sample_rate_hz = 100.0;
-  // WHEN replayed without resampling THEN it is refused, naming both rates
-  try {
-    replay_samples(lg.samples, lg.meta, lg.fields, opt, "fast.csv");
-    FAIL() << "rate mismatch accepted";
-  } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("--resample"), std::string::npos) << e.what();
-  }
-  // AND with resampling it runs at the model's rate and says so
-  opt.resample = true;
+  opt.resample_hz = 100.0;
   const Replay r = replay_samples(lg.samples, lg.meta, lg.fields, opt, "fast.csv");
   EXPECT_TRUE(r.resampled);
   EXPECT_NEAR(r.sample_rate_hz, 100.0, 1e-9);
@@ -91,8 +89,9 @@ TEST(CompareReport, JsonIsDeterministicAndHoldsTheContract) {
   const auto a = diagnosis_json(compare(r, m, CompareOptions{}));
   const auto b = diagnosis_json(compare(r, m, CompareOptions{}));
   EXPECT_EQ(a, b);
-  for (const char* key : {"\"verdict\"", "\"ranking\"", "\"effect\"", "\"sensor\"", "\"axis\"", "\"params\"",
-                          "\"explained_fraction\"", "\"evidence\"", "\"residual_rms_dps\"", "\"before\"", "\"after_best\""})
+  for (const char* key : {"\"verdict\"", "\"selected\"", "\"noise_model\"", "\"not_supported\"", "\"effect\"",
+                          "\"family\"", "\"sensor\"", "\"axis\"", "\"params\"", "\"explained_fraction\"", "\"evidence\"",
+                          "\"evidence_threshold\"", "\"residual_rms_dps\"", "\"before\"", "\"after_selected\""})
     EXPECT_NE(a.find(key), std::string::npos) << key;
 }
 

@@ -5,9 +5,12 @@
 // in slow_test_compare_twin.cpp.
 #include <gtest/gtest.h>
 
+#include "tests/diagnose/diagnosis_checks.hpp"
+
 #include <cmath>
 #include <cstdio>
 
+#include "diagnose/apply.hpp"
 #include "tests/diagnose/compare_twin_log.hpp"
 
 #include "tests/temp_path.hpp"
@@ -17,7 +20,6 @@ namespace driftless::diagnose {
 using namespace driftless::twin;  // the sensor model, scenario and simulator
 namespace {
 
-using twinlog::find_param;
 
 constexpr double kDuration = 90.0;
 
@@ -37,7 +39,7 @@ TEST(CompareTwin, CleanPanTiltLogIsConsistentWithNoise) {
   // WHEN compared
   const CompareResult r = compare(twinlog::replay(log, m), m, CompareOptions{});
   // THEN nothing is missing
-  EXPECT_EQ(r.verdict, "consistent_with_noise") << r.statement;
+  EXPECT_EQ(r.verdict, Verdict::kConsistent) << r.statement;
   std::filesystem::remove(log);
 }
 
@@ -51,12 +53,12 @@ TEST(CompareTwin, ScaleFactorFoundAppliedThroughYaml) {
   // WHEN diagnosed
   const CompareResult r = compare(rp, m, CompareOptions{});
   // THEN scale_factor on sensor 1 ranks first, within 20 %
-  ASSERT_EQ(r.verdict, "missing_effect") << r.statement;
-  const Candidate& best = r.ranking.front();
-  EXPECT_EQ(best.effect, "scale_factor") << r.statement;
+  ASSERT_EQ(r.verdict, Verdict::kMissingEffect) << r.statement;
+  const Candidate& best = check::top(r);
+  EXPECT_EQ(std::string(effect_id(best.effect)), "scale_factor") << r.statement;
   const auto* p = find_param(best, "s1.x.value_pct");
   ASSERT_NE(p, nullptr) << r.statement;
-  EXPECT_NEAR(p->value, 3.0, 0.6);
+  EXPECT_NEAR(p->new_value(), 3.0, 0.6);
   // AND --apply writes a model that compare reads back, with the systematic residual gone
   CompareModel upd = m;
   apply_candidate(upd, best);
@@ -66,7 +68,7 @@ TEST(CompareTwin, ScaleFactorFoundAppliedThroughYaml) {
   EXPECT_NEAR(back.sensor[0].scale_factor.value_pct[0], upd.sensor[0].scale_factor.value_pct[0], 1e-6);
   const CompareResult again = compare(rp, back, CompareOptions{});
   expect_error_falls(r, again, 0);
-  EXPECT_EQ(again.verdict, "consistent_with_noise") << again.statement;
+  EXPECT_EQ(again.verdict, Verdict::kConsistent) << again.statement;
   std::filesystem::remove(log);
   std::filesystem::remove(yaml);
 }
@@ -80,12 +82,12 @@ TEST(CompareTwin, EndStopErrorFoundAndWrittenToTheBox) {
   const Replay rp = twinlog::replay(log, m);
   const CompareResult r = compare(rp, m, CompareOptions{});
   // THEN end_stop_error ranks first with the + stop error of sensor 2 within 20 %
-  ASSERT_EQ(r.verdict, "missing_effect") << r.statement;
-  const Candidate& best = r.ranking.front();
-  ASSERT_EQ(best.effect, "end_stop_error") << r.statement;
+  ASSERT_EQ(r.verdict, Verdict::kMissingEffect) << r.statement;
+  const Candidate& best = check::top(r);
+  ASSERT_EQ(std::string(effect_id(best.effect)), "end_stop_error") << r.statement;
   const auto* p = find_param(best, "s2.plus_stop_deg");
   ASSERT_NE(p, nullptr) << r.statement;
-  EXPECT_NEAR(p->value, 0.5, 0.1);
+  EXPECT_NEAR(p->value, 0.5, 0.1);  // the change to the model's stop error
   // AND --apply writes it into model.box (a scenario simulate reads back) and the error falls
   CompareModel upd = m;
   apply_candidate(upd, best);
@@ -95,7 +97,7 @@ TEST(CompareTwin, EndStopErrorFoundAndWrittenToTheBox) {
   EXPECT_NEAR(back_sc.model.box.stop2_error_deg[1], sc.model.box.stop2_error_deg[1], 0.1);
   const CompareResult again = compare(rp, load_compare_model(yaml), CompareOptions{});
   for (int c = 3; c < 6; ++c) expect_error_falls(r, again, c);
-  EXPECT_EQ(again.verdict, "consistent_with_noise") << again.statement;
+  EXPECT_EQ(again.verdict, Verdict::kConsistent) << again.statement;
   std::filesystem::remove(log);
   std::filesystem::remove(yaml);
 }
@@ -119,12 +121,12 @@ TEST(CompareTwin, TheEmbeddedNominalModelFindsADatasheetGSensitivity) {
   const CompareModel m = embedded_model_for(sc);
   const CompareResult r = compare(twinlog::replay(log, m), m, CompareOptions{});
   // THEN g_sensitivity on sensor 1 ranks first within 20 %
-  ASSERT_EQ(r.verdict, "missing_effect") << r.statement;
-  const Candidate& best = r.ranking.front();
-  EXPECT_EQ(best.effect, "g_sensitivity") << r.statement;
+  ASSERT_EQ(r.verdict, Verdict::kMissingEffect) << r.statement;
+  const Candidate& best = check::top(r);
+  EXPECT_EQ(std::string(effect_id(best.effect)), "g_sensitivity") << r.statement;
   const auto* p = find_param(best, "s1.matrix_dps_per_g[z][z]");
   ASSERT_NE(p, nullptr) << r.statement;
-  EXPECT_NEAR(p->value, 0.1, 0.02);
+  EXPECT_NEAR(p->new_value(), 0.1, 0.02);
   std::filesystem::remove(log);
 }
 
@@ -135,7 +137,7 @@ TEST(CompareTwin, AnIdealSensorIsConsistentWithTheEmbeddedNominalModel) {
   const auto log = twinlog::simulate(sc, "nominal_clean");
   const CompareModel m = embedded_model_for(sc);
   const CompareResult r = compare(twinlog::replay(log, m), m, CompareOptions{});
-  EXPECT_EQ(r.verdict, "consistent_with_noise") << r.statement;
+  EXPECT_EQ(r.verdict, Verdict::kConsistent) << r.statement;
   std::filesystem::remove(log);
 }
 

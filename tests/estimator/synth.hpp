@@ -32,8 +32,13 @@ struct SynthParams {
   double noise_sigma_dps = 0.0;     // per-sample white noise, each axis
   double gm_sigma_dps = 0.0;        // Gauss-Markov bias wander (steady-state sigma)
   double gm_tau_s = 1000.0;         // its correlation time
+  // an extra sensor-2 offset (deg/s, sensor axes) while platform 2 sits at a negative angle: the
+  // signature of a position-dependent error (g-sensitivity on a horizontal hinge, misalignment)
+  Eigen::Vector3d b2_extra_at_negative_plat2_dps = Eigen::Vector3d::Zero();
   // box rate relative to ENU in box axes (zero if empty); the sensors also see the Earth rate
   std::function<Eigen::Vector3d(double)> body_rate_dps;
+  // extra noise per sample (deg/s, sensor axes) from outside, e.g. a real recording's: (sensor 1|2, index)
+  std::function<Eigen::Vector3d(int, std::size_t)> extra_noise_dps;
   bool earth_rate = true;
   double latitude_deg = 52.0;
   std::uint64_t seed = 1;
@@ -112,7 +117,8 @@ inline void synth_samples(const SynthParams& p, const std::function<void(const S
     const Eigen::Vector3d w = w_nb + q.conjugate() * w_ie_enu_dps;  // inertial, box axes
     const Eigen::Matrix3d R1 = Eigen::AngleAxisd(t1 * kRadPerDeg, p.hinge1.normalized()).toRotationMatrix();
     const Eigen::Matrix3d R2 = Eigen::AngleAxisd(t2 * kRadPerDeg, p.hinge2.normalized()).toRotationMatrix();
-    const Eigen::Vector3d b1 = p.b1_dps + gm1, b2 = p.b2_dps + gm2;
+    const Eigen::Vector3d b1 = p.b1_dps + gm1;
+    const Eigen::Vector3d b2 = p.b2_dps + gm2 + (t2 < 0.0 ? p.b2_extra_at_negative_plat2_dps : Eigen::Vector3d::Zero());
     Sample s;
     s.t_s = t;
     s.gyro1_dps = R1.transpose() * w + w1 * p.hinge1.normalized() + b1;
@@ -122,6 +128,10 @@ inline void synth_samples(const SynthParams& p, const std::function<void(const S
         s.gyro1_dps[i] += p.noise_sigma_dps * g(rng);
         s.gyro2_dps[i] += p.noise_sigma_dps * g(rng);
       }
+    }
+    if (p.extra_noise_dps) {
+      s.gyro1_dps += p.extra_noise_dps(1, k);
+      s.gyro2_dps += p.extra_noise_dps(2, k);
     }
     const bool hide = p.nan_while_moving && moving;
     s.plat1_deg = hide && w1 != 0.0 ? kNaN : t1;

@@ -80,29 +80,23 @@ TEST(EffectsNoise, NoiseAliasesWhenTheDlpfIsWiderThanNyquist) {
   const double want = 0.005 * std::sqrt(2.0 * 256.0);
   EXPECT_NEAR(std::sqrt(s2 / n), want, 0.02 * want);
   EXPECT_LT(std::abs(s11 / s2), 4.0 / std::sqrt(n));
-  // WHEN the DLPF is narrower than fs/2 (cfg 3, 42 Hz) THEN the noise goes through the filter and
-  // the per-sample sigma drops below N sqrt(fs)
-  p.lowpass_latency.dlpf_cfg = 3;
-  SensorModel m3(p, fs, 13);
-  s2 = 0;
-  for (int k = 0; k < n; ++k) s2 += std::pow(m3.step(SensorTruth{k / fs, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()}).gyro_radps[1] * kDegPerRad, 2);
-  const DlpfSetting d = mpu6050::dlpf_setting(3);
-  const LowpassDesign lp = design_lowpass(d.gyro_bandwidth_hz, d.gyro_delay_s, fs);
-  // variance gain of the IIR + two-tap delay: sum of squared impulse response
-  double gain2 = 0, u_prev = 0;
-  std::vector<double> u;
-  for (int k = 0; k < 400; ++k) {
-    const double uk = lp.pole * u_prev + (1 - lp.pole) * (k == 0 ? 1.0 : 0.0);
-    u.push_back(uk);
-    u_prev = uk;
+  // WHEN the DLPF is narrower than fs/2 (cfg 4, 20 Hz) THEN the noise goes through the filter's
+  // pole (not its delay): a first-order autoregression with lag-1 correlation a and per-sample
+  // sigma N sqrt(fs (1 - a) / (1 + a))
+  p.lowpass_latency.dlpf_cfg = 4;
+  SensorModel m4(p, fs, 13);
+  s2 = 0, s11 = 0;
+  double prev = 0.0;
+  for (int k = 0; k < n; ++k) {
+    const double v = m4.step(SensorTruth{k / fs, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()}).gyro_radps[1] * kDegPerRad;
+    s2 += v * v;
+    if (k > 0) s11 += v * prev;
+    prev = v;
   }
-  for (int k = 0; k < 400; ++k) {
-    const double a = k - lp.delay_whole_samples >= 0 ? u[k - lp.delay_whole_samples] : 0.0;
-    const double b = k - lp.delay_whole_samples - 1 >= 0 ? u[k - lp.delay_whole_samples - 1] : 0.0;
-    const double h = (1 - lp.delay_frac) * a + lp.delay_frac * b;
-    gain2 += h * h;
-  }
-  const double want3 = 0.005 * std::sqrt(fs) * std::sqrt(gain2);
-  EXPECT_NEAR(std::sqrt(s2 / n), want3, 0.02 * want3);
-  EXPECT_LT(want3, 0.9 * 0.005 * std::sqrt(fs));
+  const double a = m4.gyro_lowpass().pole;
+  EXPECT_NEAR(a, std::exp(-2.0 * kPi * 20.0 / fs), 1e-12);
+  const double want4 = 0.005 * std::sqrt(fs * (1 - a) / (1 + a));
+  EXPECT_NEAR(std::sqrt(s2 / n), want4, 0.02 * want4);
+  EXPECT_NEAR(s11 / s2, a, 4.0 / std::sqrt(n));
+  EXPECT_LT(want4, 0.9 * 0.005 * std::sqrt(fs));
 }

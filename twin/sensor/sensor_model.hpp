@@ -275,7 +275,7 @@ DlpfSetting lowpass_setting(const LowpassLatencyParams& p);
 /// A discrete low-pass at the output rate: first-order IIR then a (fractional) sample delay.
 struct LowpassDesign {
   double pole = 0.0;            // u_k = pole u_{k-1} + (1 - pole) x_k
-  int delay_whole_samples = 0;  // y_k = (1-frac) u_{k-n} + frac u_{k-n-1}
+  int delay_whole_samples = 0;  // y_k = u at k - n - frac, cubic interpolation (docs/effects.md 11)
   double delay_frac = 0.0;
   /// Group delay at 0 Hz, s: pole/(1-pole)/fs + (n + frac)/fs (equals the requested delay).
   double dc_group_delay_s(double sample_rate_hz) const;
@@ -296,7 +296,7 @@ class LowpassFilter {
  private:
   LowpassDesign d_;
   Eigen::Vector3d u_ = Eigen::Vector3d::Zero();
-  std::vector<Eigen::Vector3d> hist_;  // ring of past u, size n + 2
+  std::vector<Eigen::Vector3d> hist_;  // ring of past u, size n + 5
   int head_ = 0;
   bool primed_ = false;
 };
@@ -377,6 +377,9 @@ class SensorModel {
   SensorInstance inst_;
   TemperatureModel temp_;
   LowpassFilter gyro_filter_, accel_filter_;
+  // the chip's noise passes the DLPF's pole only: its delay is a whole number of the chip's
+  // internal samples, which does not correlate noise (interpolating it at the output rate would)
+  LowpassFilter gyro_noise_filter_, accel_noise_filter_;
   LowpassFilter delay_w_, delay_f_;  // 13: the truth delayed by sample_delay.delay_s
   std::vector<std::uint8_t> missing_lut_;  // 65536 flags, code + 32768
 

@@ -1,0 +1,139 @@
+#include "cli/estimate_health.hpp"
+
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "report/json.hpp"
+
+namespace driftless::cli {
+namespace {
+
+constexpr const char* kComponentNames[6] = {"b1_x", "b1_y", "b1_z", "b2_x", "b2_y", "b2_z"};
+
+using report::json_number;
+using report::json_string;
+
+const char* cause_key(est::HealthCause c) {
+  switch (c) {
+    case est::HealthCause::kNoUpdate: return "no_update";
+    case est::HealthCause::kAllRejected: return "all_rejected";
+    case est::HealthCause::kNeverLocked: return "never_locked";
+    case est::HealthCause::kNoiseUnderstated: return "noise_understated";
+    case est::HealthCause::kNoiseOverstated: return "noise_overstated";
+    case est::HealthCause::kRejectionsAtPosition: return "rejections_at_position";
+    case est::HealthCause::kRejections: return "rejections";
+    case est::HealthCause::kUnobservable: return "unobservable";
+    case est::HealthCause::kRelocks: return "relocks";
+  }
+  return "?";
+}
+
+// "(90, -90) and (-90, 90) deg" (plat1, plat2)
+std::string position_text(const std::vector<std::array<double, 2>>& pairs) {
+  std::string o;
+  for (std::size_t i = 0; i < pairs.size(); ++i) {
+    o += fmt::format("{}({:g}, {:g})", i == 0 ? "" : i + 1 == pairs.size() ? " and " : ", ", pairs[i][0], pairs[i][1]);
+  }
+  return o + " deg";
+}
+
+}  // namespace
+
+std::string component_names(const std::vector<int>& components) {
+  std::string o;
+  for (int c : components) o += (o.empty() ? "" : " + ") + std::string(kComponentNames[c]);
+  return o;
+}
+
+std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cfg) {
+  switch (f.cause) {
+    case est::HealthCause::kNoUpdate:
+      return "no standstill became an update: the platforms never rested for min_standstill_s "
+             "(or the angle columns are empty); check plat1_deg/plat2_deg or set standstill: gyro";
+    case est::HealthCause::kAllRejected:
+      return "the NIS gate rejected every update: the sensors do not fit the configured noise or "
+             "model; try --tune auto, or check the hinge axes in the log header";
+    case est::HealthCause::kNeverLocked:
+      return fmt::format("never locked: the largest bias sigma is {:.3g} deg/s{}; {}", f.value,
+                         f.components.empty() ? std::string() : ", unobservable: " + component_names(f.components),
+                         f.suggested > 0.02 ? fmt::format("the gate rejected {:.0f} % of the updates, so the flips "
+                                                          "that observe them were not used (see below)",
+                                                          100.0 * f.suggested)
+                                            : "record more flips (both platforms, both directions) or a longer log");
+    case est::HealthCause::kNoiseUnderstated:
+      return fmt::format("NIS mean {:.3g} above its 95 % band: the innovations are {:.2g}x larger than the filter "
+                         "expects, its sigma too small (data noisier or bias wandering more than "
+                         "noise_density_dps_rthz {:.3g} and the bias instability say); use --tune auto",
+                         f.value, std::sqrt(f.suggested), cfg.noise_density_dps_rthz);
+    case est::HealthCause::kNoiseOverstated:
+      return fmt::format("NIS mean {:.3g} below its 95 % band: the innovations are {:.2g}x smaller than the "
+                         "filter expects, its sigma too large (data quieter or the bias steadier than configured): "
+                         "safe, the estimates are trusted less than they deserve",
+                         f.value, std::sqrt(f.suggested));
+    case est::HealthCause::kRejectionsAtPosition:
+      return fmt::format("{:.0f} % of the updates at platform angles {} were rejected, few elsewhere: an error "
+                         "that depends on the position and that a constant bias cannot absorb (g-sensitivity "
+                         "on a horizontal hinge, misalignment, an end-stop angle error); calibrate with "
+                         "'driftless calibrate' and pass --calib",
+                         100.0 * f.value, position_text(f.positions_deg));
+    case est::HealthCause::kRejections:
+      return fmt::format("{:.1f} % of the updates were rejected by the NIS gate: noise or bias wander "
+                         "larger than configured, or a model that does not fit; use --tune auto",
+                         100.0 * f.value);
+    case est::HealthCause::kUnobservable:
+      return fmt::format("{} kept most of the prior sigma (largest sigma {:.3g} deg/s): the flips in this "
+                         "log do not observe them; flip both platforms",
+                         component_names(f.components), f.value);
+    case est::HealthCause::kRelocks:
+      return fmt::format("the filter lost lock and re-locked {:g} time(s) (see relocks): a bias jump, a new "
+                         "sensor, or a model that does not fit; check the log around those times",
+                         f.value);
+  }
+  return "?";
+}
+
+std::string health_json(const est::HealthReport& h, const est::EstimatorConfig& cfg) {
+  std::string unobs = "[";
+  for (std::size_t i = 0; i < h.unobservable.size(); ++i) {
+    unobs += fmt::format("{}\"{}\"", i ? ", " : "", kComponentNames[h.unobservable[i]]);
+  }
+  unobs += "]";
+  std::string findings = "[";
+  for (std::size_t i = 0; i < h.findings.size(); ++i) {
+    findings += fmt::format("{}\n    {{\"cause\": \"{}\", \"severity\": \"{}\", \"text\": {}}}", i ? "," : "",
+                            cause_key(h.findings[i].cause), est::to_string(h.findings[i].severity),
+                            json_string(describe(h.findings[i], cfg)));
+  }
+  findings += h.findings.empty() ? "]" : "\n  ]";
+  return fmt::format(
+      "  \"health\": {{\"verdict\": \"{}\", \"locked\": {}, \"lock_t_s\": {}, \"updates\": {}, \"rejected\": {}, "
+      "\"rejected_fraction\": {}, \"nis_updates\": {}, \"nis_dof_mean\": {}, \"nis_mean\": {}, "
+      "\"nis_mean_band_95\": [{}, {}], \"relocks\": {}, \"unobservable\": {},\n  \"findings\": {}}}",
+      est::to_string(h.verdict), h.locked ? "true" : "false", json_number(h.lock_t_s), h.updates, h.rejected,
+      json_number(h.rejected_fraction), h.nis_updates, json_number(h.nis_dof_mean), json_number(h.nis_mean), json_number(h.nis_mean_band_lo),
+      json_number(h.nis_mean_band_hi), h.relocks, unobs, findings);
+}
+
+std::string tune_json(const est::TuneResult* t) {
+  if (t == nullptr) return "null";
+  return fmt::format("{{\"block_s\": {}, \"noise_block_pairs\": {}, \"noise_estimated\": {}, "
+                     "\"noise_density_dps_rthz\": {}, \"wander_pairs\": {}, \"q_estimated\": {}, "
+                     "\"q_dps2_per_s\": {}}}",
+                     json_number(t->block_s), t->noise_block_pairs, t->noise_estimated ? "true" : "false",
+                     json_number(t->noise_density_dps_rthz), t->wander_pairs, t->q_estimated ? "true" : "false",
+                     json_number(t->q_dps2_per_s));
+}
+
+std::vector<std::string> health_lines(const est::HealthReport& h, const est::EstimatorConfig& cfg) {
+  std::vector<std::string> lines;
+  lines.push_back(fmt::format(
+      "health: {}: {}, {} of {} updates rejected ({:.1f} %), NIS mean {:.3g} (95 % band {:.3g}..{:.3g}), {} re-lock(s)",
+      est::to_string(h.verdict), h.locked ? fmt::format("locked at t = {:.1f} s", h.lock_t_s) : "never locked",
+      h.rejected, h.updates, std::isfinite(h.rejected_fraction) ? 100.0 * h.rejected_fraction : 0.0, h.nis_mean,
+      h.nis_mean_band_lo, h.nis_mean_band_hi, h.relocks));
+  for (const auto& f : h.findings) lines.push_back(fmt::format("  {}: {}", est::to_string(f.severity), describe(f, cfg)));
+  return lines;
+}
+
+}  // namespace driftless::cli

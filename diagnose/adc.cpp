@@ -1,0 +1,181 @@
+#include "diagnose/adc.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+
+#include "estimator/mpu6050.hpp"
+#include "estimator/sample.hpp"
+
+namespace driftless::diagnose {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+ParamRef ref_of(Param p, int channel) {
+  return ParamRef{p, static_cast<std::int8_t>(channel / 3), static_cast<std::int8_t>(channel % 3)};
+}
+
+FittedParam param(Param p, int channel, double new_value, double sigma, double model) {
+  FittedParam fp;
+  fp.ref = ref_of(p, channel);
+  fp.model_value = model;
+  fp.value = new_value - model;
+  fp.sigma = sigma;
+  return fp;
+}
+
+// lattice strength |mean exp(2 pi i y / step)|: near 1 when every output sits on the grid
+double lattice(const std::vector<double>& y, double step) {
+  double cr = 0, si = 0;
+  for (double v : y) {
+    const double ph = 2.0 * kPi * v / step;
+    cr += std::cos(ph);
+    si += std::sin(ph);
+  }
+  return std::hypot(cr, si) / std::max<double>(1.0, static_cast<double>(y.size()));
+}
+
+// the coarsest LSB the outputs lie on: the model's, the common MPU6050 ranges, the data's step
+double data_lsb(const std::vector<double>& y, const twin::SensorParams& p, double* strength) {
+  std::vector<double> steps;
+  if (p.quantization.enabled) steps.push_back(1.0 / p.quantization.sensitivity_lsb_per_dps);
+  for (int fs_sel = 0; fs_sel < 4; ++fs_sel) steps.push_back(1.0 / mpu6050::gyro_lsb_per_dps(fs_sel));
+  std::vector<double> u(y.begin(), y.begin() + static_cast<std::ptrdiff_t>(std::min<std::size_t>(y.size(), 20000)));
+  std::sort(u.begin(), u.end());
+  u.erase(std::unique(u.begin(), u.end(), [](double a, double b) { return std::abs(a - b) < 2e-7; }), u.end());
+  std::vector<double> d;
+  for (std::size_t i = 1; i < u.size(); ++i) d.push_back(u[i] - u[i - 1]);
+  if (d.size() > 10) {
+    std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(d.size() / 2), d.end());
+    steps.push_back(d[d.size() / 2]);
+  }
+  double best = 0.0;
+  *strength = 0.0;
+  for (double st : steps) {
+    if (!(st > 1e-6)) continue;
+    const double R = lattice(y, st);
+    if (R > 0.9 && st > best) best = st, *strength = R;
+  }
+  return best;
+}
+
+// codes with zero count whose neighbours on both sides are well populated
+std::vector<long> missing_codes(const std::vector<double>& y, double lsb, double log_m, double* evidence) {
+  std::map<long, long> hist;
+  for (double v : y) hist[std::lround(v / lsb)]++;
+  std::vector<long> out;
+  *evidence = 0.0;
+  if (hist.empty()) return out;
+  const long lo = hist.begin()->first, hi = hist.rbegin()->first;
+  if (hi - lo >= 200000) return out;
+  auto cnt = [&](long c) {
+    auto it = hist.find(c);
+    return it == hist.end() ? 0.0 : static_cast<double>(it->second);
+  };
+  for (long code = lo + 2; code <= hi - 2; ++code) {
+    if (hist.count(code)) continue;
+    // both sides must be populated (a clipped pile on one side is no evidence)
+    const double lam = 0.5 * std::min(cnt(code - 2) + cnt(code - 1), cnt(code + 1) + cnt(code + 2));
+    if (lam < 40.0) continue;
+    out.push_back(code);
+    *evidence += 2.0 * lam - log_m - 2.0 * std::log(static_cast<double>(hi - lo + 1));
+  }
+  return out;
+}
+
+// median of the finite entries of x (0 when none)
+double finite_median(const std::vector<double>& x) {
+  std::vector<double> v;
+  v.reserve(x.size());
+  for (double e : x)
+    if (std::isfinite(e)) v.push_back(e);
+  if (v.empty()) return 0.0;
+  auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+// saturation: repeated extreme outputs where the model, with the channel's turn-on bias (the
+// residual's median; a bias of 20 deg/s is normal), predicts beyond them
+double saturation_evidence(const Replay& r, const Residual& res, int c, double ymax, double tol, double floor_dps) {
+  const int s = c / 3, j = c % 3;
+  const double bias_dps = finite_median(res.e_dps[c]);
+  double dj = 0.0;
+  std::size_t plateau = 0;
+  for (std::size_t k = 0; k < res.n; ++k) {
+    if (!r.usable[k]) continue;
+    const double v = r.gyro_dps[s][k][j], pv = res.pred[s].gyro_dps[k][j] + bias_dps;
+    if (std::abs(std::abs(v) - ymax) <= tol && std::abs(pv) > ymax + 5.0 * floor_dps) {
+      ++plateau;
+      dj += std::pow((std::abs(pv) - ymax) / std::max(floor_dps, 1e-3), 2);
+    }
+  }
+  return plateau >= 3 ? dj : 0.0;
+}
+
+void finish(Candidate& c, double evidence, double log_m) {
+  c.evidence = evidence > 0 ? evidence : -log_m;
+  c.chi2 = std::max(0.0, evidence);
+  c.dof = static_cast<int>(c.params.size());
+  c.p_value = evidence > 0 ? 0.0 : 1.0;
+}
+
+}  // namespace
+
+std::vector<Candidate> adc_candidates(const Replay& r, const Residual& res, const CompareModel& model,
+                                      const std::array<double, 6>& noise_floor_dps, double log_m) {
+  Candidate q, sat, miss;
+  q.effect = Effect::kQuantization;
+  sat.effect = Effect::kSaturation;
+  miss.effect = Effect::kAdcMissingCodes;
+  double qev = 0, sev = 0, mev = 0;
+  for (int c = 0; c < 6; ++c) {
+    const int s = c / 3, j = c % 3;
+    const twin::SensorParams& p = model.sensor[s];
+    std::vector<double> y;
+    y.reserve(res.n);
+    for (std::size_t k = 0; k < res.n; ++k)
+      if (r.usable[k]) y.push_back(r.gyro_dps[s][k][j]);
+    const double ny = static_cast<double>(y.size());
+    double R = 0.0;
+    const double lsb = data_lsb(y, p, &R);
+    const double model_lsb = p.quantization.enabled ? 1.0 / p.quantization.sensitivity_lsb_per_dps : 0.0;
+    double ev_q = -log_m;
+    if (lsb > 0 && (model_lsb == 0.0 || std::abs(lsb - model_lsb) > 1e-3 * model_lsb)) {
+      ev_q = std::min(2.0 * ny * R * R, 2.0 * ny) - 2 * log_m;
+    } else if (lsb == 0.0 && model_lsb > 0.0) {
+      const double Rm = lattice(y, model_lsb);  // the model quantises, the data lie on no lattice
+      ev_q = (Rm < 0.5 ? 2.0 * ny * (1.0 - Rm) * 0.01 : 0.0) - log_m;
+    }
+    if (ev_q > 0) {
+      qev += ev_q;
+      q.params.push_back(param(Param::kQuantLsbPerDps, c, lsb > 0 ? 1.0 / lsb : 0.0, 0.0,
+                               p.quantization.enabled ? p.quantization.sensitivity_lsb_per_dps : 0.0));
+    }
+    if (lsb > 0 && !p.adc_missing_codes.enabled) {
+      double ev_m = 0.0;
+      const std::vector<long> codes = missing_codes(y, lsb, log_m, &ev_m);
+      if (!codes.empty() && ev_m > 0) {
+        mev += ev_m;
+        miss.params.push_back(param(Param::kMissingCodes, c, static_cast<double>(codes.size()), 0.0, 0.0));
+        for (long code : codes) miss.codes.emplace_back(c, static_cast<int>(code));
+      }
+    }
+    double ymax = 0.0;
+    for (double v : y) ymax = std::max(ymax, std::abs(v));
+    const double fsm = p.saturation.enabled ? p.saturation.full_scale_dps : kInf;
+    const double dj = saturation_evidence(r, res, c, ymax, std::max(lsb, 1e-6) * 0.51, noise_floor_dps[c]);
+    if (dj > log_m && ymax < fsm - 1e-6) {
+      sev += dj - log_m;
+      sat.params.push_back(param(Param::kFullScaleDps, c, ymax, lsb, p.saturation.enabled ? p.saturation.full_scale_dps : 0.0));
+    }
+  }
+  finish(q, qev, log_m);
+  finish(sat, sev, log_m);
+  finish(miss, mev, log_m);
+  return {q, sat, miss};
+}
+
+}  // namespace driftless::diagnose

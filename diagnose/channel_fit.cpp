@@ -1,0 +1,314 @@
+#include "diagnose/channel_fit.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <Eigen/Dense>
+
+namespace driftless::diagnose {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+double median_abs(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end(), [](double a, double b) { return std::abs(a) < std::abs(b); });
+  return std::abs(*mid);
+}
+
+// the nuisance-reduced quadratic of one channel over columns xs (positions in cols):
+// objective(beta_x) = J - 2 s' beta_x + beta_x' S beta_x, the nuisance (prior > 0, not in xs)
+// at its MAP given beta_x; in units of the channel's whitened residual variance
+struct Partial {
+  Eigen::MatrixXd S;
+  Eigen::VectorXd s;
+  double J = 0.0;
+};
+
+Partial partial_out(const ChannelData& c, const std::vector<int>& xs) {
+  const int P = static_cast<int>(c.cols.size());
+  const int yi = P;
+  std::vector<int> N;
+  for (int i = 0; i < P; ++i) {
+    if (c.prior[i] > 0 && std::find(xs.begin(), xs.end(), i) == xs.end()) N.push_back(i);
+  }
+  const int n = static_cast<int>(N.size()), p = static_cast<int>(xs.size());
+  Eigen::MatrixXd C(p + 1, p + 1);
+  for (int q = 0; q < p; ++q) {
+    for (int r = 0; r < p; ++r) C(q, r) = c.gram(xs[q], xs[r]);
+    C(q, p) = C(p, q) = c.gram(xs[q], yi);
+  }
+  C(p, p) = c.gram(yi, yi);
+  if (n > 0) {
+    Eigen::MatrixXd A(n, n), B(n, p + 1);
+    for (int a = 0; a < n; ++a) {
+      for (int b = 0; b < n; ++b) A(a, b) = c.gram(N[a], N[b]);
+      A(a, a) += c.sigma2 / (c.prior[N[a]] * c.prior[N[a]]);  // prior precision, whitened units
+      for (int q = 0; q < p; ++q) B(a, q) = c.gram(N[a], xs[q]);
+      B(a, p) = c.gram(N[a], yi);
+    }
+    C -= B.transpose() * A.ldlt().solve(B);
+  }
+  return {C.topLeftCorner(p, p) / c.sigma2, C.col(p).head(p) / c.sigma2, C(p, p) / c.sigma2};
+}
+
+// pseudo-inverse of a symmetric positive semi-definite matrix (eigenvalues below 1e-9 of the
+// largest are not identified) and its rank
+struct PseudoInverse {
+  Eigen::MatrixXd inv;
+  int rank = 0;
+};
+PseudoInverse pseudo_inverse(const Eigen::MatrixXd& H) {
+  const int p = static_cast<int>(H.rows());
+  PseudoInverse out;
+  out.inv = Eigen::MatrixXd::Zero(p, p);
+  if (p == 0) return out;
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(H);
+  const double top = std::max(es.eigenvalues().maxCoeff(), 1e-300);
+  Eigen::VectorXd d = Eigen::VectorXd::Zero(p);
+  for (int i = 0; i < p; ++i) {
+    if (es.eigenvalues()[i] > 1e-9 * top && es.eigenvalues()[i] > 1e-12) {
+      d[i] = 1.0 / es.eigenvalues()[i];
+      ++out.rank;
+    }
+  }
+  out.inv = es.eigenvectors() * d.asDiagonal() * es.eigenvectors().transpose();
+  return out;
+}
+
+// the columns of channel `channel` a spec drives: positions in cols, and per position the
+// free-parameter indices and the fixed contribution
+struct ChannelUse {
+  std::vector<int> pos;                       // distinct positions in cols
+  std::vector<std::vector<int>> free_of_pos;  // free parameter indices per position
+  Eigen::VectorXd fixed;                      // summed fixed values per position
+};
+ChannelUse channel_use(const ChannelData& c, int channel, const FitSpec& spec) {
+  ChannelUse u;
+  auto slot = [&](int col) {
+    const int i = c.index(col);
+    if (i < 0) return -1;
+    auto it = std::find(u.pos.begin(), u.pos.end(), i);
+    if (it != u.pos.end()) return static_cast<int>(it - u.pos.begin());
+    u.pos.push_back(i);
+    u.free_of_pos.emplace_back();
+    return static_cast<int>(u.pos.size()) - 1;
+  };
+  std::vector<std::pair<int, double>> fixed_at;
+  for (std::size_t f = 0; f < spec.free.size(); ++f) {
+    for (const ColumnUse& cu : columns_of(spec.free[f])) {
+      if (cu.channel != channel) continue;
+      const int q = slot(cu.col);
+      if (q >= 0) u.free_of_pos[static_cast<std::size_t>(q)].push_back(static_cast<int>(f));
+    }
+  }
+  for (const auto& [ref, v] : spec.fixed) {
+    for (const ColumnUse& cu : columns_of(ref)) {
+      if (cu.channel != channel) continue;
+      const int q = slot(cu.col);
+      if (q >= 0) fixed_at.emplace_back(q, v);
+    }
+  }
+  u.fixed = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(u.pos.size()));
+  for (const auto& [q, v] : fixed_at) u.fixed[q] += v;
+  return u;
+}
+
+}  // namespace
+
+double fit_white_density(const ChannelData& c, const BlockSeries& blocks, std::span<const double> z) {
+  std::vector<double> d;
+  for (std::size_t b = 1; b < z.size(); ++b) {
+    if (blocks.count[b] && blocks.count[b - 1]) d.push_back(z[b] - z[b - 1]);
+  }
+  std::size_t L = 1;
+  for (auto cnt : blocks.count) L = std::max<std::size_t>(L, cnt);
+  const double n0 = std::max(1e-7, 1.4826 * median_abs(d) / std::sqrt(2.0) *
+                                       std::sqrt(static_cast<double>(L) / blocks.sample_rate_hz));
+  auto f = [&](double logN) {
+    ChannelNoise nz = c.noise;
+    nz.white_dps_rthz = std::exp(logN);
+    return BiasWhitener(blocks, nz).neg2_loglik(z);
+  };
+  return std::exp(golden_min(f, std::log(n0) - 2.0, std::log(n0) + 2.0, 30));
+}
+
+namespace {
+
+}  // namespace
+
+// whitened Gram of [cols..., z] and the null (nuisance-only) fit's variance and objective
+void rebuild_gram(ChannelData& c, const BlockSeries& blocks) {
+  const int P = static_cast<int>(c.cols.size());
+  const std::size_t mb = c.z.size();
+  const BiasWhitener W(blocks, c.noise);
+  c.m = W.used_count();
+  Eigen::MatrixXd A(static_cast<Eigen::Index>(mb), P + 1);
+  std::vector<double> col(mb), w(mb);
+  for (int i = 0; i <= P; ++i) {
+    for (std::size_t b = 0; b < mb; ++b) col[b] = i < P ? c.block_cols(static_cast<Eigen::Index>(b), i) : c.z[b];
+    W.whiten(col, w);
+    for (std::size_t b = 0; b < mb; ++b) A(static_cast<Eigen::Index>(b), i) = w[b];
+  }
+  c.gram = A.transpose() * A;
+  c.sigma2 = 1.0;
+  const double j = partial_out(c, {}).J;
+  c.sigma2 = std::max(1e-6, j / static_cast<double>(std::max<std::size_t>(c.m, 1)));
+  c.j0 = partial_out(c, {}).J;
+}
+
+namespace {
+
+// block means of every excited column of channel (s, j)
+void fill_columns(const ColumnInputs& in, const Residual& res, ChannelData& c) {
+  const std::size_t n = res.n, mb = res.blocks;
+  std::vector<double> tmp(n), bm(mb);
+  std::vector<std::vector<double>> kept;
+  for (int col = 0; col < kNumCols; ++col) {
+    if ((col == kTempBias || col == kTempScale) && res.temp_span_c < 0.2) continue;
+    for (std::size_t k = 0; k < n; ++k) tmp[k] = res.bmask[k] ? column_value(in, c.s, c.j, col, k) : 0.0;
+    block_means(tmp, res.bmask, res.block_len, bm);
+    double ss = 0.0;
+    for (std::size_t b = 0; b < mb; ++b) ss += res.block_series.count[b] ? bm[b] * bm[b] : 0.0;
+    if (ss < 1e-20) continue;  // not excited by this log
+    c.cols.push_back(col);
+    c.prior.push_back(prior_sigma(in.params[c.s], c.j, col));
+    kept.push_back(bm);
+  }
+  c.block_cols.resize(static_cast<Eigen::Index>(mb), static_cast<Eigen::Index>(kept.size()));
+  for (std::size_t i = 0; i < kept.size(); ++i)
+    for (std::size_t b = 0; b < mb; ++b)
+      c.block_cols(static_cast<Eigen::Index>(b), static_cast<Eigen::Index>(i)) = static_cast<float>(kept[i][b]);
+}
+
+}  // namespace
+
+int ChannelData::index(int col) const {
+  auto it = std::find(cols.begin(), cols.end(), col);
+  return it == cols.end() ? -1 : static_cast<int>(it - cols.begin());
+}
+
+double golden_min(const std::function<double(double)>& f, double lo, double hi, int iters) {
+  const double g = 0.5 * (std::sqrt(5.0) - 1.0);
+  double a = lo, b = hi;
+  double x1 = b - g * (b - a), x2 = a + g * (b - a);
+  double f1 = f(x1), f2 = f(x2);
+  for (int i = 0; i < iters; ++i) {
+    if (f1 < f2) {
+      b = x2; x2 = x1; f2 = f1; x1 = b - g * (b - a); f1 = f(x1);
+    } else {
+      a = x1; x1 = x2; f1 = f2; x2 = a + g * (b - a); f2 = f(x2);
+    }
+  }
+  return 0.5 * (a + b);
+}
+
+Channels build_channels(const ColumnInputs& in, const Residual& res) {
+  Channels ch;
+  for (int c = 0; c < 6; ++c) {
+    ChannelData& C = ch[c];
+    C.s = c / 3;
+    C.j = c % 3;
+    const twin::SensorParams& p = in.params[C.s];
+    C.z = block_series_of(res, res.e_dps[c]);
+    fill_columns(in, res, C);
+    // noise model: the model's bias processes; the white density is a nuisance, fitted
+    C.noise.white_dps_rthz = p.white_noise.enabled ? std::max(1e-6, p.white_noise.density_dps_rthz[C.j]) : 1e-6;
+    C.noise.gm_sigma_dps = p.bias_instability.enabled ? p.bias_instability.sigma_dps[C.j] : 0.0;
+    C.noise.gm_tau_s = p.bias_instability.tau_s[C.j];
+    C.noise.rrw_dps_rts = p.rate_random_walk.enabled ? p.rate_random_walk.k_dps_rts[C.j] : 0.0;
+    C.noise.turn_on_sigma_dps = 1e3;
+    refit_white(C, res.block_series, C.z);
+    // again without the nuisance structure
+    refit_white(C, res.block_series, block_residual(C, channel_coefficients(C, c, FitSpec{}, FitResult{})));
+  }
+  return ch;
+}
+
+double refit_white(ChannelData& c, const BlockSeries& blocks, std::span<const double> z) {
+  const double before = c.noise.white_dps_rthz;
+  c.noise.white_dps_rthz = fit_white_density(c, blocks, z);
+  rebuild_gram(c, blocks);
+  return std::abs(c.noise.white_dps_rthz / before - 1.0);
+}
+
+double log_blocks(const Channels& ch) {
+  double m = 0.0;
+  for (const auto& c : ch) m += static_cast<double>(c.m);
+  return std::log(std::max(2.0, m / 6.0));
+}
+
+FitResult map_fit(const Channels& ch, const FitSpec& spec) {
+  const auto P = static_cast<Eigen::Index>(spec.free.size());
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(P, P);
+  Eigen::VectorXd g = Eigen::VectorXd::Zero(P);
+  double cst = 0.0, j_null = 0.0;
+  for (int c = 0; c < 6; ++c) {
+    const ChannelUse u = channel_use(ch[c], c, spec);
+    if (u.pos.empty()) continue;
+    const Partial pt = partial_out(ch[c], u.pos);
+    const auto q = static_cast<Eigen::Index>(u.pos.size());
+    Eigen::MatrixXd A = Eigen::MatrixXd::Zero(q, P);
+    for (Eigen::Index i = 0; i < q; ++i)
+      for (int f : u.free_of_pos[static_cast<std::size_t>(i)]) A(i, f) += 1.0;
+    H += A.transpose() * pt.S * A;
+    g += A.transpose() * (pt.s - pt.S * u.fixed);
+    cst += pt.J - 2.0 * pt.s.dot(u.fixed) + u.fixed.dot(pt.S * u.fixed);
+    j_null += ch[c].j0;
+  }
+  const PseudoInverse pi = pseudo_inverse(H);
+  FitResult out;
+  out.value = pi.inv * g;
+  out.rank = pi.rank;
+  out.gain = j_null - (cst - g.dot(out.value));
+  out.sigma = Eigen::VectorXd(P);
+  for (Eigen::Index i = 0; i < P; ++i) out.sigma[i] = pi.inv(i, i) > 0 ? std::sqrt(pi.inv(i, i)) : kInf;
+  return out;
+}
+
+Eigen::VectorXd channel_coefficients(const ChannelData& c, int channel, const FitSpec& spec, const FitResult& fit) {
+  const int P = static_cast<int>(c.cols.size());
+  Eigen::VectorXd coef = Eigen::VectorXd::Zero(P);
+  std::vector<int> held;
+  auto hold = [&](const ParamRef& ref, double v) {
+    for (const ColumnUse& cu : columns_of(ref)) {
+      const int i = cu.channel == channel ? c.index(cu.col) : -1;
+      if (i < 0) continue;
+      coef[i] += v;
+      if (std::find(held.begin(), held.end(), i) == held.end()) held.push_back(i);
+    }
+  };
+  for (std::size_t f = 0; f < spec.free.size(); ++f) hold(spec.free[f], fit.value[static_cast<Eigen::Index>(f)]);
+  for (const auto& [ref, v] : spec.fixed) hold(ref, v);
+  // the nuisance at its MAP given the held columns:
+  // beta_N = (G_NN + sigma^2/prior^2)^-1 (G_Ny - G_NX beta_X)
+  std::vector<int> N;
+  for (int i = 0; i < P; ++i)
+    if (c.prior[i] > 0 && std::find(held.begin(), held.end(), i) == held.end()) N.push_back(i);
+  if (N.empty()) return coef;
+  const auto k = static_cast<Eigen::Index>(N.size());
+  Eigen::MatrixXd A(k, k);
+  Eigen::VectorXd b(k);
+  for (Eigen::Index a = 0; a < k; ++a) {
+    for (Eigen::Index e = 0; e < k; ++e) A(a, e) = c.gram(N[a], N[e]);
+    A(a, a) += c.sigma2 / (c.prior[N[a]] * c.prior[N[a]]);
+    b[a] = c.gram(N[a], P);
+    for (int h : held) b[a] -= c.gram(N[a], h) * coef[h];
+  }
+  const Eigen::VectorXd x = A.ldlt().solve(b);
+  for (Eigen::Index a = 0; a < k; ++a) coef[N[a]] = x[a];
+  return coef;
+}
+
+std::vector<double> block_residual(const ChannelData& c, const Eigen::VectorXd& coef) {
+  std::vector<double> zr = c.z;
+  for (int i = 0; i < static_cast<int>(c.cols.size()); ++i) {
+    if (coef[i] == 0.0) continue;
+    for (std::size_t b = 0; b < zr.size(); ++b) zr[b] -= c.block_cols(static_cast<Eigen::Index>(b), i) * coef[i];
+  }
+  return zr;
+}
+
+}  // namespace driftless::diagnose

@@ -1,0 +1,133 @@
+// The report's plots: gnuplot data and scripts under DIR/plots/, drawn to PNG.
+
+#include <sstream>
+
+#include <fmt/core.h>
+
+#include "diagnose/report_plots.hpp"
+#include "diagnose/report_text.hpp"
+#include "estimator/output_file.hpp"
+#include "report/json.hpp"
+
+namespace driftless::diagnose {
+namespace {
+
+using report_text::gnuplot_png;
+std::string n(double v) { return report::json_number(v); }
+
+// residual after the selected effects and the smoothed bias (points), per sensor; the smoothed
+// bias itself below (it is a nuisance, drawn so its size is visible)
+Plot residual_plot(const CompareResult& r, const std::filesystem::path& dir) {
+  const auto dat = dir / "residual.dat";
+  {
+    std::ostringstream d;
+    for (std::size_t b = 0; b < r.block_t_s.size(); ++b) {
+      d << fmt::format("{:.3f}", r.block_t_s[b]);
+      for (int c = 0; c < 6; ++c) d << ' ' << n(r.block_residual_dps[c][b]) << ' ' << n(r.block_bias_dps[c][b]);
+      d << '\n';
+    }
+    io::write_file(dat, d.str());  // before gnuplot reads it
+  }
+  std::string s = "set termoption noenhanced\nset multiplot layout 3,1\nset xlabel 't (s)'\nset key outside right\n"
+                  "set datafile missing 'null'\n";
+  for (int sn = 0; sn < 2; ++sn) {
+    s += fmt::format("set ylabel 'deg/s'\nset title 'sensor {}: block-mean residual after the selected effects and the "
+                     "smoothed bias'\nplot ", sn + 1);
+    for (int a = 0; a < 3; ++a) {
+      const int c = sn * 3 + a;
+      s += fmt::format("'{}' u 1:{} w p pt 7 ps 0.25 t '{}'{}", dat.filename().string(), 2 + 2 * c, channel_name(c), a < 2 ? ", " : "\n");
+    }
+  }
+  s += "set title 'smoothed bias (nuisance: turn-on bias and drift)'\nplot ";
+  for (int c = 0; c < 6; ++c) s += fmt::format("'{}' u 1:{} w l t '{}'{}", dat.filename().string(), 3 + 2 * c, channel_name(c), c < 5 ? ", " : "\n");
+  s += "unset multiplot\n";
+  return {"Residual over time", gnuplot_png(dir, "residual", s, 900, 720)};
+}
+
+Plot windows_plot(const CompareResult& r, const std::filesystem::path& dir) {
+  const auto dat = dir / "windows.dat";
+  {
+    std::ostringstream d;
+    for (const auto& w : r.windows) {
+      d << fmt::format("{:.3f}", 0.5 * (w.t0_s + w.t1_s));
+      for (int c = 0; c < 6; ++c) d << ' ' << n(w.rms_dps[c]) << ' ' << n(r.channels[c].noise_floor_dps);
+      d << '\n';
+    }
+    io::write_file(dat, d.str());  // before gnuplot reads it
+  }
+  std::string s = "set termoption noenhanced\nset xlabel 't (s)'\nset ylabel 'rms (deg/s)'\nset yrange [0:*]\nset key outside right\n"
+                  "set title 'windowed residual rms after the selected effects (dashed: the model noise floor)'\nplot ";
+  for (int c = 0; c < 6; ++c) {
+    s += fmt::format("'{0}' u 1:{1} w lp lc {3} t '{2}', '' u 1:{4} w l dt 2 lc {3} notitle{5}", dat.filename().string(), 2 + 2 * c,
+                     channel_name(c), c + 1, 3 + 2 * c, c < 5 ? ", " : "\n");
+  }
+  return {"Windowed residual RMS", gnuplot_png(dir, "windows", s)};
+}
+
+// per sensor: the residual's ADEV with its 95 % interval (error bars) against the model's
+// ADEV and its 95 % band for a record this long
+Plot allan_plot(const CompareResult& r, const std::filesystem::path& dir) {
+  const auto dat = dir / "adev.dat";
+  {
+    std::ostringstream d;
+    std::size_t np = 0;
+    for (const auto& ch : r.channels) np = std::max(np, ch.adev.points.size());
+    for (std::size_t i = 0; i < np; ++i) {
+      for (int c = 0; c < 6; ++c) {
+        const auto& ch = r.channels[c];
+        if (i < ch.adev.points.size() && i < ch.adev_model.size()) {
+          const auto& p = ch.adev.points[i];
+          d << n(p.tau_s) << ' ' << n(p.adev) << ' ' << n(p.adev_lo) << ' ' << n(p.adev_hi) << ' ' << n(ch.adev_model[i]) << ' '
+            << n(ch.adev_model_lo[i]) << ' ' << n(ch.adev_model_hi[i]) << ' ';
+        } else {
+          d << "null null null null null null null ";
+        }
+      }
+      d << '\n';
+    }
+    io::write_file(dat, d.str());  // before gnuplot reads it
+  }
+  std::string s = "set termoption noenhanced\nset multiplot layout 1,2\nset logscale xy\nset xlabel 'tau (s)'\nset ylabel 'ADEV (deg/s)'\n"
+                  "set key bottom left\nset datafile missing 'null'\nset style fill transparent solid 0.2 noborder\n";
+  for (int sn = 0; sn < 2; ++sn) {
+    s += fmt::format("set title 'sensor {}: residual (95 % CI) and model (95 % band)'\nplot ", sn + 1);
+    for (int a = 0; a < 3; ++a) {
+      const int c = sn * 3 + a, o = 7 * c;
+      s += fmt::format("'{0}' u {1}:{6}:{7} w filledcurves lc {8} notitle, '' u {1}:{5} w l lc {8} dt 2 t '{9} model', "
+                       "'' u {1}:{2}:{3}:{4} w yerrorbars pt 7 ps 0.5 lc {8} t '{9}'{10}",
+                       dat.filename().string(), o + 1, o + 2, o + 3, o + 4, o + 5, o + 6, o + 7, a + 1, channel_name(c), a < 2 ? ", " : "\n");
+    }
+  }
+  s += "unset multiplot\n";
+  return {"Allan deviation", gnuplot_png(dir, "adev", s, 1100, 460)};
+}
+
+// bars from zero: the residual rms after the selected effects by regime
+Plot regimes_plot(const CompareResult& r, const std::filesystem::path& dir) {
+  const auto dat = dir / "regimes.dat";
+  {
+    std::ostringstream d;
+    for (const auto& g : r.regimes) {
+      if (g.group == "flip" && g.name == "during flips") continue;  // no truth there: in the table only
+      d << '"' << g.group << ": " << g.name << '"';
+      for (int c = 0; c < 6; ++c) d << ' ' << n(g.rms_dps[c]);
+      d << '\n';
+    }
+    io::write_file(dat, d.str());  // before gnuplot reads it
+  }
+  std::string s = "set termoption noenhanced\nset style data histograms\nset style histogram clustered gap 1\n"
+                  "set style fill solid 0.8\n"
+                  "set yrange [0:*]\nset xtics rotate by -30\nset ylabel 'rms (deg/s)'\nset key outside right\n"
+                  "set title 'residual rms by regime, after the selected effects (during flips: table only, no truth there)'\nplot ";
+  for (int c = 0; c < 6; ++c) s += fmt::format("'{}' u {}:xtic(1) t '{}'{}", dat.filename().string(), 2 + c, channel_name(c), c < 5 ? ", " : "\n");
+  return {"Residual by regime", gnuplot_png(dir, "regimes", s, 900, 480)};
+}
+
+}  // namespace
+
+std::vector<Plot> draw_plots(const CompareResult& r, const std::filesystem::path& plot_dir) {
+  std::filesystem::create_directories(plot_dir);
+  return {residual_plot(r, plot_dir), windows_plot(r, plot_dir), allan_plot(r, plot_dir), regimes_plot(r, plot_dir)};
+}
+
+}  // namespace driftless::diagnose

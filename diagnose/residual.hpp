@@ -1,0 +1,41 @@
+// Stage 1 of a comparison: the model's prediction along a replayed log, the residual
+// (measured - predicted) per channel, which samples the fits may use, and the block layout.
+// docs/compare.md sections 1-2.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "diagnose/bias_filter.hpp"
+#include "diagnose/compare_model.hpp"
+#include "diagnose/replay.hpp"
+
+namespace driftless::diagnose {
+
+/// The residual of a log against a model, per sample and per 0.1 s block.
+struct Residual {
+  std::size_t n = 0;            // samples
+  double fs_hz = 0.0;           // sample rate of the replay
+  std::size_t block_len = 1;    // samples per block
+  std::size_t blocks = 0;       // number of blocks
+  std::array<SensorPrediction, 2> pred;       // noise-free prediction and temperature per sensor
+  std::array<std::vector<double>, 6> e_dps;   // measured - predicted; NaN where unusable
+  std::vector<std::uint8_t> mask;   // sample enters the fits (usable, at rest, rebuilt, no burst)
+  std::vector<std::uint8_t> bmask;  // ... and its block has enough data
+  BlockSeries block_series;         // block times and sample counts (0 = block left out)
+  double temp_span_c = 0.0;         // spread of the temperature over the log, degC
+  std::size_t samples_used = 0;
+  std::vector<std::string> notes;   // what was left out and why
+};
+
+/// Predicts both sensors along `r` with `model`, forms the residual, leaves out samples where a
+/// platform left its stop while the log says it rests, and lays out blocks of `block_s`.
+/// Throws std::runtime_error when fewer than 50 samples remain.
+Residual make_residual(const Replay& r, const CompareModel& model, double block_s);
+
+/// Block means of a per-sample series over the residual's blocks (masked samples only).
+std::vector<double> block_series_of(const Residual& res, const std::vector<double>& x);
+
+}  // namespace driftless::diagnose

@@ -1,0 +1,40 @@
+// The residual after the selected effects, and what a comparison reports about it: per-channel
+// statistics (whiteness, Allan deviation against the model's band), regimes, windows,
+// correlations with inputs, and the verdict in one sentence. docs/compare.md section 4.
+#pragma once
+
+#include <array>
+#include <vector>
+
+#include "diagnose/channel_fit.hpp"
+#include "diagnose/compare.hpp"
+
+namespace driftless::diagnose {
+
+/// The residual of every channel after a fit (nuisance and the fit's effects taken out).
+struct AfterFit {
+  std::array<std::vector<double>, 6> z;       // block means
+  std::array<std::vector<double>, 6> bias;    // smoothed bias per block (RTS)
+  std::array<std::vector<float>, 6> e_drift;  // per sample, bias drift kept (NaN unusable)
+  std::array<std::vector<float>, 6> e;        // per sample, smoothed bias removed too
+};
+/// Computes the residual after `spec` / `fit` (an empty spec: the nuisance-only residual).
+AfterFit residual_after(const Channels& ch, const ColumnInputs& in, const Residual& res, const FitSpec& spec,
+                        const FitResult& fit, bool per_sample);
+
+/// Fills channel statistics: raw and nuisance-only residual (`before`, against `model`), after
+/// the selection (`after`, against `selected_model`: the model with the selected effects), noise
+/// floors, whiteness of the whitened block residual, turn-on bias, Allan deviation against the
+/// selected model's with its 95 % band.
+void summarise_channels(const Channels& ch, const Residual& res, const CompareModel& model,
+                        const CompareModel& selected_model, const AfterFit& before, const AfterFit& after,
+                        const CompareOptions& opt, CompareResult& out);
+
+/// Fills regimes, windows and correlations from the residual after the selection.
+void summarise_regimes(const Replay& r, const Residual& res, const Channels& ch, const AfterFit& after,
+                       const CompareOptions& opt, CompareResult& out);
+
+/// Sets the verdict and the one-sentence statement from the selection, noise model and tests.
+void decide_verdict(CompareResult& out);
+
+}  // namespace driftless::diagnose

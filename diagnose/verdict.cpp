@@ -1,0 +1,66 @@
+// The verdict of a comparison in one sentence: consistent with the noise model, missing effects
+// (each with its values +- 1 sigma), or structure no candidate explains (docs/compare.md 4).
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/core.h>
+
+#include "diagnose/summary.hpp"
+
+namespace driftless::diagnose {
+namespace {
+
+std::string value_text(const FittedParam& p) {
+  return fmt::format("{} = {:.4g} ± {:.2g} {}", p.name(), p.new_value(), p.sigma, p.unit());
+}
+
+// "scale_factor on sensor 1 (x): s1.x.value_pct = 3.01 ± 0.02 %"
+std::string effect_text(const Candidate& c) {
+  std::string ps;
+  for (std::size_t i = 0; i < std::min<std::size_t>(c.params.size(), 4); ++i) ps += (i ? ", " : "") + value_text(c.params[i]);
+  if (c.params.size() > 4) ps += fmt::format(", ... ({} more)", c.params.size() - 4);
+  if (c.effect == Effect::kLowpass) {
+    // say "no filter" where the fitted delay is zero
+    for (const auto& p : c.params)
+      if (p.new_value() <= 1e-4) ps += p.ref.sensor < 0 ? std::string(": no low-pass") : fmt::format("; sensor {}: no low-pass", p.ref.sensor + 1);
+  }
+  const std::string where = sensor_text(c) == "-" ? "box" : "sensor " + sensor_text(c);
+  return fmt::format("{} on {} ({}){}: {}", effect_id(c.effect), where, axis_text(c), c.absurd ? " [IMPLAUSIBLE]" : "", ps);
+}
+
+}  // namespace
+
+void decide_verdict(CompareResult& out) {
+  bool white_ok = true;
+  for (const auto& cs : out.channels) white_ok = white_ok && cs.white;
+  std::string noise;
+  for (const auto& c : out.noise_model) noise += (noise.empty() ? "" : "; ") + effect_text(c);
+  const std::string noise_tail = noise.empty() ? "" : "; the noise model differs (a noise-model change, after the effects): " + noise;
+  if (!out.selected.empty()) {
+    out.verdict = Verdict::kMissingEffect;
+    std::string list;
+    for (const auto& c : out.selected) list += (list.empty() ? "" : "; ") + effect_text(c);
+    out.statement = fmt::format("{} missing effect{} (evidence > {:g}): {}{}", out.selected.size(),
+                                out.selected.size() == 1 ? "" : "s", out.threshold, list, noise_tail);
+    if (out.any_absurd()) out.statement += "; IMPLAUSIBLE values: check the log's units, axes and frame (docs/log-format.md)";
+    return;
+  }
+  if (!white_ok || !out.correlations.empty()) {
+    out.verdict = Verdict::kUnexplained;
+    std::string sig, bad;
+    for (std::size_t i = 0; i < std::min<std::size_t>(out.correlations.size(), 4); ++i)
+      sig += fmt::format("{}{} on {} (rho {:+.3f})", i ? ", " : "", out.correlations[i].signal,
+                         channel_name(out.correlations[i].channel), out.correlations[i].rho);
+    for (int c = 0; c < 6; ++c)
+      if (!out.channels[c].white) bad += (bad.empty() ? "" : ", ") + channel_name(c);
+    out.statement = fmt::format("unexplained structure: no candidate effect explains the residual{}{}{}",
+                                bad.empty() ? "" : "; not white on " + bad,
+                                sig.empty() ? "" : "; it correlates with " + sig, noise_tail);
+    return;
+  }
+  out.verdict = Verdict::kConsistent;
+  out.statement = "consistent with the noise model: the residual is white and no candidate effect is supported by the data" +
+                  noise_tail;
+}
+
+}  // namespace driftless::diagnose

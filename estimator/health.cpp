@@ -1,0 +1,156 @@
+#include "estimator/health.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "estimator/stats.hpp"
+
+namespace driftless::est {
+namespace {
+
+long tenth_deg(double deg) { return std::isfinite(deg) ? std::lround(deg * 10.0) : 1L << 40; }
+
+// a finding of severity ok is a note: it does not change the verdict
+void add(HealthReport& h, HealthFinding f) {
+  if (f.severity == HealthVerdict::kFailed) h.verdict = HealthVerdict::kFailed;
+  else if (f.severity == HealthVerdict::kDegraded && h.verdict == HealthVerdict::kOk) h.verdict = HealthVerdict::kDegraded;
+  h.findings.push_back(std::move(f));
+}
+
+}  // namespace
+
+const char* to_string(HealthVerdict v) {
+  switch (v) {
+    case HealthVerdict::kOk: return "ok";
+    case HealthVerdict::kDegraded: return "degraded";
+    case HealthVerdict::kFailed: return "failed";
+  }
+  return "?";
+}
+
+void HealthMonitor::on_update(const UpdateRecord& rec, const DriftlessFilter& filter) {
+  ++updates_;
+  PositionCount& pc = by_position_[{tenth_deg(rec.plat1_deg), tenth_deg(rec.plat2_deg)}];
+  ++pc.updates;
+  if (!rec.accepted) {
+    ++rejected_;
+    ++pc.rejected;
+    return;
+  }
+  // the NIS of accepted updates: under a consistent model each is chi-square with `dim` dof.
+  // Before lock S is dominated by P0, a spec bound rather than a statistical sigma, so those
+  // updates are kept apart and only used when the filter never locks.
+  if (std::isfinite(rec.nis)) {
+    NisSums& sums = locked_ ? nis_locked_ : nis_before_;
+    sums.sum += rec.nis;
+    sums.dof += rec.dim;
+    ++sums.n;
+  }
+  if (!locked_ && filter.sigma_dps().maxCoeff() < limits_.lock_sigma_dps) {
+    locked_ = true;
+    lock_t_s_ = rec.t_s;
+  }
+}
+
+// too many gate rejections: concentrated on some position pairs (a position-dependent sensor
+// error the constant-bias model cannot absorb) or spread over all of them
+void HealthMonitor::add_gate_findings(HealthReport& h) const {
+  if (!(h.rejected_fraction > limits_.max_rejected_fraction) || h.rejected == h.updates) return;
+  HealthFinding f;
+  f.cause = HealthCause::kRejections;
+  f.value = h.rejected_fraction;
+  PositionCount in, out;
+  std::vector<std::array<double, 2>> pairs;
+  for (const auto& [key, pc] : by_position_) {
+    const bool bad = pc.updates >= 3 && double(pc.rejected) > limits_.position_rejected_fraction * double(pc.updates);
+    PositionCount& c = bad ? in : out;
+    c.updates += pc.updates;
+    c.rejected += pc.rejected;
+    if (bad) pairs.push_back({double(key.first) / 10.0, double(key.second) / 10.0});
+  }
+  if (!pairs.empty() && out.updates > 0) {
+    const double fin = double(in.rejected) / double(in.updates), fout = double(out.rejected) / double(out.updates);
+    if (fout < 0.25 * fin) {
+      f.cause = HealthCause::kRejectionsAtPosition;
+      f.value = fin;
+      f.positions_deg = pairs;
+    }
+  }
+  add(h, f);
+}
+
+// the mean NIS against its chi-square band, and its ratio to the dof
+void HealthMonitor::add_nis_findings(HealthReport& h) const {
+  if (h.nis_updates == 0) return;
+  const bool high = h.nis_mean > h.nis_mean_band_hi, low = h.nis_mean < h.nis_mean_band_lo;
+  if (!high && !low) return;
+  HealthFinding f;
+  f.cause = high ? HealthCause::kNoiseUnderstated : HealthCause::kNoiseOverstated;
+  // sigma too large is safe (the estimate is trusted less than it deserves): a note, not degraded
+  if (low) f.severity = HealthVerdict::kOk;
+  f.value = h.nis_mean;
+  f.suggested = h.nis_mean / h.nis_dof_mean;
+  add(h, f);
+}
+
+// never locked (failed) and the components that kept their prior sigma
+void HealthMonitor::add_lock_findings(HealthReport& h, const DriftlessFilter& filter, double duration_s) const {
+  const EstimatorConfig& cfg = filter.config();
+  // the sigma a component would have without any measurement: P0 grown by the random walk
+  const double T = std::isfinite(duration_s) ? std::max(duration_s, 0.0) : 0.0;
+  const double prior_sigma = std::sqrt(cfg.initial_sigma_dps * cfg.initial_sigma_dps + cfg.q_dps2_per_s() * T);
+  const Vector6d sigma = filter.sigma_dps();
+  for (int i = 0; i < 6; ++i) {
+    if (sigma[i] > limits_.unobservable_ratio * prior_sigma) h.unobservable.push_back(i);
+  }
+  if (h.updates == 0 || h.rejected == h.updates || !h.locked) {
+    HealthFinding f;
+    f.severity = HealthVerdict::kFailed;
+    f.cause = h.updates == 0 ? HealthCause::kNoUpdate
+              : h.rejected == h.updates ? HealthCause::kAllRejected : HealthCause::kNeverLocked;
+    f.value = sigma.maxCoeff();
+    f.suggested = h.rejected_fraction;  // rejections may be why the flips did not observe them
+    f.components = h.unobservable;
+    add(h, f);
+    return;
+  }
+  if (!h.unobservable.empty()) {
+    HealthFinding f;
+    f.cause = HealthCause::kUnobservable;
+    f.value = sigma.maxCoeff();
+    f.components = h.unobservable;
+    add(h, f);
+  }
+}
+
+HealthReport HealthMonitor::finish(const DriftlessFilter& filter, double duration_s) const {
+  HealthReport h;
+  h.locked = locked_;
+  h.lock_t_s = lock_t_s_;
+  h.updates = updates_;
+  h.rejected = rejected_;
+  h.rejected_fraction = updates_ > 0 ? double(rejected_) / double(updates_) : kNaN;
+  h.relocks = filter.counters().relocks;
+  const NisSums& nis = locked_ ? nis_locked_ : nis_before_;
+  h.nis_updates = nis.n;
+  if (nis.n > 0) {
+    // the sum of independent chi-square NIS values is chi-square with the summed dof
+    const double n = double(nis.n), tail = 0.5 * (1.0 - limits_.band_probability);
+    h.nis_mean = nis.sum / n;
+    h.nis_dof_mean = nis.dof / n;
+    h.nis_mean_band_lo = chi2_quantile(tail, nis.dof) / n;
+    h.nis_mean_band_hi = chi2_quantile(1.0 - tail, nis.dof) / n;
+  }
+  add_lock_findings(h, filter, duration_s);
+  add_gate_findings(h);
+  add_nis_findings(h);
+  if (h.relocks > 0) {
+    HealthFinding f;
+    f.cause = HealthCause::kRelocks;
+    f.value = double(h.relocks);
+    add(h, f);
+  }
+  return h;
+}
+
+}  // namespace driftless::est

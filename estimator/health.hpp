@@ -1,0 +1,106 @@
+// The filter's health verdict (docs/estimator.md section 6.1): did it lock, how many updates did the
+// NIS gate reject, is the mean NIS inside its chi-square band, which bias components stayed
+// unobservable, did it re-lock. Each finding carries its likely cause and the fix, so a run on data
+// the configuration does not fit never ends silently. Eigen + std only.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "estimator/filter.hpp"
+
+namespace driftless::est {
+
+/// ok: every check passed. degraded: the estimate exists but its sigma or its gate decisions
+/// cannot be trusted (a cause is named). failed: there is no usable estimate (never locked).
+enum class HealthVerdict { kOk, kDegraded, kFailed };
+const char* to_string(HealthVerdict v);
+
+/// What a finding is about (the text is made at the edge: cli/estimate_health.cpp).
+enum class HealthCause {
+  kNoUpdate,             // no standstill became an update
+  kAllRejected,          // updates were made but the gate rejected every one
+  kNeverLocked,          // updates accepted, yet some bias sigma never fell below the lock level
+  kNoiseUnderstated,     // NIS mean above its band: the data are noisier than R and Q say
+  kNoiseOverstated,      // NIS mean below its band: sigma too pessimistic (a note: verdict stays ok)
+  kRejectionsAtPosition, // the gate rejects at one position pair: a position-dependent error
+  kRejections,           // the gate rejects too often, spread over the positions
+  kUnobservable,         // some bias components kept (most of) their prior sigma
+  kRelocks,              // the gate lost lock and re-locked
+};
+
+/// One check that did not pass, with the numbers that describe() turns into text.
+struct HealthFinding {
+  HealthCause cause = HealthCause::kNoUpdate;
+  HealthVerdict severity = HealthVerdict::kDegraded;  // kOk = a note that leaves the verdict
+  double value = kNaN;        // the measured quantity (fraction, NIS mean, ...)
+  double suggested = kNaN;    // kNoiseUnder/Overstated: nis_mean / dof, the factor by which the
+                              // innovation variance exceeds (or falls short of) what S predicts;
+                              // kNeverLocked: the rejected fraction
+  // kRejectionsAtPosition: the (plat1, plat2) angle pairs (deg) where most updates were rejected
+  std::vector<std::array<double, 2>> positions_deg;
+  std::vector<int> components;  // kUnobservable: 0..5 = b1_x .. b2_z
+};
+
+/// Limits of the verdict (docs/estimator.md section 6.1).
+struct HealthLimits {
+  double lock_sigma_dps = 0.05;        // deg/s, locked once every bias sigma is below this
+  double band_probability = 0.95;      // two-sided band of the NIS mean
+  double max_rejected_fraction = 0.02; // above: degraded
+  double position_rejected_fraction = 0.5;  // position pairs rejecting more than this are named
+                                            // when the others together reject under a quarter
+                                            // as often
+  double unobservable_ratio = 0.5;     // final sigma / prior sigma above this = unobservable
+};
+
+/// The health block of summary.json.
+struct HealthReport {
+  HealthVerdict verdict = HealthVerdict::kOk;
+  bool locked = false;
+  double lock_t_s = kNaN;              // s, first update after which every bias sigma < lock level
+  std::uint64_t updates = 0, rejected = 0;
+  double rejected_fraction = kNaN;
+  std::uint64_t nis_updates = 0;       // accepted updates in the NIS mean: those after the lock
+                                       // (all accepted ones if it never locked)
+  double nis_dof_mean = kNaN;          // mean residual dimension of those updates
+  double nis_mean = kNaN;              // mean NIS of the accepted updates
+  double nis_mean_band_lo = kNaN, nis_mean_band_hi = kNaN;  // chi-square band of that mean
+  std::uint64_t relocks = 0;
+  std::vector<int> unobservable;       // 0..5 = b1_x .. b2_z
+  std::vector<HealthFinding> findings; // worst first
+};
+
+/// Watches the updates of one pass and gives the verdict at the end.
+class HealthMonitor {
+ public:
+  explicit HealthMonitor(const HealthLimits& limits = {}) : limits_(limits) {}
+  /// Every update the filter made (accepted or rejected), with the filter after it.
+  void on_update(const UpdateRecord& rec, const DriftlessFilter& filter);
+  /// The verdict after the pass: `filter` is the filter at the end, `duration_s` the log's span.
+  HealthReport finish(const DriftlessFilter& filter, double duration_s) const;
+
+ private:
+  struct PositionCount {
+    std::uint64_t updates = 0, rejected = 0;
+  };
+  void add_gate_findings(HealthReport& h) const;
+  void add_nis_findings(HealthReport& h) const;
+  void add_lock_findings(HealthReport& h, const DriftlessFilter& filter, double duration_s) const;
+
+  HealthLimits limits_;
+  bool locked_ = false;
+  double lock_t_s_ = kNaN;
+  std::uint64_t updates_ = 0, rejected_ = 0;
+  struct NisSums {
+    std::uint64_t n = 0;
+    double sum = 0.0, dof = 0.0;
+  };
+  NisSums nis_before_, nis_locked_;  // accepted updates before lock / from the lock on
+  std::map<std::pair<long, long>, PositionCount> by_position_;  // key: positions in 0.1 deg
+};
+
+}  // namespace driftless::est

@@ -1,0 +1,91 @@
+// Tuning from the data (`estimate --tune auto`, docs/estimator.md section 6.2): a first pass over
+// the log measures the white noise and the bias wander the filter's R and Q stand for, so a
+// sensor the defaults do not describe (another MEMS part, 10x the MPU6050's noise) needs no
+// hand-written configuration.
+//  - noise density N: every standstill is cut into blocks of block_s; the eq. (2) residual
+//    r = M1 y1 - M2 y2 (body rate and Earth rate cancel) of consecutive blocks differs only by
+//    noise, E|r_a - r_b|^2 = 6 sigma^2 (1/n_a + 1/n_b) with sigma^2 = N^2 f_s per sample and axis
+//    (an Allan variance of the residual at tau = block_s, where the white noise dominates);
+//  - bias random walk K (Q = K^2 per second): visits to the same platform positions differ by the
+//    bias change plus noise, E|r_j - r_k|^2 = 6 K^2 dt + 6 sigma^2 (1/n_j + 1/n_k).
+// Eigen + std only.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <utility>
+
+#include "estimator/config.hpp"
+#include "estimator/filter.hpp"
+#include "estimator/log.hpp"
+#include "estimator/standstill.hpp"
+
+namespace driftless::est {
+
+/// What the first pass measured. A quantity without enough data keeps the configured value.
+struct TuneResult {
+  double block_s = kNaN;                     // s, block length of the noise estimate
+  std::uint64_t noise_block_pairs = 0;       // consecutive block pairs used
+  bool noise_estimated = false;
+  double noise_density_dps_rthz = kNaN;      // deg/s/sqrt(Hz), N
+  std::uint64_t wander_pairs = 0;            // same-position visit pairs used
+  bool q_estimated = false;
+  double q_dps2_per_s = kNaN;                // (deg/s)^2/s, K^2 per axis
+  double sample_rate_hz = kNaN;              // Hz, used for N
+};
+
+/// Minimum counts before a quantity is trusted.
+struct TuneLimits {
+  double block_s = 0.5;                   // s, block of the noise estimate
+  std::uint64_t min_noise_block_pairs = 10;
+  std::uint64_t min_wander_pairs = 5;
+};
+
+/// The first pass: push every sample, then finish().
+class NoiseTuner {
+ public:
+  /// `cfg`'s standstill settings and calibration and the box geometry decide where the
+  /// standstills are and which matrices M form the residual.
+  NoiseTuner(const EstimatorConfig& cfg, const BoxGeometry& box, const TuneLimits& limits = {});
+  void push(const Sample& s);
+  TuneResult finish();
+
+ private:
+  struct Visit {
+    double t_mid_s = kNaN;
+    std::size_t n = 0;
+    Eigen::Vector3d r_sum = Eigen::Vector3d::Zero();  // sum of n * block residual
+  };
+  void use_piece(const StandstillSegment& seg);
+  void close_visit();
+
+  TuneLimits limits_;
+  DriftlessFilter geometry_;  // only for its M_body_from_sensor (rotations or calibrated)
+  StandstillDetector detector_;
+  double last_t_s_ = kNaN;
+  // the previous block of the current standstill
+  bool have_block_ = false;
+  double block_rest_s_ = kNaN;
+  std::size_t block_n_ = 0;
+  Eigen::Vector3d block_r_ = Eigen::Vector3d::Zero();
+  // sums of the two estimates
+  double noise_sq_ = 0.0, noise_w_ = 0.0;
+  std::uint64_t noise_pairs_ = 0;
+  struct WanderPair {
+    double sq, dt_s, inv_n;
+  };
+  std::vector<WanderPair> wander_;
+  // the standstill being collected, and the last visit per position pair (0.1 deg keys)
+  Visit visit_;
+  std::pair<long, long> visit_key_{0, 0};
+  std::map<std::pair<long, long>, Visit> last_visit_;
+  double rate_hz_ = kNaN;
+};
+
+/// Runs the first pass over `reader` (which it consumes).
+TuneResult tune_from_log(log::LogReader& reader, const EstimatorConfig& cfg, const TuneLimits& limits = {});
+/// Puts what was estimated into `cfg` (noise_density_dps_rthz, q_override_dps2_per_s; r_override
+/// cleared) and leaves the rest.
+void apply_tune(const TuneResult& t, EstimatorConfig& cfg);
+
+}  // namespace driftless::est
