@@ -113,6 +113,13 @@ std::vector<OutputCheck> check_estimate(const fs::path& dir) {
                         : fmt::format("never locked: after {} updates in {:.0f} s the largest bias sigma is {:.3g} deg/s; "
                                       "a few minutes of flips are needed (each update sees one pair of positions)",
                                       number(j["updates"]), number(j["t_last_s"]) - number(j["t_first_s"]), sigma_max);
+  // the estimate's own health verdict (docs/estimator.md 6.1): a degraded filter still locked,
+  // but the demo says so with the cause instead of a bare "ok"
+  const YAML::Node health = j["health"];
+  if (lock.ok && health && health["verdict"] && health["verdict"].as<std::string>() != "ok") {
+    lock.detail += "; health " + health["verdict"].as<std::string>();
+    if (health["findings"] && health["findings"].size() > 0) lock.detail += ": " + health["findings"][0]["text"].as<std::string>();
+  }
   const double drift = number(j["attitude_drift_deg_per_h"]["with_driftless"]);
   att.ok = lock.ok && std::isfinite(drift);
   att.detail = att.ok ? fmt::format("drift {:.2f} deg/h with DriftLess, {:.2f} deg/h with the bias fixed at lock", drift,
