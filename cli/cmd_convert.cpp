@@ -119,13 +119,15 @@ TimePlan plan_time(const ConvertArgs& a, const importers::StreamInfo& info, cons
                                  fmt::join(st.describe("line"), "; ")));
   }
   if (info.has_time) p.t0_s = st.first_t_s;
-  if (p.uniform) {
-    p.notes.push_back(info.has_time ? fmt::format("t = first stamp + k / {:.6g} Hz (the stamps are {})", p.rate_hz,
-                                                  st.bursty ? "bursty arrival times" : "not strictly increasing")
-                                    : fmt::format("t = k / {:.6g} Hz (the rows carry no time)", p.rate_hz));
-    if (want == TimeBase::kUniform) p.notes.back() = fmt::format("t = first stamp + k / {:.6g} Hz (--time uniform)", p.rate_hz);
-  } else {
+  if (!p.uniform) {
     p.notes.push_back("t = the stamps");
+  } else if (!info.has_time) {
+    p.notes.push_back(fmt::format("t = k / {:.6g} Hz (the rows carry no time)", p.rate_hz));
+  } else {
+    const char* why = want == TimeBase::kUniform ? "--time uniform"
+                      : st.bursty                ? "the stamps are bursty arrival times"
+                                                 : "the stamps are not strictly increasing";
+    p.notes.push_back(fmt::format("t = first stamp + k / {:.6g} Hz ({})", p.rate_hz, why));
   }
   return p;
 }
