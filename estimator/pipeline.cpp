@@ -153,6 +153,10 @@ EstimateSummary run_estimate(log::LogReader& reader, const EstimatorConfig& cfg,
   add_filter_warnings(filter, sum);
   sum.bias_dps = filter.bias_dps();
   sum.sigma_dps = filter.sigma_dps();
+  sum.temp_states = filter.has_temp_states();
+  sum.temp_coef_dps_per_degc = filter.temp_coef_dps_per_degc();
+  sum.temp_coef_sigma_dps_per_degc = filter.temp_coef_sigma_dps_per_degc();
+  sum.temp_ref_c = filter.temperature_ref_c();
   sum.attitude_start_s = att.start_s();
   if (att.started()) sum.fixed_bias_dps = att.fixed_bias_dps();
   const AttitudeDrifts drift = att.drifts();
