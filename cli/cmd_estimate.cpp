@@ -33,6 +33,8 @@ struct EstimateArgs {
   std::string calib;  // calib.yaml from driftless calibrate (docs/calibration.md)
   bool plot = false;
   bool corrected = false;  // write corrected.csv (--corrected)
+  bool selfcal = false;   // self-calibrating mode: g-sensitivity states (docs/estimator.md section 1b)
+  bool box_at_rest = false;  // the box stands still on the Earth: the vertical Earth rate is a measurement
   bool strict = false;    // exit 1 on a degraded health verdict too (failed always exits 1)
   std::string tune;       // "auto": noise density and bias wander from the log (docs/estimator.md section 6.2)
   double attitude_start_sigma_dps = est::EstimateRunOptions{}.attitude_start_sigma_dps;
@@ -81,11 +83,13 @@ int run_estimate_cmd(const EstimateArgs& a) {
     cfg = est::paper_config();
   }
   if (!a.mode.empty()) est::set_config_value(cfg, "mode", a.mode);
+  if (a.selfcal) cfg.self_calibration = true;
+  if (a.box_at_rest) cfg.box_at_rest = true;
   // parse the column groups the pass uses (the accelerometers only for a g-sensitivity calibration;
   // the temperatures drive the bias temperature states)
   log::ReaderOptions read_opt;
   read_opt.fields = kFieldRefQ | kFieldTrueBias | kFieldTemp;
-  if (!a.calib.empty()) read_opt.fields |= kFieldAccel;
+  if (!a.calib.empty() || cfg.self_calibration || cfg.box_at_rest) read_opt.fields |= kFieldAccel;
   log::LogReader reader(a.log, read_opt);
   // --calib: the calibrated matrices M replace R in eq. (1)-(2) (docs/calibration.md)
   if (!a.calib.empty()) {
@@ -222,6 +226,14 @@ const bool registered = register_command(30, [](CLI::App& app) {
   cmd->add_flag("--plot", a->plot,
                 "Also write Fig. 4 (bias vs truth, deg/s), Fig. 5 (Allan deviation, deg/s vs s) and "
                 "Fig. 9 (attitude error, deg vs s) as PNG + SVG with their gnuplot scripts");
+  cmd->add_flag("--selfcal", a->selfcal,
+                "Self-calibrating mode: each sensor's g-sensitivity (deg/s per g, 9 states a sensor, "
+                "driven by the log's accel columns) is estimated with the bias; summary.json reports it "
+                "with its sigma; docs/estimator.md section 1b");
+  cmd->add_flag("--box-at-rest", a->box_at_rest,
+                "The box stands still on the Earth (a lab test): each standstill also measures the rate "
+                "about 'up' (accel columns, else ref_q) as the vertical Earth rate at the log's latitude; "
+                "with --selfcal this observes the bias common to both sensors about the vertical");
   cmd->add_flag("--strict", a->strict,
                 "Exit 1 when the health verdict is 'degraded' too (gate rejections, NIS outside its "
                 "band, unobservable components, re-locks); 'failed' (never locked) always exits 1");

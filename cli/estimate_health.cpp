@@ -74,8 +74,9 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
     case est::HealthCause::kRejectionsAtPosition:
       return fmt::format("{:.0f} % of the updates at platform angles {} were rejected, few elsewhere: an error "
                          "that depends on the position and that a constant bias cannot absorb (g-sensitivity "
-                         "on a horizontal hinge, misalignment, an end-stop angle error); calibrate with "
-                         "'driftless calibrate' and pass --calib",
+                         "on a horizontal hinge, misalignment, an end-stop angle error); estimate it with "
+                         "--selfcal (g-sensitivity states; add --box-at-rest for a box standing still), or "
+                         "calibrate with 'driftless calibrate' and pass --calib",
                          100.0 * f.value, position_text(f.positions_deg));
     case est::HealthCause::kRejections:
       return fmt::format("{:.1f} % of the updates were rejected by the NIS gate: noise or bias wander "

@@ -189,6 +189,16 @@ void write_estimate_summary(const fs::path& path, const SummaryContext& ctx, con
       "\"sigma_dps_per_degc\": {}}},\n",
       s.temp_states ? "true" : "false", json_number(s.temp_ref_c[0]), json_number(s.temp_ref_c[1]),
       json_vec(s.temp_coef_dps_per_degc), json_vec(s.temp_coef_sigma_dps_per_degc));
+  // row-major 3x3 per sensor
+  const auto mat = [](const Eigen::Matrix3d& m) {
+    return fmt::format("[[{}, {}, {}], [{}, {}, {}], [{}, {}, {}]]", json_number(m(0, 0)), json_number(m(0, 1)),
+                       json_number(m(0, 2)), json_number(m(1, 0)), json_number(m(1, 1)), json_number(m(1, 2)),
+                       json_number(m(2, 0)), json_number(m(2, 1)), json_number(m(2, 2)));
+  };
+  add("  \"self_calibration\": {{\"enabled\": {}, \"correction_sigma_dps\": {}, "
+      "\"g_sensitivity_dps_per_g\": [{}, {}], \"g_sensitivity_sigma_dps_per_g\": [{}, {}]}},\n",
+      s.gsens_states ? "true" : "false", json_vec(s.correction_sigma_dps), mat(s.gsens_dps_per_g[0]),
+      mat(s.gsens_dps_per_g[1]), mat(s.gsens_sigma_dps_per_g[0]), mat(s.gsens_sigma_dps_per_g[1]));
   add("  \"attitude_start_s\": {},\n", json_number(s.attitude_start_s));
   add("  \"attitude_drift_deg_per_h\": {{\"with_driftless\": {}, \"bias_fixed_at_start\": {}, "
       "\"without_driftless\": {}}},\n",

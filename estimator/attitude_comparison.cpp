@@ -7,7 +7,7 @@
 namespace driftless::est {
 
 bool filter_locked(const DriftlessFilter& filter, double start_sigma_dps) {
-  return start_sigma_dps <= 0.0 || (filter.has_update() && filter.sigma_dps().maxCoeff() < start_sigma_dps);
+  return start_sigma_dps <= 0.0 || (filter.has_update() && filter.correction_sigma_dps().maxCoeff() < start_sigma_dps);
 }
 
 AttitudeComparison::AttitudeComparison(double latitude_deg, double start_sigma_dps, double interval_s)

@@ -89,6 +89,18 @@ struct EstimatorConfig {
   /// not an outlier). 0 = never re-lock.
   int gate_relock_after = 3;
 
+  // self-calibrating mode (docs/estimator.md section 1b): each sensor's g-sensitivity G_i becomes
+  // 9 states driven by the log's accel columns, prior sigma per element (MPU6050: 0.1 deg/s/g as
+  // the rms row norm). General mode only.
+  bool self_calibration = false;
+  double gsens_sigma_dps_per_g = 0.1 / 1.7320508075688772;
+  // a box known to stand still on the Earth (a lab test like the paper's Fig. 4/5 runs): each
+  // standstill also measures the fused rate about "up" (from the accel columns, else ref_q) as the
+  // vertical Earth rate, Omega sin(latitude); that observes the bias common to both sensors about
+  // the vertical, which eq. (2) cannot see once g-sensitivity is a state. General mode only.
+  bool box_at_rest = false;
+  double box_rest_rate_sigma_dps = 1e-4;  // deg/s, how still the box is about the vertical (1 sigma)
+
   Calibration calibration;  // optional calibrated matrices (issue 4); empty = rotations
 
   /// Throws std::invalid_argument naming the field on a bad value.

@@ -76,6 +76,11 @@ void EstimatorConfig::validate() const {
   positive(bias_instability_tau_s, "bias_instability_tau_s", "s");
   non_negative(q_override_dps2_per_s, "q_override_dps2_per_s", "(deg/s)^2/s (0 = from spec)");
   non_negative(r_override_dps2, "r_override_dps2", "(deg/s)^2 (0 = from noise density)");
+  non_negative(gsens_sigma_dps_per_g, "gsens_sigma_dps_per_g", "deg/s per g");
+  positive(box_rest_rate_sigma_dps, "box_rest_rate_sigma_dps", "deg/s");
+  if (mode == FilterMode::kPaper && (self_calibration || box_at_rest)) {
+    throw std::invalid_argument("estimator config: self_calibration and box_at_rest need mode: general");
+  }
   non_negative(temp_coef_sigma_dps_per_degc, "temp_coef_sigma_dps_per_degc", "deg/s per degC (0 = no temperature states)");
   if (!finite(initial_bias_dps)) throw std::invalid_argument("estimator config: initial_bias_dps must be a number");
   positive(initial_sigma_dps, "initial_sigma_dps", "deg/s");
@@ -141,10 +146,17 @@ DriftlessFilter::DriftlessFilter(const EstimatorConfig& cfg, const BoxGeometry& 
   P_.setZero();
   P_.diagonal().head<kStateDim>().setConstant(cfg_.initial_sigma_dps * cfg_.initial_sigma_dps);
   // the temperature coefficients start at 0 with the spec's sigma; off, they stay exactly 0
-  P_.diagonal().tail<6>().setConstant(cfg_.temp_coef_sigma_dps_per_degc * cfg_.temp_coef_sigma_dps_per_degc);
+  P_.diagonal().segment<6>(kTempCoef1.start).setConstant(cfg_.temp_coef_sigma_dps_per_degc *
+                                                          cfg_.temp_coef_sigma_dps_per_degc);
+  // the g-sensitivities start at 0 with the spec's sigma in self-calibrating mode, else stay 0
+  if (has_gsens_states()) {
+    P_.diagonal().segment<18>(kGSens1.start).setConstant(cfg_.gsens_sigma_dps_per_g * cfg_.gsens_sigma_dps_per_g);
+  }
   gate3_ = cfg_.nis_gate_probability < 1.0 ? chi2_quantile(cfg_.nis_gate_probability, 3.0)
                                            : std::numeric_limits<double>::infinity();
   gate6_ = cfg_.nis_gate_probability < 1.0 ? chi2_quantile(cfg_.nis_gate_probability, 6.0)
+                                           : std::numeric_limits<double>::infinity();
+  gate4_ = cfg_.nis_gate_probability < 1.0 ? chi2_quantile(cfg_.nis_gate_probability, 4.0)
                                            : std::numeric_limits<double>::infinity();
 }
 
@@ -201,13 +213,15 @@ void DriftlessFilter::predict_temperature(double temp1_c, double temp2_c) {
     temp_ref_c_[i] = temp[i];
   }
   if (d.isZero(0.0)) return;
-  x_.head<kStateDim>() += d.cwiseProduct(x_.tail<6>());
-  // P <- F P F^T, written out per block: with B = bias, K = coefficient block
-  const Matrix6d Pbk = P_.topRightCorner<6, 6>(), Pkk = P_.bottomRightCorner<6, 6>();
+  const Eigen::Index k0 = kTempCoef1.start;
+  x_.head<kStateDim>() += d.cwiseProduct(x_.segment<6>(k0));
+  // P <- F P F^T = P + E P + P E^T + E P E^T with E = F - I (D in the bias rows, k columns)
   const auto D = d.asDiagonal();
-  P_.topLeftCorner<6, 6>() += D * Pbk.transpose() + Pbk * D + D * Pkk * D;
-  P_.topRightCorner<6, 6>() = Pbk + D * Pkk;
-  P_.bottomLeftCorner<6, 6>() = P_.topRightCorner<6, 6>().transpose();
+  const Eigen::Matrix<double, 6, kFullStateDim> EP = D * P_.middleRows<6>(k0);
+  const Matrix6d Pkk = P_.block<6, 6>(k0, k0);
+  P_.topRows<6>() += EP;
+  P_.leftCols<6>() += EP.transpose();
+  P_.topLeftCorner<6, 6>() += D * Pkk * D;
 }
 
 Vector6d DriftlessFilter::bias_at(const Sample& s) const {
@@ -217,29 +231,70 @@ Vector6d DriftlessFilter::bias_at(const Sample& s) const {
   for (std::size_t i = 0; i < 2; ++i) {
     if (!finite(temp[i]) || !finite(temp_ref_c_[i])) continue;
     const Eigen::Index o = 3 * static_cast<Eigen::Index>(i);
-    b.segment<3>(o) += (temp[i] - temp_ref_c_[i]) * x_.segment<3>(6 + o);
+    b.segment<3>(o) += (temp[i] - temp_ref_c_[i]) * x_.segment<3>(kTempCoef1.start + o);
+  }
+  if (has_gsens_states()) {
+    // self-calibration: the sample's own specific force, else the last update's
+    const std::array<const Eigen::Vector3d*, 2> acc{&s.accel1_mps2, &s.accel2_mps2};
+    for (int i = 0; i < 2; ++i) {
+      const std::size_t u = static_cast<std::size_t>(i);
+      const Eigen::Vector3d f = acc[u]->allFinite() ? Eigen::Vector3d(*acc[u] / kStandardGravityMps2) : last_f_g_[u];
+      if (f.allFinite()) b.segment<3>(3 * i) += g_sensitivity_dps_per_g(i + 1) * f;
+    }
   }
   return b;
 }
 
+namespace {
+// d(M G f)/d vec(G) for row-major vec(G): column 3 r + c is M.col(r) f_c
+Eigen::Matrix<double, 3, 9> gsens_jacobian(const Eigen::Matrix3d& M, const Eigen::Vector3d& f_g) {
+  Eigen::Matrix<double, 3, 9> J;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) J.col(3 * r + c) = M.col(r) * f_g[c];
+  return J;
+}
+}  // namespace
+
+Eigen::Matrix3d DriftlessFilter::g_sensitivity_dps_per_g(int sensor) const {
+  const Eigen::Index o = sensor == 1 ? kGSens1.start : kGSens2.start;
+  return Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(x_.data() + o);
+}
+
+Eigen::Matrix3d DriftlessFilter::g_sensitivity_sigma_dps_per_g(int sensor) const {
+  const Eigen::Index o = sensor == 1 ? kGSens1.start : kGSens2.start;
+  const Eigen::Matrix<double, 9, 1> sd = P_.diagonal().segment<9>(o).cwiseSqrt();
+  return Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(sd.data());
+}
+
+Vector6d DriftlessFilter::correction_sigma_dps() const {
+  if (!has_gsens_states()) return sigma_dps();
+  // o_i = b_i + G_i f_i: J = [I 0 .. (I kron f_i^T) ..] per sensor
+  Eigen::Matrix<double, 6, kFullStateDim> J = Eigen::Matrix<double, 6, kFullStateDim>::Zero();
+  J.block<6, 6>(0, 0).setIdentity();
+  for (int i = 0; i < 2; ++i) {
+    const Eigen::Vector3d& f = last_f_g_[static_cast<std::size_t>(i)];
+    if (f.allFinite()) J.block<3, 9>(3 * i, i == 0 ? kGSens1.start : kGSens2.start) = gsens_jacobian(Eigen::Matrix3d::Identity(), f);
+  }
+  return (J * P_ * J.transpose()).diagonal().cwiseSqrt();
+}
+
 template <int D>
-bool DriftlessFilter::update(const Eigen::Matrix<double, D, 1>& r, const Eigen::Matrix<double, D, 6>& H,
+bool DriftlessFilter::update(const Eigen::Matrix<double, D, 1>& r, const Eigen::Matrix<double, D, kFullStateDim>& H,
                              const Eigen::Matrix<double, D, D>& R, UpdateRecord& rec) {
   // P here is P_k + Q_k (predict_to ran); the recursion of section 2, S^-1 through a Cholesky solve
-  const Eigen::Matrix<double, kFullStateDim, D> PHt = P_.template leftCols<kStateDim>() * H.transpose();
-  const Eigen::Matrix<double, D, D> S = R + H * PHt.template topRows<kStateDim>();
+  const Eigen::Matrix<double, kFullStateDim, D> PHt = P_ * H.transpose();
+  const Eigen::Matrix<double, D, D> S = R + H * PHt;
   Eigen::LLT<Eigen::Matrix<double, D, D>> llt(S);
-  const Eigen::Matrix<double, D, 1> innov = r - H * x_.head<kStateDim>();
+  const Eigen::Matrix<double, D, 1> innov = r - H * x_;
   rec.dim = D;
   rec.innovation_dps.setZero();
   rec.innovation_dps.head(D) = innov;
-  rec.nis_gate = D == 3 ? gate3_ : gate6_;
+  rec.nis_gate = D == 3 ? gate3_ : D == 4 ? gate4_ : gate6_;
   if (llt.info() != Eigen::Success) {
     rec.nis = kNaN;
     return false;
   }
   rec.nis = innov.dot(llt.solve(innov));
-  // the rows of H touch the bias only: H_a = [H 0], so H_a P H_a^T = H P_bb H^T above
   if (!(rec.nis <= rec.nis_gate)) {
     // an outlier is rejected once or twice; a run of rejections means the state lost lock
     // (a bias step, another sensor after a source switch): widen P by the innovation, re-lock
@@ -257,8 +312,7 @@ bool DriftlessFilter::update(const Eigen::Matrix<double, D, 1>& r, const Eigen::
   // W = (P + Q) H^T S^-1
   const Eigen::Matrix<double, kFullStateDim, D> W = llt.solve(PHt.transpose()).transpose();
   x_ += W * innov;
-  Matrix12d IKH = Matrix12d::Identity();
-  IKH.template leftCols<kStateDim>() -= W * H;
+  const StateMatrix IKH = StateMatrix::Identity() - W * H;
   if (cfg_.covariance_update == CovarianceUpdate::kJoseph) {
     P_ = IKH * P_ * IKH.transpose() + W * R * W.transpose();
   } else {
@@ -302,15 +356,8 @@ int DriftlessFilter::use_segment(const StandstillSegment& s) {
   const Eigen::Matrix3d M1 = body_from_sensor(1, p1);
   const Eigen::Matrix3d M2 = body_from_sensor(2, p2);
   Residual3 cur;
-  cur.valid = true;
   cur.pattern = pattern;
-  cur.r = M1 * s.mean_gyro1_dps() - M2 * s.mean_gyro2_dps();  // eq. (2): r = R1 y1 - R2 y2
-  cur.H.block<3, 3>(0, kBias1.start) = M1;
-  cur.H.block<3, 3>(0, kBias2.start) = -M2;
-  // eq. (2)'s noise R1 n1 - R2 n2, averaged over n samples; the bias random walk adds q T / 12
-  // (its mean over the standstill scatters about its value at the midpoint)
-  const double var = cfg_.sample_variance_dps2(rate_hz) / double(s.n) + q_rate_dps2_per_s_ * s.span_s() / 12.0;
-  cur.R = var * (M1 * M1.transpose() + M2 * M2.transpose());
+  residual_rows(s, M1, M2, rate_hz, cur);
 
   UpdateRecord rec;
   rec.t_s = s.t_last_s;
@@ -326,7 +373,21 @@ int DriftlessFilter::use_segment(const StandstillSegment& s) {
   if (s.n_temp > 0) predict_temperature(s.sum_temp1_c / double(s.n_temp), s.sum_temp2_c / double(s.n_temp));
   predict_to(std::max(t_mid, finite(t_filter_s_) ? t_filter_s_ : t_mid));
   int result = 0;
-  if (cfg_.mode == FilterMode::kGeneral) {
+  Eigen::Matrix<double, 1, kFullStateDim> h;
+  double z = 0.0, var_z = 0.0;
+  if (cfg_.mode == FilterMode::kGeneral && cfg_.box_at_rest && rest_row(s, M1, M2, cur.R(0, 0), h, z, var_z)) {
+    // a box at rest: the residual stacked with the vertical rate (independent noise, section 1b)
+    Eigen::Matrix<double, 4, 1> r4;
+    r4 << cur.r, z;
+    Eigen::Matrix<double, 4, kFullStateDim> H4;
+    H4 << cur.H, h;
+    Eigen::Matrix<double, 4, 4> R4 = Eigen::Matrix<double, 4, 4>::Zero();
+    R4.topLeftCorner<3, 3>() = cur.R;
+    R4(3, 3) = var_z;
+    const bool ok = update<4>(r4, H4, R4, rec);
+    emit_update(rec, ok);
+    result = ok ? 1 : -1;
+  } else if (cfg_.mode == FilterMode::kGeneral) {
     const bool ok = update<3>(cur.r, cur.H, cur.R, rec);
     emit_update(rec, ok);
     result = ok ? 1 : -1;
@@ -335,7 +396,7 @@ int DriftlessFilter::use_segment(const StandstillSegment& s) {
     // the paper assumes (delta-correlated v_k) although r_prev was already used at k - 1
     Eigen::Matrix<double, 6, 1> r6;
     r6 << prev_res_.r, cur.r;
-    Eigen::Matrix<double, 6, 6> H6;
+    Eigen::Matrix<double, 6, kFullStateDim> H6;
     H6 << prev_res_.H, cur.H;
     Eigen::Matrix<double, 6, 6> R6 = Eigen::Matrix<double, 6, 6>::Zero();
     R6.block<3, 3>(0, 0) = prev_res_.R;
@@ -348,6 +409,51 @@ int DriftlessFilter::use_segment(const StandstillSegment& s) {
   predict_to(s.t_last_s);
   if (result != 0) last_update_.sigma_dps = sigma_dps();
   return result;
+}
+
+// eq. (2) for one standstill: r = M1 y1 - M2 y2 = M1 (b1 + G1 f1) - M2 (b2 + G2 f2) + noise
+void DriftlessFilter::residual_rows(const StandstillSegment& s, const Eigen::Matrix3d& M1, const Eigen::Matrix3d& M2,
+                                    double rate_hz, Residual3& cur) {
+  cur.valid = true;
+  cur.r = M1 * s.mean_gyro1_dps() - M2 * s.mean_gyro2_dps();
+  cur.H.setZero();
+  cur.H.block<3, 3>(0, kBias1.start) = M1;
+  cur.H.block<3, 3>(0, kBias2.start) = -M2;
+  if (has_gsens_states() && s.n_accel > 0) {
+    const double to_g = 1.0 / (double(s.n_accel) * kStandardGravityMps2);
+    last_f_g_ = {s.sum_accel1_mps2 * to_g, s.sum_accel2_mps2 * to_g};
+    cur.H.block<3, 9>(0, kGSens1.start) = gsens_jacobian(M1, last_f_g_[0]);
+    cur.H.block<3, 9>(0, kGSens2.start) = -gsens_jacobian(M2, last_f_g_[1]);
+  }
+  // eq. (2)'s noise R1 n1 - R2 n2, averaged over n samples; the bias random walk adds q T / 12
+  // (its mean over the standstill scatters about its value at the midpoint)
+  const double var = cfg_.sample_variance_dps2(rate_hz) / double(s.n) + q_rate_dps2_per_s_ * s.span_s() / 12.0;
+  cur.R = var * (M1 * M1.transpose() + M2 * M2.transpose());
+}
+
+// a box at rest: the mean of the two sensors' rates about "up" is the vertical Earth rate,
+// z = up^T (M1 y1 + M2 y2) / 2 - Omega sin(lat) = up^T (M1 o1 + M2 o2) / 2 + noise; its noise is
+// independent of eq. (2)'s (Cov = up^T (M1 M1^T - M2 M2^T) / 2 = 0 for rotations). `var_r` is
+// one axis of eq. (2)'s R: 2 (sigma^2/n + q T/12), so the mean of two sensors has var_r / 4
+bool DriftlessFilter::rest_row(const StandstillSegment& s, const Eigen::Matrix3d& M1, const Eigen::Matrix3d& M2,
+                               double var_r, Eigen::Matrix<double, 1, kFullStateDim>& h, double& z,
+                               double& var_z) const {
+  Eigen::Vector3d up = Eigen::Vector3d::Zero();
+  if (s.n_accel > 0) up = M1 * s.sum_accel1_mps2 + M2 * s.sum_accel2_mps2;  // specific force points up
+  else if (s.n_up > 0) up = s.sum_up_box;
+  if (!(up.norm() > 0.0) || !up.allFinite()) return false;
+  up.normalize();
+  const double earth_up_dps = geo::earth_rate_enu_radps(box_.latitude_deg).z() * kDegPerRad;
+  z = 0.5 * up.dot(M1 * s.mean_gyro1_dps() + M2 * s.mean_gyro2_dps()) - earth_up_dps;
+  h.setZero();
+  h.segment<3>(kBias1.start) = 0.5 * up.transpose() * M1;
+  h.segment<3>(kBias2.start) = 0.5 * up.transpose() * M2;
+  if (has_gsens_states() && s.n_accel > 0) {
+    h.segment<9>(kGSens1.start) = 0.5 * up.transpose() * gsens_jacobian(M1, last_f_g_[0]);
+    h.segment<9>(kGSens2.start) = 0.5 * up.transpose() * gsens_jacobian(M2, last_f_g_[1]);
+  }
+  var_z = 0.25 * var_r + cfg_.box_rest_rate_sigma_dps * cfg_.box_rest_rate_sigma_dps;
+  return true;
 }
 
 void DriftlessFilter::fuse_rate(const Sample& s, const StandstillStep& st) {
@@ -454,9 +560,11 @@ PushStatus DriftlessFilter::finish() {
   return result > 0 ? PushStatus::kUpdated : result < 0 ? PushStatus::kRejected : PushStatus::kMoving;
 }
 
-template bool DriftlessFilter::update<3>(const Eigen::Matrix<double, 3, 1>&, const Eigen::Matrix<double, 3, 6>&,
+template bool DriftlessFilter::update<3>(const Eigen::Matrix<double, 3, 1>&, const Eigen::Matrix<double, 3, kFullStateDim>&,
                                          const Eigen::Matrix<double, 3, 3>&, UpdateRecord&);
-template bool DriftlessFilter::update<6>(const Eigen::Matrix<double, 6, 1>&, const Eigen::Matrix<double, 6, 6>&,
+template bool DriftlessFilter::update<4>(const Eigen::Matrix<double, 4, 1>&, const Eigen::Matrix<double, 4, kFullStateDim>&,
+                                         const Eigen::Matrix<double, 4, 4>&, UpdateRecord&);
+template bool DriftlessFilter::update<6>(const Eigen::Matrix<double, 6, 1>&, const Eigen::Matrix<double, 6, kFullStateDim>&,
                                          const Eigen::Matrix<double, 6, 6>&, UpdateRecord&);
 
 }  // namespace driftless::est

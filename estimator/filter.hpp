@@ -20,8 +20,6 @@ namespace driftless::est {
 
 using Vector6d = Eigen::Matrix<double, 6, 1>;
 using Matrix6d = Eigen::Matrix<double, 6, 6>;
-using Vector12d = Eigen::Matrix<double, 12, 1>;
-using Matrix12d = Eigen::Matrix<double, 12, 12>;
 
 /// A named slice of the state vector (like PX4's State::gyro_bias.idx).
 struct StateSlice {
@@ -36,7 +34,14 @@ inline constexpr int kStateDim = 6;        // the bias [b1; b2]
 // while no temperature is known or temp_coef_sigma_dps_per_degc is 0
 inline constexpr StateSlice kTempCoef1{6, 3};
 inline constexpr StateSlice kTempCoef2{9, 3};
-inline constexpr int kFullStateDim = 12;
+// self-calibrating mode: each sensor's g-sensitivity G_i (deg/s per g, sensor axes, row-major:
+// G_i[r][c] at start + 3 r + c): y_i += G_i f_i, f_i the specific force in g from the accel
+// columns (docs/estimator.md section 1b); frozen at 0 (P = 0) unless self_calibration is on
+inline constexpr StateSlice kGSens1{12, 9};
+inline constexpr StateSlice kGSens2{21, 9};
+inline constexpr int kFullStateDim = 30;
+using StateVector = Eigen::Matrix<double, kFullStateDim, 1>;
+using StateMatrix = Eigen::Matrix<double, kFullStateDim, kFullStateDim>;
 
 /// What push() did with a sample. It never throws per sample.
 enum class PushStatus {
@@ -132,12 +137,20 @@ class DriftlessFilter {
   Matrix6d covariance_dps2() const { return P_.topLeftCorner<kStateDim, kStateDim>(); }
   Vector6d sigma_dps() const { return covariance_dps2().diagonal().cwiseSqrt(); }
   /// Temperature coefficients [k1; k2], deg/s per degC, their sigma, and whether they are states.
-  Vector6d temp_coef_dps_per_degc() const { return x_.tail<6>(); }
-  Vector6d temp_coef_sigma_dps_per_degc() const { return P_.diagonal().tail<6>().cwiseSqrt(); }
+  Vector6d temp_coef_dps_per_degc() const { return x_.segment<6>(kTempCoef1.start); }
+  Vector6d temp_coef_sigma_dps_per_degc() const { return P_.diagonal().segment<6>(kTempCoef1.start).cwiseSqrt(); }
   bool has_temp_states() const { return cfg_.temp_coef_sigma_dps_per_degc > 0.0; }
-  /// The whole state [b1; b2; k1; k2] and its covariance (units as above).
-  const Vector12d& state() const { return x_; }
-  const Matrix12d& full_covariance() const { return P_; }
+  /// g-sensitivity G_i of sensor 1 or 2 (deg/s per g) and the sigma of each element.
+  Eigen::Matrix3d g_sensitivity_dps_per_g(int sensor) const;
+  Eigen::Matrix3d g_sensitivity_sigma_dps_per_g(int sensor) const;
+  bool has_gsens_states() const { return cfg_.self_calibration && cfg_.gsens_sigma_dps_per_g > 0.0; }
+  /// Sigma of the correction the filter applies, o_i = b_i + G_i f_i at the specific force of
+  /// the last update (deg/s): what "locked" means. The bias sigma without self-calibration; with
+  /// it, b_i alone may stay unobservable (a g-sensitivity along a fixed gravity looks like bias).
+  Vector6d correction_sigma_dps() const;
+  /// The whole state [b1; b2; k1; k2; G1; G2] and its covariance (units as above).
+  const StateVector& state() const { return x_; }
+  const StateMatrix& full_covariance() const { return P_; }
   /// Temperatures (degC) the bias estimate refers to; NaN until the first one is known.
   const std::array<double, 2>& temperature_ref_c() const { return temp_ref_c_; }
   /// The latest update (has_update() false before the first).
@@ -154,13 +167,25 @@ class DriftlessFilter {
   Eigen::Matrix3d body_from_sensor(int sensor, double plat_deg) const;
 
  private:
+  // one standstill's residual of eq. (2), its rows of H and its noise
+  struct Residual3 {
+    bool valid = false;
+    Eigen::Vector3d r = Eigen::Vector3d::Zero();
+    Eigen::Matrix<double, 3, kFullStateDim> H = Eigen::Matrix<double, 3, kFullStateDim>::Zero();
+    Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+    int pattern = 0;  // position index 0..3 of eq. (5)'s sequence
+  };
   PushStatus push_corrected(const Sample& s);
   int use_segment(const StandstillSegment& seg);
+  void residual_rows(const StandstillSegment& seg, const Eigen::Matrix3d& M1, const Eigen::Matrix3d& M2,
+                     double rate_hz, Residual3& out);
+  bool rest_row(const StandstillSegment& seg, const Eigen::Matrix3d& M1, const Eigen::Matrix3d& M2,
+                double var_dps2, Eigen::Matrix<double, 1, kFullStateDim>& h, double& z, double& var_z) const;
   void predict_to(double t_s);
   void predict_temperature(double temp1_c, double temp2_c);
   Vector6d bias_at(const Sample& s) const;
   template <int D>
-  bool update(const Eigen::Matrix<double, D, 1>& r, const Eigen::Matrix<double, D, 6>& H,
+  bool update(const Eigen::Matrix<double, D, 1>& r, const Eigen::Matrix<double, D, kFullStateDim>& H,
               const Eigen::Matrix<double, D, D>& R, UpdateRecord& rec);
   void emit_update(const UpdateRecord& rec, bool accepted);
   void fuse_rate(const Sample& s, const StandstillStep& st);
@@ -170,28 +195,24 @@ class DriftlessFilter {
   BoxGeometry box_;
   double q_rate_dps2_per_s_ = 0.0;
 
-  Vector12d x_ = Vector12d::Zero();
+  StateVector x_ = StateVector::Zero();
   Vector6d fixed_bias_ = Vector6d::Zero();  // deg/s, for rate_body_fixed_dps only
-  Matrix12d P_ = Matrix12d::Identity();
+  StateMatrix P_ = StateMatrix::Identity();
+  // specific force (g, sensor axes) of the last update that had accel columns, per sensor
+  std::array<Eigen::Vector3d, 2> last_f_g_{Eigen::Vector3d::Constant(kNaN), Eigen::Vector3d::Constant(kNaN)};
   std::array<double, 2> temp_ref_c_{kNaN, kNaN};  // degC, temperatures x_'s bias refers to
   int consecutive_rejections_ = 0;
   double t_filter_s_ = kNaN;  // time P and x refer to
   double last_t_s_ = kNaN;
 
   StandstillDetector standstill_;
-  double gate3_ = 0.0, gate6_ = 0.0;
+  double gate3_ = 0.0, gate4_ = 0.0, gate6_ = 0.0;
   // cached M_body_from_sensor of the last angle asked for, per sensor
   mutable std::array<double, 2> cache_deg_{kNaN, kNaN};
   mutable std::array<Eigen::Matrix3d, 2> cache_M_{Eigen::Matrix3d::Identity(), Eigen::Matrix3d::Identity()};
 
   // paper mode: the previous standstill (for the 6-dim stack) and the eq. (5) counter
-  struct Residual3 {
-    bool valid = false;
-    Eigen::Vector3d r = Eigen::Vector3d::Zero();
-    Eigen::Matrix<double, 3, 6> H = Eigen::Matrix<double, 3, 6>::Zero();
-    Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
-    int pattern = 0;  // position index 0..3 of eq. (5)'s sequence
-  } prev_res_;
+  Residual3 prev_res_;
   std::int64_t paper_k_ = -1;   // k of eq. (5); -1 until the phase is known
 
   UpdateRecord last_update_;

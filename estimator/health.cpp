@@ -46,7 +46,7 @@ void HealthMonitor::on_update(const UpdateRecord& rec, const DriftlessFilter& fi
     sums.dof += rec.dim;
     ++sums.n;
   }
-  if (!locked_ && filter.sigma_dps().maxCoeff() < limits_.lock_sigma_dps) {
+  if (!locked_ && filter.correction_sigma_dps().maxCoeff() < limits_.lock_sigma_dps) {
     locked_ = true;
     lock_t_s_ = rec.t_s;
   }

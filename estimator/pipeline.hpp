@@ -103,6 +103,12 @@ struct EstimateSummary {
   Vector6d temp_coef_dps_per_degc = Vector6d::Constant(kNaN);
   Vector6d temp_coef_sigma_dps_per_degc = Vector6d::Constant(kNaN);
   std::array<double, 2> temp_ref_c{kNaN, kNaN};  // degC, the temperatures bias_dps refers to
+  // self-calibrating mode: each sensor's g-sensitivity (deg/s per g, sensor axes) and its sigma,
+  // and the sigma of the correction b + G f the filter applies (what "locked" looks at)
+  bool gsens_states = false;
+  std::array<Eigen::Matrix3d, 2> gsens_dps_per_g{Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero()};
+  std::array<Eigen::Matrix3d, 2> gsens_sigma_dps_per_g{Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero()};
+  Vector6d correction_sigma_dps = Vector6d::Constant(kNaN);
   double t_first_s = kNaN, t_last_s = kNaN;
   bool attitude_available = false;   // the log has ref_q
   double drift_corrected_deg_per_h = kNaN;

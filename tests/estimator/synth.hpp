@@ -1,8 +1,11 @@
-// Synthetic dual-gyro samples from the closed-form sensor equation of docs/log-format.md:
-//   y_i = R_i^T w_body + thetadot_i a_i + b_i + n_i,   R_i = Rot(a_i, theta_i)
+// Synthetic dual-gyro samples from the closed-form sensor equation of docs/log-format.md, with
+// the temperature and g-sensitivity terms of docs/estimator.md sections 1a, 1b when asked for:
+//   y_i = R_i^T w_body + thetadot_i a_i + b_i + k_i (T - T0) + G_i f_i + n_i,   R_i = Rot(a_i, theta_i)
+//   f_i = R_i^T up_box (g: a box that does not accelerate)
 // Test-only; independent of the twin. Flips follow eq. (5)'s sequence (+,+) (+,-) (-,-) (-,+).
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <functional>
@@ -42,6 +45,11 @@ struct SynthParams {
   bool earth_rate = true;
   double latitude_deg = 52.0;
   std::uint64_t seed = 1;
+  // sensor errors beyond the paper's (zero = its ideal sensor); true_bias holds b + k (T - T0)
+  std::array<Eigen::Matrix3d, 2> G_dps_per_g{Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero()};
+  std::array<Eigen::Vector3d, 2> temp_coef_dps_per_degc{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  double temp0_c = 25.0, temp_rise_c = 0.0, temp_tau_s = 600.0;  // T = T0 + rise (1 - e^-t/tau), degC
+  bool write_accel_temp = false;  // log accel (m/s^2, sensor axes) and temperature columns
 };
 
 inline log::Metadata synth_metadata(const SynthParams& p) {
@@ -117,12 +125,21 @@ inline void synth_samples(const SynthParams& p, const std::function<void(const S
     const Eigen::Vector3d w = w_nb + q.conjugate() * w_ie_enu_dps;  // inertial, box axes
     const Eigen::Matrix3d R1 = Eigen::AngleAxisd(t1 * kRadPerDeg, p.hinge1.normalized()).toRotationMatrix();
     const Eigen::Matrix3d R2 = Eigen::AngleAxisd(t2 * kRadPerDeg, p.hinge2.normalized()).toRotationMatrix();
-    const Eigen::Vector3d b1 = p.b1_dps + gm1;
-    const Eigen::Vector3d b2 = p.b2_dps + gm2 + (t2 < 0.0 ? p.b2_extra_at_negative_plat2_dps : Eigen::Vector3d::Zero());
+    const double temp_c = p.temp0_c + p.temp_rise_c * (1.0 - std::exp(-t / p.temp_tau_s));
+    const Eigen::Vector3d b1 = p.b1_dps + gm1 + p.temp_coef_dps_per_degc[0] * (temp_c - p.temp0_c);
+    const Eigen::Vector3d b2 = p.b2_dps + gm2 + p.temp_coef_dps_per_degc[1] * (temp_c - p.temp0_c) +
+                               (t2 < 0.0 ? p.b2_extra_at_negative_plat2_dps : Eigen::Vector3d::Zero());
+    const Eigen::Vector3d up_box = q.conjugate() * Eigen::Vector3d::UnitZ();  // specific force at rest, g
+    const Eigen::Vector3d f1 = R1.transpose() * up_box, f2 = R2.transpose() * up_box;
     Sample s;
     s.t_s = t;
-    s.gyro1_dps = R1.transpose() * w + w1 * p.hinge1.normalized() + b1;
-    s.gyro2_dps = R2.transpose() * w + w2 * p.hinge2.normalized() + b2;
+    s.gyro1_dps = R1.transpose() * w + w1 * p.hinge1.normalized() + b1 + p.G_dps_per_g[0] * f1;
+    s.gyro2_dps = R2.transpose() * w + w2 * p.hinge2.normalized() + b2 + p.G_dps_per_g[1] * f2;
+    if (p.write_accel_temp) {
+      s.accel1_mps2 = f1 * kStandardGravityMps2;
+      s.accel2_mps2 = f2 * kStandardGravityMps2;
+      s.temp1_c = s.temp2_c = temp_c;
+    }
     if (p.noise_sigma_dps > 0.0) {
       for (int i = 0; i < 3; ++i) {
         s.gyro1_dps[i] += p.noise_sigma_dps * g(rng);
@@ -157,7 +174,8 @@ inline void synth_samples(const SynthParams& p, const std::function<void(const S
 
 /// Writes the samples as a log (ref_q and truth columns included).
 inline void synth_log(const SynthParams& p, const std::filesystem::path& path) {
-  log::LogWriter w(path, synth_metadata(p), kFieldRefQ | kFieldTrueBias | kFieldTrueRate | kFieldTruePlat);
+  const std::uint32_t extra = p.write_accel_temp ? (kFieldAccel | kFieldTemp) : 0u;
+  log::LogWriter w(path, synth_metadata(p), kFieldRefQ | kFieldTrueBias | kFieldTrueRate | kFieldTruePlat | extra);
   synth_samples(p, [&](const Sample& s) { w.write(s); });
   w.finish(true);
 }
