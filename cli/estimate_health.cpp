@@ -55,12 +55,16 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
       return "the NIS gate rejected every update: the sensors do not fit the configured noise or "
              "model; try --tune auto, or check the hinge axes in the log header";
     case est::HealthCause::kNeverLocked:
-      return fmt::format("never locked: the largest bias sigma is {:.3g} deg/s{}; {}", f.value,
+      return fmt::format("never locked: the largest sigma of the bias correction is {:.3g} deg/s{}; {}", f.value,
                          f.components.empty() ? std::string() : ", unobservable: " + component_names(f.components),
                          f.suggested > 0.02 ? fmt::format("the gate rejected {:.0f} % of the updates, so the flips "
                                                           "that observe them were not used (see below)",
                                                           100.0 * f.suggested)
-                                            : "record more flips (both platforms, both directions) or a longer log");
+                                            : cfg.self_calibration && !cfg.box_at_rest
+                                                  ? "in self-calibrating mode a g-sensitivity that keeps its sign "
+                                                    "about the box vertical looks like a bias common to both "
+                                                    "sensors; if the box stands still, add --box-at-rest"
+                                                  : "record more flips (both platforms, both directions) or a longer log");
     case est::HealthCause::kNoiseUnderstated:
       return fmt::format("NIS mean {:.3g} above its 95 % band: the innovations are {:.2g}x larger than the filter "
                          "expects, its sigma too small (data noisier or bias wandering more than "

@@ -108,7 +108,7 @@ void HealthMonitor::add_lock_findings(HealthReport& h, const DriftlessFilter& fi
     f.severity = HealthVerdict::kFailed;
     f.cause = h.updates == 0 ? HealthCause::kNoUpdate
               : h.rejected == h.updates ? HealthCause::kAllRejected : HealthCause::kNeverLocked;
-    f.value = sigma.maxCoeff();
+    f.value = filter.correction_sigma_dps().maxCoeff();  // what locking waits for
     f.suggested = h.rejected_fraction;  // rejections may be why the flips did not observe them
     f.components = h.unobservable;
     add(h, f);

@@ -59,6 +59,31 @@ void BM_PushLive(benchmark::State& state) {
 }
 BENCHMARK(BM_PushLive)->Unit(benchmark::kMillisecond);
 
+// the same in self-calibrating mode on a box at rest: samples with accel and temperature columns,
+// 30 states, 4-dim updates; each sample's correction is b + k dT + G f
+void BM_PushLiveSelfCal(benchmark::State& state) {
+  auto p = live_params(600.0);
+  p.body_rate_dps = nullptr;
+  p.write_accel_temp = true;
+  p.temp_rise_c = 2.0;
+  p.G_dps_per_g[1](1, 1) = 0.05;
+  const auto samples = test::synth_all(p);
+  const auto meta = test::synth_metadata(p);
+  est::EstimatorConfig cfg;
+  cfg.self_calibration = true;
+  cfg.box_at_rest = true;
+  std::size_t n = 0;
+  for (auto _ : state) {
+    est::DriftlessFilter f(cfg, est::box_geometry_from_metadata(meta));
+    for (const auto& s : samples) benchmark::DoNotOptimize(f.push(s));
+    n += samples.size();
+  }
+  state.SetItemsProcessed(static_cast<int64_t>(n));
+  state.counters["ns_per_sample"] =
+      benchmark::Counter(static_cast<double>(n), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_PushLiveSelfCal)->Unit(benchmark::kMillisecond);
+
 void BM_Estimate14hLog(benchmark::State& state) {
   // setup: a 14 h log as the twin writes it (ref_q and truth columns), once per process
   static const std::filesystem::path path = [] {

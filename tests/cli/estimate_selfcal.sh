@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# The self-calibrating mode (docs/estimator.md section 1b) on the built-in static scenario (MPU6050
+# defaults, g-sensitivity not calibrated out): without it the estimate fails, exits 1 and names
+# --selfcal; with --selfcal --box-at-rest it locks, rejects nothing and reports G with its sigma.
+# usage: estimate_selfcal.sh <path-to-driftless> <source-dir>
+set -uo pipefail
+bin=$1
+t=$(mktemp -d); trap 'rm -rf "$t"' EXIT
+fail() { echo "FAIL: $*"; exit 1; }
+verdict() { grep -o '"verdict": "[a-z]*"' "$1/summary.json" | cut -d'"' -f4; }
+
+# GIVEN 10 minutes of the static scenario
+"$bin" simulate --scenario static --duration 600 --out "$t/sim" > /dev/null 2>&1 || fail "simulate: exit $?"
+# WHEN estimated with defaults THEN failed, exit 1, and the finding proposes --selfcal
+"$bin" estimate --log "$t/sim/log.csv" --out "$t/plain" > "$t/plain.out" 2> "$t/plain.err"
+[[ $? -eq 1 ]] || fail "defaults: expected exit 1: $(cat "$t/plain.err")"
+[[ $(verdict "$t/plain") == failed ]] || fail "defaults: verdict $(verdict "$t/plain")"
+grep -q -- "--selfcal" "$t/plain.err" || fail "defaults: the fix is not named: $(cat "$t/plain.err")"
+# WHEN estimated with --selfcal --box-at-rest THEN ok (exit 0 even with --strict), nothing rejected
+"$bin" estimate --log "$t/sim/log.csv" --out "$t/sc" --selfcal --box-at-rest --strict > "$t/sc.out" 2> "$t/sc.err" ||
+  fail "--selfcal --box-at-rest: exit $?: $(cat "$t/sc.out" "$t/sc.err")"
+[[ $(verdict "$t/sc") == ok ]] || fail "--selfcal: verdict $(verdict "$t/sc")"
+grep -q '"rejected": 0,' "$t/sc/summary.json" || fail "--selfcal: updates rejected"
+grep -q '"self_calibration": {"enabled": true' "$t/sc/summary.json" || fail "no self_calibration block"
+grep -q '"g_sensitivity_sigma_dps_per_g": \[\[\[' "$t/sc/summary.json" || fail "no G sigma in summary.json"
+# AND without --box-at-rest the lock failure names it
+"$bin" estimate --log "$t/sim/log.csv" --out "$t/free" --selfcal > /dev/null 2> "$t/free.err"
+grep -q -- "--box-at-rest" "$t/free.err" || fail "--selfcal alone: --box-at-rest not proposed: $(cat "$t/free.err")"
+echo "ok"
