@@ -20,6 +20,7 @@ namespace driftless::diagnose {
 /// The regression data of one gyro channel.
 struct ChannelData {
   int s = 0, j = 0;               // sensor, axis
+  bool present = true;            // false: sensor 2 of a single-sensor log (no data, no columns)
   std::vector<int> cols;          // regressor columns the log excites
   std::vector<double> prior;      // prior sigma per entry of cols (0 = not a nuisance)
   Eigen::MatrixXf block_cols;     // block means of the columns (blocks x cols), unwhitened
@@ -74,6 +75,10 @@ double fit_white_density(const ChannelData& c, const BlockSeries& blocks, std::s
 
 /// ln m of the BIC penalty: ln(mean blocks per channel).
 double log_blocks(const Channels& ch);
+
+/// Brent's minimum of f on [lo, hi] (golden section with parabolic interpolation) starting at
+/// x0, to `tol` in x plus 1e-10 relative.
+double brent_min(const std::function<double(double)>& f, double lo, double hi, double x0, double tol);
 
 /// Golden-section minimum of f on [lo, hi].
 double golden_min(const std::function<double(double)>& f, double lo, double hi, int iters = 40);

@@ -1,6 +1,7 @@
 #include "diagnose/selection.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <functional>
@@ -9,6 +10,7 @@
 #include <fmt/core.h>
 
 #include "diagnose/apply.hpp"
+#include "diagnose/parallel.hpp"
 #include "estimator/stats.hpp"
 
 namespace driftless::diagnose {
@@ -44,6 +46,7 @@ bool lowpass_taken(const Terms& S, const ParamRef& x) {
 // every parameter the log excites: per channel, per sensor, box-wide
 std::vector<ParamRef> make_universe(const Channels& ch) {
   std::vector<ParamRef> u;
+  const bool single = !ch[3].present;  // a single-sensor log
   auto add = [&](Param p, int s, int row, int col) {
     const ParamRef ref{p, static_cast<std::int8_t>(s), static_cast<std::int8_t>(row), static_cast<std::int8_t>(col)};
     for (const ColumnUse& cu : columns_of(ref)) {
@@ -67,9 +70,11 @@ std::vector<ParamRef> make_universe(const Channels& ch) {
     for (int k = 0; k < 3; ++k) add(Param::kMountingDeg, s, k, -1);
     for (int side = 0; side < 2; ++side) add(Param::kStopErrorDeg, s, -1, side);
     add(Param::kLowpassDelayS, s, -1, -1);
-    add(Param::kSampleDelayS, s, -1, -1);
+    if (!single) add(Param::kSampleDelayS, s, -1, -1);
   }
-  add(Param::kLowpassDelayS, -1, -1, -1);  // both sensors' filter at once (one chip configuration)
+  // both sensors' filter at once (one chip configuration); with one sensor it is sensor 1's, and
+  // that sensor's sample delay is the box time offset: the same signals, one is tested
+  if (!single) add(Param::kLowpassDelayS, -1, -1, -1);
   add(Param::kLatitudeErrorDeg, -1, -1, -1);
   add(Param::kTimeOffsetS, -1, -1, -1);
   return u;
@@ -362,13 +367,13 @@ void Selector::prune(Terms& S) const {
 bool Selector::refit_noise(const Terms& S) {
   FitResult fit;
   const FitSpec spec = solve(S, &fit);
-  bool moved = false;
-  for (int c = 0; c < 6; ++c) {
+  std::array<double, 6> change{};
+  for_each_index(in_.res.channels(), [&](int c) {
     const Eigen::VectorXd coef = channel_coefficients(in_.ch[c], c, spec, fit);
     const std::vector<double> z = block_residual(in_.ch[c], coef);
-    moved = refit_white(in_.ch[c], in_.res.block_series, z) > 0.02 || moved;
-  }
-  return moved;
+    change[static_cast<std::size_t>(c)] = refit_white(in_.ch[c], in_.res.block_series, z);
+  });
+  return std::any_of(change.begin(), change.end(), [](double d) { return d > 0.02; });
 }
 
 Selection Selector::run() {
