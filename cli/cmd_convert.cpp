@@ -119,6 +119,10 @@ TimePlan plan_time(const ConvertArgs& a, const importers::StreamInfo& info, cons
                                  fmt::join(st.describe("line"), "; ")));
   }
   if (info.has_time) p.t0_s = st.first_t_s;
+  if (info.has_time && info.epoch_s != 0) {
+    p.notes.push_back(fmt::format("t counts from the epoch {} s (the first stamp floored to whole seconds): "
+                                  "t = stamp - {} s, formed in integer ns", info.epoch_s, info.epoch_s));
+  }
   if (!p.uniform) {
     p.notes.push_back("t = the stamps");
   } else if (!info.has_time) {

@@ -45,13 +45,20 @@ awk -F, -v r="$row" 'BEGIN { split(r, c, ","); exit !(c[1] == 0.01 && c[2] + 408
 
 # 3. EuRoC: regular ns stamps are the log's time
 awk -F, 'NR == 1 { print "#timestamp [ns],w_RS_S_x [rad s^-1],w_RS_S_y [rad s^-1],w_RS_S_z [rad s^-1],a_RS_S_x [m s^-2],a_RS_S_y [m s^-2],a_RS_S_z [m s^-2]"; next }
-  NR < 2000 { printf "%.0f,%.17g,%.17g,%.17g,0,0,9.81\n", 1403636579758555392 + (NR - 2) * 5000000, $5 / 57.29577951308232, $6 / 57.29577951308232, $7 / 57.29577951308232 }' \
+  NR < 2000 { ns = 758555392 + (NR - 2) * 5000000  # the 1.4e18 ns stamp written exactly (awk numbers are doubles)
+    printf "%d%09d,%.17g,%.17g,%.17g,0,0,9.81\n", 1403636579 + int(ns / 1e9), ns % 1000000000, $5 / 57.29577951308232, $6 / 57.29577951308232, $7 / 57.29577951308232 }' \
   "$real" > "$t/data.csv"
 "$bin" convert --in "$t/data.csv" --out "$t/euroc.csv" > "$t/euroc.txt" || { cat "$t/euroc.txt"; fail "EuRoC"; }
 grep -q "t = the stamps" "$t/euroc.txt" || fail "EuRoC stamps not used: $(cat "$t/euroc.txt")"
-# (epoch stamps in ns held as double seconds resolve 2.4e-7 s: the median 5 ms step is good to 1e-4)
-awk -v r="$(meta "$t/euroc.csv" sample_rate_hz)" 'BEGIN { exit !(r > 199.98 && r < 200.02) }' ||
+# the epoch (first stamp floored to whole seconds) is subtracted in integer ns: the 5 ms steps stay
+# exact (as double seconds, 1.4e9 s resolves only 2.4e-7 s), the rate is 200 Hz to 1e-9
+grep -q "epoch 1403636579 s" "$t/euroc.txt" || fail "the epoch is not said: $(cat "$t/euroc.txt")"
+grep -q "^# event: .*epoch 1403636579 s" "$t/euroc.csv" || fail "the epoch is not in the log's events"
+awk -v r="$(meta "$t/euroc.csv" sample_rate_hz)" 'BEGIN { d = r - 200; exit !(d < 1e-7 && d > -1e-7) }' ||
   fail "EuRoC rate: $(meta "$t/euroc.csv" sample_rate_hz)"
+awk -F, '!/^#/ && !/^t,/ { if (n++ > 0) { d = $1 - p - 0.005; if (d > 1e-9 || d < -1e-9) { print "step " $1 - p " at t " $1; exit 1 } } p = $1 }
+' "$t/euroc.csv" || fail "EuRoC steps are not 5 ms"
+[[ $(awk -F, '!/^#/ && !/^t,/ { print $1; exit }' "$t/euroc.csv") == 0.758555 ]] || fail "EuRoC first t is not stamp - epoch"
 
 # 4. refusals: a stamp that steps back with --time stamps; two triads without --columns
 printf 't,gx,gy,gz\n0.00,1,2,3\n0.01,1,2,3\n0.005,1,2,3\n0.02,1,2,3\n' > "$t/back.csv"
