@@ -1,5 +1,6 @@
 #include "estimator/pipeline.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <string>
@@ -10,6 +11,9 @@
 
 namespace driftless::est {
 namespace {
+
+// normalised estimation error squared e^T P^-1 e (Cholesky solve, no inverse)
+double nees(const Vector6d& e, const Matrix6d& P) { return e.dot(P.llt().solve(e)); }
 
 // NEES and error statistics of the accepted updates against the log's true_bias columns
 class TruthScore {
@@ -25,9 +29,9 @@ class TruthScore {
     truth << s.true_bias1_dps, s.true_bias2_dps;
     const Vector6d e = filter.bias_dps() - truth;
     const Matrix6d& P = filter.covariance_dps2();
-    const double nees = e.dot(P.llt().solve(e));
-    nees_sum_ += nees;
-    nees_in_ += (nees >= ts_.nees_band_lo && nees <= ts_.nees_band_hi) ? 1 : 0;
+    const double v = nees(e, P);
+    nees_sum_ += v;
+    nees_in_ += (v >= ts_.nees_band_lo && v <= ts_.nees_band_hi) ? 1 : 0;
     for (int i = 0; i < 6; ++i) {
       comp_in_ += std::fabs(e[i]) <= 3.0 * std::sqrt(P(i, i)) ? 1 : 0;
       ++comp_n_;
@@ -62,6 +66,53 @@ class TruthScore {
   std::size_t nees_in_ = 0, comp_in_ = 0, comp_n_ = 0;
 };
 
+// per-sample error statistics over the evaluation window (WindowStats)
+class WindowScore {
+ public:
+  WindowScore(WindowStats& ws, double start_s) : ws_(ws), start_s_(start_s) { ws_.start_s = start_s; }
+
+  void add(const DriftlessFilter& filter, const Sample& s) {
+    if (!(s.t_s >= start_s_) || !s.true_bias1_dps.allFinite() || !s.true_bias2_dps.allFinite()) return;
+    Vector6d truth;
+    truth << s.true_bias1_dps, s.true_bias2_dps;
+    const Vector6d e = filter.bias_dps() - truth;
+    sum2_ += e.squaredNorm();
+    comp2_ += e.cwiseAbs2();
+    max_ = std::max(max_, e.cwiseAbs().maxCoeff());
+    nees_ += nees(e, filter.covariance_dps2()) / 6.0;
+    last_ = e;
+    ++n_;
+  }
+
+  void on_update(const UpdateRecord& u) {
+    if (!u.accepted || !std::isfinite(u.nis) || !(u.t_s >= start_s_)) return;
+    nis_ += u.nis / u.dim;
+    ++n_nis_;
+  }
+
+  void finish(const DriftlessFilter& filter) {
+    ws_.sigma_rms_final_dps = std::sqrt(filter.covariance_dps2().trace() / 6.0);
+    ws_.nis_updates = n_nis_;
+    if (n_nis_ > 0) ws_.nis_per_dof_mean = nis_ / double(n_nis_);
+    if (n_ == 0) return;
+    const double n = double(n_);
+    ws_.available = true;
+    ws_.samples = n_;
+    ws_.bias_error_rms_dps = std::sqrt(sum2_ / (6.0 * n));
+    for (int i = 0; i < 6; ++i) ws_.component_rms_dps[i] = std::sqrt(comp2_[i] / n);
+    ws_.bias_error_max_dps = max_;
+    ws_.final_error_dps = last_;
+    ws_.nees_per_dof_mean = nees_ / n;
+  }
+
+ private:
+  WindowStats& ws_;
+  double start_s_;
+  double sum2_ = 0.0, max_ = 0.0, nees_ = 0.0, nis_ = 0.0;
+  Vector6d comp2_ = Vector6d::Zero(), last_ = Vector6d::Zero();
+  std::size_t n_ = 0, n_nis_ = 0;
+};
+
 void add_reader_warnings(const log::LogReader& reader, EstimateSummary& sum) {
   sum.rows_missing_gyro = reader.rows_with_missing_gyro();
   if (sum.rows_missing_gyro > 0) {
@@ -69,7 +120,6 @@ void add_reader_warnings(const log::LogReader& reader, EstimateSummary& sum) {
                            " rows had a missing or NaN gyro value and were skipped");
   }
   if (reader.dropped_truncated_row()) sum.warnings.push_back("the last row was cut off and dropped");
-  if (sum.rows == 0) sum.warnings.push_back("the log holds no rows");
 }
 
 void add_filter_warnings(const DriftlessFilter& filter, EstimateSummary& sum) {
@@ -88,13 +138,7 @@ void add_filter_warnings(const DriftlessFilter& filter, EstimateSummary& sum) {
   }
 }
 
-}  // namespace
-
-EstimateSummary run_estimate(log::LogReader& reader, const EstimatorConfig& cfg, EstimateSink* sink,
-                             const EstimateRunOptions& opt, bool (*should_stop)()) {
-  EstimateSummary sum;
-  const auto& meta = reader.metadata();
-  DriftlessFilter filter(cfg, box_geometry_from_metadata(meta));
+void add_stream_warnings(const log::Metadata& meta, EstimateSummary& sum) {
   sum.log_complete = meta.complete();
   if (!sum.log_complete) {
     sum.warnings.push_back("the log says 'complete: false' (" +
@@ -104,25 +148,67 @@ EstimateSummary run_estimate(log::LogReader& reader, const EstimatorConfig& cfg,
   if (!std::isfinite(meta.latitude_deg())) {
     sum.warnings.push_back("no latitude_deg in the log: the Earth rate is removed at latitude 0");
   }
-  const bool have_truth = (reader.fields() & kFieldTrueBias) != 0;
-  const bool have_ref = (reader.fields() & kFieldRefQ) != 0;
-  sum.attitude_available = have_ref;
+}
+
+AttitudeComparisonOptions comparison_options(const EstimateRunOptions& opt) {
+  AttitudeComparisonOptions a;
+  a.start_sigma_dps = opt.attitude_start_sigma_dps;
+  a.interval_s = opt.attitude_interval_s;
+  a.fixed_bias_from = opt.fixed_bias_from;
+  a.realign_at_s = opt.realign_at_eval_start ? opt.eval_start_s : kNaN;
+  return a;
+}
+
+void add_attitude_results(const AttitudeComparison& att, const DriftlessFilter& filter,
+                          const EstimateRunOptions& opt, EstimateSummary& sum) {
+  sum.attitude_start_s = att.start_s();
+  sum.attitude_realign_s = att.realign_s();
+  if (att.started()) sum.fixed_bias_dps = att.fixed_bias_dps();
+  const AttitudeDrifts drift = att.drifts();
+  sum.drift_corrected_deg_per_h = drift.corrected_deg_per_h;
+  sum.drift_raw_deg_per_h = drift.raw_deg_per_h;
+  sum.drift_fixed_deg_per_h = drift.fixed_deg_per_h;
+  sum.drift_net_corrected_deg_per_h = drift.net_corrected_deg_per_h;
+  sum.drift_net_raw_deg_per_h = drift.net_raw_deg_per_h;
+  sum.drift_net_fixed_deg_per_h = drift.net_fixed_deg_per_h;
+  if (att.points() < 2 && sum.attitude_available && !att.started() && sum.rows > 0) {
+    sum.warnings.push_back(
+        "no attitude comparison: the filter never locked on (every bias sigma below " +
+        std::to_string(opt.attitude_start_sigma_dps) + " deg/s; the largest is " +
+        std::to_string(filter.sigma_dps().maxCoeff()) +
+        " deg/s); an attitude start sigma of 0 compares from the log's start");
+  }
+}
+
+// the pass itself; `reader` (optional) adds the log reader's findings to the warnings
+EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const SampleSource& next,
+                         const log::LogReader* reader, const EstimatorConfig& cfg, EstimateSink* sink,
+                         const EstimateRunOptions& opt, bool (*should_stop)()) {
+  EstimateSummary sum;
+  DriftlessFilter filter(cfg, box_geometry_from_metadata(meta));
+  add_stream_warnings(meta, sum);
+  const bool have_truth = (fields & kFieldTrueBias) != 0;
+  sum.attitude_available = (fields & kFieldRefQ) != 0;
   sum.truth.available = have_truth;
-  AttitudeComparison att(meta.latitude_deg(), opt.attitude_start_sigma_dps, opt.attitude_interval_s);
+  AttitudeComparison att(meta.latitude_deg(), comparison_options(opt));
   TruthScore score(sum.truth, opt.nees_band_probability);
+  WindowScore window(sum.window, opt.eval_start_s);
+  const bool use_window = have_truth && std::isfinite(opt.eval_start_s);
   HealthMonitor health(opt.health);
 
-  // an update (accepted or rejected) reaches the sink, the truth score and the re-lock list
+  // an update (accepted or rejected) reaches the sink, the truth scores and the re-lock list
   auto on_update = [&](PushStatus st, const Sample& s) {
     if (st != PushStatus::kUpdated && st != PushStatus::kRejected) return;
-    if (sink != nullptr) sink->on_update(filter.last_update(), filter.covariance_dps2(), s);
-    health.on_update(filter.last_update(), filter);
-    if (filter.last_update().relocked) sum.relocks.push_back({filter.last_update().t_s, filter.last_update().nis});
+    const UpdateRecord& u = filter.last_update();
+    if (sink != nullptr) sink->on_update(u, filter.covariance_dps2(), s);
+    health.on_update(u, filter);
+    if (u.relocked) sum.relocks.push_back({u.t_s, u.nis});
     if (have_truth && st == PushStatus::kUpdated) score.add(filter, s);
+    if (use_window) window.on_update(u);
   };
 
   Sample s;
-  while (reader.next(s)) {
+  while (next(s)) {
     if (should_stop != nullptr && (sum.rows & 4095u) == 0 && should_stop()) {
       sum.warnings.push_back("stopped early at t = " + std::to_string(s.t_s) + " s (interrupted)");
       break;
@@ -131,9 +217,9 @@ EstimateSummary run_estimate(log::LogReader& reader, const EstimatorConfig& cfg,
     if (!std::isfinite(sum.t_first_s)) sum.t_first_s = s.t_s;
     sum.t_last_s = s.t_s;
     const PushStatus st = filter.push(s);
-    const SampleOutput& out = filter.output();
-    if (sink != nullptr) sink->on_sample(s, out);
+    if (sink != nullptr) sink->on_sample(s, filter.output());
     on_update(st, s);
+    if (use_window) window.add(filter, s);
 
     // attitude: the comparison starts at the first finite ref_q once the filter has locked on
     // (every bias sigma below attitude_start_sigma_dps)
@@ -148,27 +234,31 @@ EstimateSummary run_estimate(log::LogReader& reader, const EstimatorConfig& cfg,
   // a log that ends at rest (or never moved) still gives its last standstill
   if (sum.rows > 0) on_update(filter.finish(), s);
 
-  add_reader_warnings(reader, sum);
+  if (reader != nullptr) add_reader_warnings(*reader, sum);
+  if (sum.rows == 0) sum.warnings.push_back("the log holds no rows");
   sum.counters = filter.counters();
   add_filter_warnings(filter, sum);
   sum.bias_dps = filter.bias_dps();
   sum.sigma_dps = filter.sigma_dps();
-  sum.attitude_start_s = att.start_s();
-  if (att.started()) sum.fixed_bias_dps = att.fixed_bias_dps();
-  const AttitudeDrifts drift = att.drifts();
-  sum.drift_corrected_deg_per_h = drift.corrected_deg_per_h;
-  sum.drift_raw_deg_per_h = drift.raw_deg_per_h;
-  sum.drift_fixed_deg_per_h = drift.fixed_deg_per_h;
-  if (att.points() < 2 && have_ref && !att.started() && sum.rows > 0) {
-    sum.warnings.push_back(
-        "no attitude comparison: the filter never locked on (every bias sigma below " +
-        std::to_string(opt.attitude_start_sigma_dps) + " deg/s; the largest is " +
-        std::to_string(filter.sigma_dps().maxCoeff()) +
-        " deg/s); an attitude start sigma of 0 compares from the log's start");
-  }
+  add_attitude_results(att, filter, opt, sum);
   score.finish();
+  if (use_window) window.finish(filter);
   sum.health = health.finish(filter, sum.rows > 0 ? sum.t_last_s - sum.t_first_s : 0.0);
   return sum;
+}
+
+}  // namespace
+
+EstimateSummary run_estimate(log::LogReader& reader, const EstimatorConfig& cfg, EstimateSink* sink,
+                             const EstimateRunOptions& opt, bool (*should_stop)()) {
+  return run_pass(reader.metadata(), reader.fields(), [&reader](Sample& s) { return reader.next(s); }, &reader,
+                  cfg, sink, opt, should_stop);
+}
+
+EstimateSummary run_estimate(const log::Metadata& meta, std::uint32_t fields, const SampleSource& next,
+                             const EstimatorConfig& cfg, EstimateSink* sink, const EstimateRunOptions& opt,
+                             bool (*should_stop)()) {
+  return run_pass(meta, fields, next, nullptr, cfg, sink, opt, should_stop);
 }
 
 }  // namespace driftless::est

@@ -1,9 +1,11 @@
-// One pass over a log: the DriftLess filter, strapdown attitude with and without the correction,
-// and (evaluation only) errors against the log's true_ columns. The CLI, the benchmarks and the
-// tests share it; file output is the caller's (EstimateSink). Eigen + std only.
+// One pass over a log or any stream of samples: the DriftLess filter, strapdown attitude with and
+// without the correction, and (evaluation only) errors against the samples' true_ columns. The
+// CLI, the sweep (studies/), the benchmarks and the tests share it; file output is the caller's
+// (EstimateSink). Eigen + std only.
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -27,11 +29,24 @@ class EstimateSink {
   virtual void on_attitude(const AttitudePoint& /*p*/) {}
 };
 
+/// Where the samples come from when they are not a log file: fills the next sample, false at
+/// the end (a simulator, the sweep's closed-form box, a replay).
+using SampleSource = std::function<bool(Sample&)>;
+
 struct EstimateRunOptions {
   double attitude_interval_s = 1.0;  // s, spacing of attitude comparison points
   // deg/s: the attitude comparison starts at the first ref_q once every bias sigma is below this
   // (the filter has locked on); <= 0 starts it at the log's first ref_q
   double attitude_start_sigma_dps = 0.05;
+  // what the 'fixed' attitude integration holds: the estimate at the start (estimate) or the
+  // true bias there, a perfect turn-on calibration (sweep; needs true_bias columns)
+  FixedBiasFrom fixed_bias_from = FixedBiasFrom::kEstimate;
+  // s: start of the evaluation window: per-sample truth statistics (WindowStats) from here; NaN:
+  // no window
+  double eval_start_s = kNaN;
+  // re-align the attitude integrations on ref_q at eval_start_s: the net drift is what
+  // accumulates inside the window
+  bool realign_at_eval_start = false;
   double nees_band_probability = 0.95;  // two-sided chi-square band for the NEES statistics
   HealthLimits health;                  // limits of the health verdict (docs/estimator.md section 6.1)
 };
@@ -49,6 +64,23 @@ struct TruthStats {
   double nees_fraction_in_band = kNaN;  // fraction of single NEES values inside the 6-dof band
   double nees_band_lo = kNaN, nees_band_hi = kNaN;
   double within_3sigma_fraction = kNaN;  // component errors inside +-3 sigma
+};
+
+/// Per-sample statistics against the truth over the evaluation window (every sample with t >=
+/// eval_start_s and finite true_bias columns counts, not only the updates, so the time a filter
+/// spends converging inside the window shows). Errors are estimate minus truth, deg/s.
+struct WindowStats {
+  bool available = false;  // a window was asked for and held samples with truth
+  double start_s = kNaN;   // s, eval_start_s
+  std::size_t samples = 0;
+  double bias_error_rms_dps = kNaN;                      // over samples and the 6 components
+  Vector6d component_rms_dps = Vector6d::Constant(kNaN);  // per component (1x 1y 1z 2x 2y 2z)
+  double bias_error_max_dps = kNaN;                      // largest |component error|
+  Vector6d final_error_dps = Vector6d::Constant(kNaN);   // at the window's last sample
+  double nees_per_dof_mean = kNaN;  // mean over the samples of e^T P^-1 e / 6
+  double nis_per_dof_mean = kNaN;   // mean NIS / dim of the accepted updates at t >= eval_start_s
+  std::size_t nis_updates = 0;
+  double sigma_rms_final_dps = kNaN;  // sqrt(trace P / 6) at the pass's end
 };
 
 /// A gate re-lock (docs/estimator.md: gate_relock_after).
@@ -69,10 +101,17 @@ struct EstimateSummary {
   double drift_corrected_deg_per_h = kNaN;
   double drift_raw_deg_per_h = kNaN;
   double drift_fixed_deg_per_h = kNaN;
+  // deg/h: the error angle at the last ref_q over the hours since the start (or the re-alignment
+  // at eval_start_s); NaN when a requested re-alignment never came
+  double drift_net_corrected_deg_per_h = kNaN;
+  double drift_net_raw_deg_per_h = kNaN;
+  double drift_net_fixed_deg_per_h = kNaN;
   double attitude_start_s = kNaN;                  // s, where the comparison started
+  double attitude_realign_s = kNaN;                // s, where it was re-aligned (NaN: not)
   Vector6d fixed_bias_dps = Vector6d::Constant(kNaN);  // deg/s, the bias held by `fixed`
   AttitudeError final_corrected, final_raw, final_fixed;
   TruthStats truth;
+  WindowStats window;  // with EstimateRunOptions::eval_start_s
   bool log_complete = true;
   std::vector<RelockEvent> relocks;
   HealthReport health;  // the verdict: lock, gate rejections, NIS against its band, observability
@@ -84,5 +123,12 @@ struct EstimateSummary {
 /// `should_stop` (optional) is polled every 4096 rows (Ctrl-C).
 EstimateSummary run_estimate(log::LogReader& reader, const EstimatorConfig& cfg, EstimateSink* sink,
                              const EstimateRunOptions& opt = {}, bool (*should_stop)() = nullptr);
+
+/// The same pass over a stream: `meta` describes it as a log header would (box geometry,
+/// latitude, completeness), `fields` says which optional column groups its samples fill
+/// (SampleField bits: true_bias, ref_q). Whatever `next` throws ends the pass and propagates.
+EstimateSummary run_estimate(const log::Metadata& meta, std::uint32_t fields, const SampleSource& next,
+                             const EstimatorConfig& cfg, EstimateSink* sink, const EstimateRunOptions& opt = {},
+                             bool (*should_stop)() = nullptr);
 
 }  // namespace driftless::est

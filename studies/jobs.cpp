@@ -11,7 +11,7 @@
 
 #include "estimator/numbers.hpp"
 #include "estimator/output_file.hpp"
-#include "estimator/attitude.hpp"
+#include "estimator/pipeline.hpp"
 #include "estimator/geometry.hpp"
 #include "estimator/random.hpp"
 #include "twin/simulator.hpp"
@@ -124,112 +124,64 @@ RunSetup SetupBuilder::build(const RunSpec& spec) const {
   return s;
 }
 
+namespace {
+
+// attitude_<i>.csv: the two attitude error angles (deg) at the comparison points, a nan row at the
+// re-alignment (gnuplot breaks its lines there)
+class AttitudeCsv final : public est::EstimateSink {
+ public:
+  AttitudeCsv() { out_ << "t_s,err_driftless_deg,err_zeroed_deg\n"; }
+  void on_attitude(const est::AttitudePoint& p) override {
+    if (p.realigned) {
+      out_ << p.t_s << ",nan,nan\n";
+      return;
+    }
+    out_ << p.t_s << ',' << p.corrected.angle_deg << ',' << p.fixed.angle_deg << '\n';
+  }
+  std::string text() const { return out_.str(); }
+
+ private:
+  std::ostringstream out_;
+};
+
+}  // namespace
+
+est::EstimateRunOptions bias_run_options(const RunSetup& setup) {
+  est::EstimateRunOptions opt;
+  opt.attitude_start_sigma_dps = 0.0;
+  opt.attitude_interval_s = 1.0;
+  opt.fixed_bias_from = est::FixedBiasFrom::kTruth;
+  opt.eval_start_s = setup.eval_start_s >= 0 ? setup.eval_start_s : 0.25 * setup.scenario.duration_s;
+  opt.realign_at_eval_start = true;
+  return opt;
+}
+
 Metrics evaluate_bias(const RunSetup& setup, const log::Metadata& meta, const SampleSource& source,
                       const std::filesystem::path& attitude_csv) {
-  // attitude.csv: collected here, written through the output helper when the run is done
-  const bool att_file = !attitude_csv.empty();
-  std::ostringstream att_out;
-  if (att_file) att_out << "t_s,err_driftless_deg,err_zeroed_deg\n";
-  double next_att_out_s = 0.0;
-  est::DriftlessFilter filter(setup.estimator, est::box_geometry_from_metadata(meta));
-  const double eval_start =
-      setup.eval_start_s >= 0 ? setup.eval_start_s : 0.25 * setup.scenario.duration_s;
-  Sample s;
-  double sum2 = 0, nees = 0, nis = 0, maxe = 0;
-  est::Vector6d comp2 = est::Vector6d::Zero();
-  est::Vector6d last_err = est::Vector6d::Zero();
-  long n = 0, n_nis = 0;
-  std::uint64_t last_update = 0;
-  // attitude (paper Fig. 9): strapdown from the DriftLess-corrected rate, and from the gyros with
-  // their bias zeroed once at the first sample (a perfect turn-on calibration, then drift: the
-  // paper's "without DriftLess"); both start on the reference attitude
-  est::AttitudeIntegrator att_dl(setup.scenario.latitude_deg), att_zero(setup.scenario.latitude_deg);
-  Eigen::Quaterniond err_dl0 = Eigen::Quaterniond::Identity(), err_zero0 = Eigen::Quaterniond::Identity();
-  bool att_window = false;
-  double att_t0 = kNaN, att_t1 = kNaN;
-  Eigen::Quaterniond err_dl1 = Eigen::Quaterniond::Identity(), err_zero1 = Eigen::Quaterniond::Identity();
-  while (source(s)) {
-    filter.push(s);
-    if (s.ref_q_wxyz.allFinite() && s.true_bias1_dps.allFinite() && s.true_bias2_dps.allFinite()) {
-      const est::SampleOutput& out = filter.output();
-      if (!att_dl.initialized()) {
-        // the true bias at the first sample, held: the filter fuses its rate with it
-        // (rate_body_fixed_dps), the same fusion as the corrected rate
-        est::Vector6d bias_at_start;
-        bias_at_start << s.true_bias1_dps, s.true_bias2_dps;
-        filter.set_fixed_bias_dps(bias_at_start);
-        att_dl.reset(s.q_enu_from_body(), s.t_s);
-        att_zero.reset(s.q_enu_from_body(), s.t_s);
-      } else {
-        att_dl.step(s.t_s, out.rate_body_dps);
-        att_zero.step(s.t_s, out.rate_body_fixed_dps);
-      }
-      const Eigen::Quaterniond q_ref = s.q_enu_from_body();
-      const Eigen::Quaterniond e_dl = att_dl.q_enu_from_body() * q_ref.conjugate();
-      const Eigen::Quaterniond e_zero = att_zero.q_enu_from_body() * q_ref.conjugate();
-      if (!att_window && s.t_s >= eval_start) {
-        // re-align both on the reference at the window start: the drift is what accumulates
-        // after it (an offset left by the filter's convergence is fixed in the body frame and
-        // would turn with the box in an ENU error, reading as drift)
-        att_window = true;
-        att_t0 = s.t_s;
-        att_dl.reset(q_ref, s.t_s);
-        att_zero.reset(q_ref, s.t_s);
-        err_dl0 = err_zero0 = Eigen::Quaterniond::Identity();
-        next_att_out_s = s.t_s;
-        if (att_file) att_out << s.t_s << ",nan,nan\n";  // gnuplot: break the lines
-      } else if (att_file && s.t_s >= next_att_out_s) {
-        att_out << s.t_s << ',' << geo::rotvec_rad(e_dl).norm() * kDegPerRad << ','
-                << geo::rotvec_rad(e_zero).norm() * kDegPerRad << '\n';
-        next_att_out_s += 1.0;
-      }
-      att_t1 = s.t_s;
-      err_dl1 = e_dl;
-      err_zero1 = e_zero;
-    }
-    if (filter.counters().updates > last_update) {
-      last_update = filter.counters().updates;
-      const auto& u = filter.last_update();
-      if (u.accepted && std::isfinite(u.nis) && u.t_s >= eval_start) {
-        nis += u.nis / u.dim;
-        ++n_nis;
-      }
-    }
-    if (s.t_s < eval_start || !s.true_bias1_dps.allFinite()) continue;
-    est::Vector6d truth;
-    truth << s.true_bias1_dps, s.true_bias2_dps;
-    const est::Vector6d e = filter.bias_dps() - truth;
-    sum2 += e.squaredNorm();
-    comp2 += e.cwiseAbs2();
-    maxe = std::max(maxe, e.cwiseAbs().maxCoeff());
-    nees += e.dot(filter.covariance_dps2().ldlt().solve(e)) / 6.0;
-    last_err = e;
-    ++n;
-  }
-  if (att_file) io::write_file(attitude_csv, att_out.str());
-  if (n == 0) throw std::runtime_error("sweep: no samples after eval start (duration too short?)");
+  AttitudeCsv csv;
+  const est::EstimateSummary sum =
+      est::run_estimate(meta, Simulator::fields(), source, setup.estimator,
+                        attitude_csv.empty() ? nullptr : &csv, bias_run_options(setup));
+  if (!attitude_csv.empty()) io::write_file(attitude_csv, csv.text());
+  const est::WindowStats& w = sum.window;
+  if (!w.available) throw std::runtime_error("sweep: no samples after eval start (duration too short?)");
   Metrics m;
-  m.emplace_back("bias_err_rms_dph", std::sqrt(sum2 / (6.0 * n)) * kDphPerDps);
+  m.emplace_back("bias_err_rms_dph", w.bias_error_rms_dps * kDphPerDps);
   static const char* names[6] = {"1x", "1y", "1z", "2x", "2y", "2z"};
   for (int i = 0; i < 6; ++i) {
-    m.emplace_back(std::string("bias_err_rms_") + names[i] + "_dph", std::sqrt(comp2[i] / n) * kDphPerDps);
+    m.emplace_back(std::string("bias_err_rms_") + names[i] + "_dph", w.component_rms_dps[i] * kDphPerDps);
   }
-  m.emplace_back("bias_err_max_dph", maxe * kDphPerDps);
-  m.emplace_back("bias_err_final_dph", std::sqrt(last_err.squaredNorm() / 6.0) * kDphPerDps);
-  m.emplace_back("sigma_final_dph", std::sqrt(filter.covariance_dps2().trace() / 6.0) * kDphPerDps);
-  m.emplace_back("nees_mean", nees / n);
-  m.emplace_back("nis_mean", n_nis ? nis / n_nis : std::nan(""));
-  m.emplace_back("updates", static_cast<double>(filter.counters().updates));
-  m.emplace_back("rejected", static_cast<double>(filter.counters().rejected));
+  m.emplace_back("bias_err_max_dph", w.bias_error_max_dps * kDphPerDps);
+  m.emplace_back("bias_err_final_dph", std::sqrt(w.final_error_dps.squaredNorm() / 6.0) * kDphPerDps);
+  m.emplace_back("sigma_final_dph", w.sigma_rms_final_dps * kDphPerDps);
+  m.emplace_back("nees_mean", w.nees_per_dof_mean);
+  m.emplace_back("nis_mean", w.nis_per_dof_mean);
+  m.emplace_back("updates", static_cast<double>(sum.counters.updates));
+  m.emplace_back("rejected", static_cast<double>(sum.counters.rejected));
   // attitude error accumulated over the evaluation window from a perfect alignment at its start,
   // per hour (NaN without ref_q)
-  const double window_h = (att_t1 - att_t0) / 3600.0;
-  const auto drift = [&](const Eigen::Quaterniond& e0, const Eigen::Quaterniond& e1) {
-    if (!att_window || !(window_h > 0)) return kNaN;
-    return geo::rotvec_rad(e1 * e0.conjugate()).norm() * kDegPerRad / window_h;
-  };
-  m.emplace_back("att_drift_dph", drift(err_dl0, err_dl1));
-  m.emplace_back("att_drift_zeroed_dph", drift(err_zero0, err_zero1));
+  m.emplace_back("att_drift_dph", sum.drift_net_corrected_deg_per_h);
+  m.emplace_back("att_drift_zeroed_dph", sum.drift_net_fixed_deg_per_h);
   return m;
 }
 

@@ -10,6 +10,7 @@
 #include "estimator/fdi.hpp"
 #include "estimator/filter.hpp"
 #include "estimator/log.hpp"
+#include "estimator/pipeline.hpp"
 #include "twin/scenario.hpp"
 #include "studies/sweep.hpp"
 
@@ -41,10 +42,18 @@ class SetupBuilder {
 };
 
 /// Source of samples for evaluate(): fills the next sample, false at the end.
-using SampleSource = std::function<bool(Sample&)>;
+using SampleSource = est::SampleSource;
 
-/// Runs `source` through a DriftlessFilter built from `setup` and scores the bias estimate
-/// against the true_bias columns: bias_err_rms_dph (all six components over t >= eval start),
+/// The estimate pass as the sweep scores it (docs/sweep.md): attitude (paper Fig. 9) from the
+/// DriftLess-corrected rate and from the gyros with their bias zeroed once at the first sample
+/// (a perfect turn-on calibration, then drift: the paper's "without DriftLess"), both started on
+/// the reference and re-aligned on it at the window start (eval_start_s; < 0: a quarter of the
+/// duration); truth statistics over the window. `driftless estimate` on a saved run log with
+/// these options scores what the sweep scored.
+est::EstimateRunOptions bias_run_options(const RunSetup& setup);
+
+/// Runs `source` through the estimate pass (est::run_estimate) with the filter of `setup` and
+/// scores the bias estimate against the true_bias columns: bias_err_rms_dph (all six components over t >= eval start),
 /// per-component RMS, max, final, mean NEES/6, NIS mean, updates and rejections, attitude drift
 /// with DriftLess and with the bias zeroed once. With `attitude_csv` set, also writes the attitude
 /// error angles (deg) once per second: t_s,err_driftless_deg,err_zeroed_deg.

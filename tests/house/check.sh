@@ -76,5 +76,7 @@ estimator/mpu6050.hpp|the MPU6050 DLPF table|13\.4e-3|0\.0134|18\.6e-3
 estimator/mpu6050.hpp|the MPU6050 sensitivities|131\.0, 65\.5|16384\.0|/ 340\.0|36\.53
 estimator/output_file.hpp estimator/output_file.cpp|writing a file (use the output helper: partial name, checked writes, rename)|std::ofstream|fmt::output_file|fopen\(.*"[wa]
 estimator/random.hpp estimator/random.cpp|the random generators|std::(normal|uniform_real)_distribution|std::mt19937|0x9E3779B97F4A7C15
+estimator/attitude.hpp estimator/attitude.cpp estimator/attitude_comparison.hpp estimator/attitude_comparison.cpp|strapdown attitude integration (compare through est::run_estimate / AttitudeComparison)|AttitudeIntegrator
+estimator/pipeline.cpp|NEES against the truth (score through est::run_estimate)|\.(llt|ldlt)\(\)\.solve\(e\)
 RULES
 exit $bad
