@@ -37,6 +37,9 @@ class BiasWhitener {
   void whiten(std::span<const double> z, std::span<double> out) const;
   /// -2 log-likelihood of z under the model (the diffuse first block left out).
   double neg2_loglik(std::span<const double> z) const;
+  /// The same -2 log-likelihood in one pass that keeps no gains: for the noise-model searches,
+  /// which evaluate many noise models once each (no per-block storage, identical arithmetic).
+  static double neg2_loglik(const BlockSeries& blocks, const ChannelNoise& noise, std::span<const double> z);
   /// Smoothed bias (RTS) given z: the nuisance estimate, deg/s, per block.
   std::vector<double> smooth(std::span<const double> z) const;
   /// Which blocks enter fits (data present, not the diffuse first one).

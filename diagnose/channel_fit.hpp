@@ -75,6 +75,10 @@ double fit_white_density(const ChannelData& c, const BlockSeries& blocks, std::s
 /// ln m of the BIC penalty: ln(mean blocks per channel).
 double log_blocks(const Channels& ch);
 
+/// Brent's minimum of f on [lo, hi] (golden section with parabolic interpolation) starting at
+/// x0, to `tol` in x plus 1e-10 relative.
+double brent_min(const std::function<double(double)>& f, double lo, double hi, double x0, double tol);
+
 /// Golden-section minimum of f on [lo, hi].
 double golden_min(const std::function<double(double)>& f, double lo, double hi, int iters = 40);
 

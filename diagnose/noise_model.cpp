@@ -7,6 +7,7 @@
 #include <Eigen/Dense>
 
 #include "diagnose/apply.hpp"
+#include "diagnose/parallel.hpp"
 #include "estimator/sample.hpp"
 #include "estimator/stats.hpp"
 
@@ -44,7 +45,7 @@ PerChannel white_noise(const Residual& res, const ChannelData& C, int c, const C
   fit.white_dps_rthz = fit_white_density(C, res.block_series, z);
   const double n_model = p.white_noise.enabled ? p.white_noise.density_dps_rthz[C.j] : 0.0;
   mod.white_dps_rthz = std::max(n_model * std::sqrt(ratio), 1e-7);
-  const double gain = BiasWhitener(res.block_series, mod).neg2_loglik(z) - BiasWhitener(res.block_series, fit).neg2_loglik(z);
+  const double gain = BiasWhitener::neg2_loglik(res.block_series, mod, z) - BiasWhitener::neg2_loglik(res.block_series, fit, z);
   const double n_est = fit.white_dps_rthz / std::sqrt(ratio);
   PerChannel out{gain - log_m, gain, {}};
   out.params.push_back(noise_param(m, Param::kWhiteDensity, c, n_est,
@@ -100,7 +101,7 @@ std::array<PerChannel, 2> slow_processes(const ChannelData& C, int c, const Comp
       ChannelNoise nz = C.noise;
       nz.gm_sigma_dps = std::exp(ls);
       nz.gm_tau_s = tau;
-      return BiasWhitener(sb.series, nz).neg2_loglik(z1);
+      return BiasWhitener::neg2_loglik(sb.series, nz, z1);
     };
     const double ls = golden_min(f, std::log(1e-5), std::log(50.0), 30);
     if (const double v = f(ls); v < best) best = v, bs = std::exp(ls), bt = tau;
@@ -110,7 +111,7 @@ std::array<PerChannel, 2> slow_processes(const ChannelData& C, int c, const Comp
   auto f = [&](double lk) {
     ChannelNoise nz = C.noise;
     nz.rrw_dps_rts = std::exp(lk);
-    return BiasWhitener(sb.series, nz).neg2_loglik(z1);
+    return BiasWhitener::neg2_loglik(sb.series, nz, z1);
   };
   const double lk = golden_min(f, std::log(1e-7), std::log(1.0), 30);
   const double g = l_model - std::min(f(lk), l_model);
@@ -202,18 +203,19 @@ NoiseModelFindings noise_model_candidates(const Replay& r, const Residual& res, 
   const double log_m = log_blocks(ch);
   const double duration = r.t_s.back() - r.t_s.front();
   const SlowBlocks sb = slow_blocks(res);
-  std::vector<PerChannel> white, gm, rrw, bias, jit;
+  std::vector<PerChannel> white(6), gm(6), rrw(6), bias(6), jit;
   std::array<double, 6> floors{};
-  for (int c = 0; c < 6; ++c) {
-    const ChannelData& C = ch[c];
-    floors[static_cast<std::size_t>(c)] = white_noise_floor_dps(model.sensor[C.s], C.j, res.fs_hz);
-    const std::vector<double> z = finite_or_zero(after.z[c]);
-    white.push_back(white_noise(res, C, c, model, z, log_m));
+  for_each_index(6, [&](int c) {
+    const auto i = static_cast<std::size_t>(c);
+    const ChannelData& C = ch[i];
+    floors[i] = white_noise_floor_dps(model.sensor[C.s], C.j, res.fs_hz);
+    const std::vector<double> z = finite_or_zero(after.z[i]);
+    white[i] = white_noise(res, C, c, model, z, log_m);
     const auto slow = slow_processes(C, c, model, sb, slow_means(res, sb, z), duration);
-    gm.push_back(slow[0]);
-    rrw.push_back(slow[1]);
-    bias.push_back(constant_bias(C, c, model, after, res, duration, log_m));
-  }
+    gm[i] = slow[0];
+    rrw[i] = slow[1];
+    bias[i] = constant_bias(C, c, model, after, res, duration, log_m);
+  });
   for (int s = 0; s < 2; ++s) jit.push_back(jitter(r, res, floors, model, after, s, log_m));
   NoiseModelFindings out;
   for (Candidate c : {gather(Effect::kWhiteNoise, white, 1, threshold), gather(Effect::kBiasInstability, gm, 2, threshold),

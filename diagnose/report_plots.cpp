@@ -1,6 +1,11 @@
 // The report's plots: gnuplot data and scripts under DIR/plots/, drawn to PNG.
 
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
 #include <sstream>
+#include <vector>
 
 #include <fmt/core.h>
 
@@ -15,15 +20,60 @@ namespace {
 using report_text::gnuplot_png;
 std::string n(double v) { return report::json_number(v); }
 
+// a long log has more blocks than the plot has pixels (1 h at 0.1 s: 36 000 per channel, and
+// gnuplot took over a second on them): above kPlotBuckets * 2 blocks each bucket of blocks is
+// drawn as two rows, its smallest and largest residual per channel (the envelope the eye sees)
+// with the bucket's mean smoothed bias
+constexpr std::size_t kPlotBuckets = 1500;
+
+struct PlotRow {
+  double t_s;
+  std::array<double, 6> residual_dps, bias_dps;
+};
+
+std::vector<PlotRow> residual_rows(const CompareResult& r) {
+  const std::size_t m = r.block_t_s.size();
+  std::vector<PlotRow> rows;
+  if (m <= 2 * kPlotBuckets) {
+    for (std::size_t b = 0; b < m; ++b) {
+      PlotRow row{r.block_t_s[b], {}, {}};
+      for (int c = 0; c < 6; ++c) row.residual_dps[c] = r.block_residual_dps[c][b], row.bias_dps[c] = r.block_bias_dps[c][b];
+      rows.push_back(row);
+    }
+    return rows;
+  }
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  for (std::size_t k = 0; k < kPlotBuckets; ++k) {
+    const std::size_t a = k * m / kPlotBuckets, e = (k + 1) * m / kPlotBuckets;
+    PlotRow lo{r.block_t_s[(a + e - 1) / 2], {}, {}};
+    PlotRow hi = lo;
+    for (int c = 0; c < 6; ++c) {
+      double mn = kNaN, mx = kNaN, bias = 0.0;
+      for (std::size_t b = a; b < e; ++b) {
+        const double v = r.block_residual_dps[c][b];
+        bias += r.block_bias_dps[c][b];
+        if (!std::isfinite(v)) continue;
+        mn = std::isfinite(mn) ? std::min(mn, v) : v;
+        mx = std::isfinite(mx) ? std::max(mx, v) : v;
+      }
+      lo.residual_dps[c] = mn, hi.residual_dps[c] = mx;
+      lo.bias_dps[c] = hi.bias_dps[c] = bias / static_cast<double>(e - a);
+    }
+    rows.push_back(lo);
+    rows.push_back(hi);
+  }
+  return rows;
+}
+
 // residual after the selected effects and the smoothed bias (points), per sensor; the smoothed
 // bias itself below (it is a nuisance, drawn so its size is visible)
 Plot residual_plot(const CompareResult& r, const std::filesystem::path& dir) {
   const auto dat = dir / "residual.dat";
   {
     std::ostringstream d;
-    for (std::size_t b = 0; b < r.block_t_s.size(); ++b) {
-      d << fmt::format("{:.3f}", r.block_t_s[b]);
-      for (int c = 0; c < 6; ++c) d << ' ' << n(r.block_residual_dps[c][b]) << ' ' << n(r.block_bias_dps[c][b]);
+    for (const PlotRow& row : residual_rows(r)) {
+      d << fmt::format("{:.3f}", row.t_s);
+      for (int c = 0; c < 6; ++c) d << ' ' << n(row.residual_dps[c]) << ' ' << n(row.bias_dps[c]);
       d << '\n';
     }
     io::write_file(dat, d.str());  // before gnuplot reads it

@@ -1,6 +1,7 @@
 #include "diagnose/selection.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <functional>
@@ -9,6 +10,7 @@
 #include <fmt/core.h>
 
 #include "diagnose/apply.hpp"
+#include "diagnose/parallel.hpp"
 #include "estimator/stats.hpp"
 
 namespace driftless::diagnose {
@@ -362,13 +364,13 @@ void Selector::prune(Terms& S) const {
 bool Selector::refit_noise(const Terms& S) {
   FitResult fit;
   const FitSpec spec = solve(S, &fit);
-  bool moved = false;
-  for (int c = 0; c < 6; ++c) {
+  std::array<double, 6> change{};
+  for_each_index(6, [&](int c) {
     const Eigen::VectorXd coef = channel_coefficients(in_.ch[c], c, spec, fit);
     const std::vector<double> z = block_residual(in_.ch[c], coef);
-    moved = refit_white(in_.ch[c], in_.res.block_series, z) > 0.02 || moved;
-  }
-  return moved;
+    change[static_cast<std::size_t>(c)] = refit_white(in_.ch[c], in_.res.block_series, z);
+  });
+  return std::any_of(change.begin(), change.end(), [](double d) { return d > 0.02; });
 }
 
 Selection Selector::run() {

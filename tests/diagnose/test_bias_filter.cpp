@@ -118,6 +118,8 @@ TEST(BiasWhitener, MatchesAnExplicitKalmanFilterAndSmoother) {
     EXPECT_EQ(w.used()[j] != 0, e.s[j] > 0) << j;
   }
   EXPECT_NEAR(w.neg2_loglik(z), e.neg2ll, 1e-9 * std::abs(e.neg2ll));
+  // the one-pass form (no stored gains) does the same arithmetic: the same bits
+  EXPECT_EQ(BiasWhitener::neg2_loglik(b, noise, z), w.neg2_loglik(z));
   const std::vector<double> sm = w.smooth(z);
   for (std::size_t j = 0; j < z.size(); ++j) EXPECT_NEAR(sm[j], e.smooth[j], 1e-9) << j;
   EXPECT_NEAR(w.final_bias_sigma_dps(), std::sqrt(e.p_end(0, 0)), 1e-12);

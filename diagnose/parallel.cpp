@@ -1,0 +1,33 @@
+#include "diagnose/parallel.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <exception>
+#include <thread>
+#include <vector>
+
+namespace driftless::diagnose {
+
+void for_each_index(int n, const std::function<void(int)>& fn) {
+  if (n <= 0) return;
+  const int workers = std::min(n, static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
+  std::vector<std::exception_ptr> errors(static_cast<std::size_t>(n));
+  std::atomic<int> next{0};
+  auto work = [&] {
+    for (int i = next++; i < n; i = next++) {
+      try {
+        fn(i);
+      } catch (...) {
+        errors[static_cast<std::size_t>(i)] = std::current_exception();
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int w = 1; w < workers; ++w) pool.emplace_back(work);
+  work();  // the calling thread takes its share
+  for (auto& t : pool) t.join();
+  for (const auto& e : errors)
+    if (e) std::rethrow_exception(e);
+}
+
+}  // namespace driftless::diagnose
