@@ -81,9 +81,10 @@ int run_estimate_cmd(const EstimateArgs& a) {
     cfg = est::paper_config();
   }
   if (!a.mode.empty()) est::set_config_value(cfg, "mode", a.mode);
-  // parse the column groups the pass uses (the accelerometers only for a g-sensitivity calibration)
+  // parse the column groups the pass uses (the accelerometers only for a g-sensitivity calibration;
+  // the temperatures drive the bias temperature states)
   log::ReaderOptions read_opt;
-  read_opt.fields = kFieldRefQ | kFieldTrueBias;
+  read_opt.fields = kFieldRefQ | kFieldTrueBias | kFieldTemp;
   if (!a.calib.empty()) read_opt.fields |= kFieldAccel;
   log::LogReader reader(a.log, read_opt);
   // --calib: the calibrated matrices M replace R in eq. (1)-(2) (docs/calibration.md)

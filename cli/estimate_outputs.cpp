@@ -185,6 +185,10 @@ void write_estimate_summary(const fs::path& path, const SummaryContext& ctx, con
       s.counters.updates, s.counters.rejected, s.counters.standstills_too_short, s.counters.schedule_mismatches);
   add("  \"final_bias_dps\": {},\n", json_vec(s.bias_dps));
   add("  \"final_sigma_dps\": {},\n", json_vec(s.sigma_dps));
+  add("  \"temperature_states\": {{\"enabled\": {}, \"reference_degc\": [{}, {}], \"coef_dps_per_degc\": {}, "
+      "\"sigma_dps_per_degc\": {}}},\n",
+      s.temp_states ? "true" : "false", json_number(s.temp_ref_c[0]), json_number(s.temp_ref_c[1]),
+      json_vec(s.temp_coef_dps_per_degc), json_vec(s.temp_coef_sigma_dps_per_degc));
   add("  \"attitude_start_s\": {},\n", json_number(s.attitude_start_s));
   add("  \"attitude_drift_deg_per_h\": {{\"with_driftless\": {}, \"bias_fixed_at_start\": {}, "
       "\"without_driftless\": {}}},\n",

@@ -131,7 +131,7 @@ std::vector<Candidate> adc_candidates(const Replay& r, const Residual& res, cons
   sat.effect = Effect::kSaturation;
   miss.effect = Effect::kAdcMissingCodes;
   double qev = 0, sev = 0, mev = 0;
-  for (int c = 0; c < 6; ++c) {
+  for (int c = 0; c < res.channels(); ++c) {
     const int s = c / 3, j = c % 3;
     const twin::SensorParams& p = model.sensor[s];
     std::vector<double> y;

@@ -259,6 +259,13 @@ Channels build_channels(const ColumnInputs& in, const Residual& res) {
     C.s = c / 3;
     C.j = c % 3;
     const twin::SensorParams& p = in.params[C.s];
+    if (c >= res.channels()) {  // an absent channel: no columns, no data, no objective
+      C.present = false;
+      C.z.assign(res.blocks, 0.0);
+      C.block_cols.resize(static_cast<Eigen::Index>(res.blocks), 0);
+      C.gram = Eigen::MatrixXd::Zero(1, 1);
+      return;
+    }
     C.z = block_series_of(res, res.e_dps[c]);
     fill_columns(in, res, C);
     // noise model: the model's bias processes; the white density is a nuisance, fitted
@@ -283,8 +290,9 @@ double refit_white(ChannelData& c, const BlockSeries& blocks, std::span<const do
 
 double log_blocks(const Channels& ch) {
   double m = 0.0;
-  for (const auto& c : ch) m += static_cast<double>(c.m);
-  return std::log(std::max(2.0, m / 6.0));
+  int present = 0;
+  for (const auto& c : ch) m += static_cast<double>(c.m), present += c.present;
+  return std::log(std::max(2.0, m / std::max(1, present)));
 }
 
 FitResult map_fit(const Channels& ch, const FitSpec& spec) {

@@ -20,6 +20,7 @@ namespace driftless::diagnose {
 /// The regression data of one gyro channel.
 struct ChannelData {
   int s = 0, j = 0;               // sensor, axis
+  bool present = true;            // false: sensor 2 of a single-sensor log (no data, no columns)
   std::vector<int> cols;          // regressor columns the log excites
   std::vector<double> prior;      // prior sigma per entry of cols (0 = not a nuisance)
   Eigen::MatrixXf block_cols;     // block means of the columns (blocks x cols), unwhitened

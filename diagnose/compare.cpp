@@ -28,6 +28,7 @@ CompareResult header(const Replay& r, const CompareModel& model, const CompareOp
   out.resampled = r.resampled;
   out.samples = r.size();
   out.sample_rate_hz = r.sample_rate_hz;
+  out.sensors = r.sensors;
   out.duration_s = r.t_s.back() - r.t_s.front();
   out.threshold = opt.evidence_threshold;
   return out;
@@ -65,7 +66,8 @@ bool adopt_drift(const NoiseModelFindings& nm, const Residual& res, Channels& ch
     }
   }
   if (!changed) return false;
-  for (ChannelData& C : ch) rebuild_gram(C, res.block_series);
+  for (ChannelData& C : ch)
+    if (C.present) rebuild_gram(C, res.block_series);
   return true;
 }
 

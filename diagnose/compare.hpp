@@ -139,6 +139,7 @@ struct CompareResult {
   std::vector<std::string> notes;         // assumptions (replay, resampling, model)
   std::string model_source, log_path;
   double duration_s = 0.0, sample_rate_hz = 0.0, block_s = 0.0;
+  int sensors = 2;  // 1: a single-sensor log (channels gyro2_* are null in the outputs)
   std::size_t samples = 0, samples_used = 0, blocks_used = 0;
   bool resampled = false;
   // series for plots: block times; per channel the block residual after the selected effects and

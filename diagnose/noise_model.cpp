@@ -203,9 +203,11 @@ NoiseModelFindings noise_model_candidates(const Replay& r, const Residual& res, 
   const double log_m = log_blocks(ch);
   const double duration = r.t_s.back() - r.t_s.front();
   const SlowBlocks sb = slow_blocks(res);
-  std::vector<PerChannel> white(6), gm(6), rrw(6), bias(6), jit;
+  const int nc = res.channels();  // a single-sensor log: sensor 1's three channels
+  const auto ncs = static_cast<std::size_t>(nc);
+  std::vector<PerChannel> white(ncs), gm(ncs), rrw(ncs), bias(ncs), jit;
   std::array<double, 6> floors{};
-  for_each_index(6, [&](int c) {
+  for_each_index(nc, [&](int c) {
     const auto i = static_cast<std::size_t>(c);
     const ChannelData& C = ch[i];
     floors[i] = white_noise_floor_dps(model.sensor[C.s], C.j, res.fs_hz);
@@ -216,7 +218,7 @@ NoiseModelFindings noise_model_candidates(const Replay& r, const Residual& res, 
     rrw[i] = slow[1];
     bias[i] = constant_bias(C, c, model, after, res, duration, log_m);
   });
-  for (int s = 0; s < 2; ++s) jit.push_back(jitter(r, res, floors, model, after, s, log_m));
+  for (int s = 0; s < res.sensors; ++s) jit.push_back(jitter(r, res, floors, model, after, s, log_m));
   NoiseModelFindings out;
   for (Candidate c : {gather(Effect::kWhiteNoise, white, 1, threshold), gather(Effect::kBiasInstability, gm, 2, threshold),
                       gather(Effect::kRateRandomWalk, rrw, 1, threshold), gather(Effect::kConstantBias, bias, 1, threshold),

@@ -22,16 +22,19 @@ void add_regime(const Replay& r, const AfterFit& a, const std::string& group, co
   rs.group = group;
   rs.name = name;
   std::array<double, 6> s1{}, s2{};
+  const int nc = 3 * r.sensors;  // channels with data
   for (std::size_t k = 0; k < r.size(); ++k) {
     if (!r.usable[k] || !sel(k)) continue;
     bool ok = true;
-    for (int c = 0; c < 6; ++c) ok = ok && std::isfinite(a.e[c][k]);
+    for (int c = 0; c < nc; ++c) ok = ok && std::isfinite(a.e[c][k]);
     if (!ok) continue;
     ++rs.samples;
-    for (int c = 0; c < 6; ++c) s1[c] += a.e[c][k], s2[c] += static_cast<double>(a.e[c][k]) * a.e[c][k];
+    for (int c = 0; c < nc; ++c) s1[c] += a.e[c][k], s2[c] += static_cast<double>(a.e[c][k]) * a.e[c][k];
   }
   if (rs.samples == 0) return;
-  for (int c = 0; c < 6; ++c) {
+  rs.mean_dps.fill(kNaN);
+  rs.rms_dps.fill(kNaN);
+  for (int c = 0; c < nc; ++c) {
     rs.mean_dps[c] = s1[c] / static_cast<double>(rs.samples);
     rs.rms_dps[c] = std::sqrt(s2[c] / static_cast<double>(rs.samples));
   }
@@ -99,14 +102,15 @@ void windows(const Replay& r, const Residual& res, const AfterFit& a, const Comp
     for (; k < res.n && r.t_s[k] < w.t0_s + ws; ++k) {
       if (!res.mask[k]) continue;
       bool ok = true;
-      for (int c = 0; c < 6; ++c) ok = ok && std::isfinite(a.e[c][k]);
+      for (int c = 0; c < res.channels(); ++c) ok = ok && std::isfinite(a.e[c][k]);
       if (!ok) continue;
-      for (int c = 0; c < 6; ++c) s2[c] += static_cast<double>(a.e[c][k]) * a.e[c][k];
+      for (int c = 0; c < res.channels(); ++c) s2[c] += static_cast<double>(a.e[c][k]) * a.e[c][k];
       ++cnt;
     }
     w.t1_s = k < res.n ? r.t_s[k] : r.t_s.back();
     if (cnt < 10) continue;
-    for (int c = 0; c < 6; ++c) {
+    w.rms_dps.fill(kNaN);
+    for (int c = 0; c < res.channels(); ++c) {
       w.rms_dps[c] = std::sqrt(s2[c] / static_cast<double>(cnt));
       const double ratio = w.rms_dps[c] / std::max(1e-9, out.channels[c].noise_floor_dps);
       if (ratio > w.worst_ratio) w.worst_ratio = ratio, w.worst_channel = c;
@@ -131,12 +135,12 @@ void correlations(const Replay& r, const Residual& res, const Channels& ch, cons
     sigs.emplace_back(fmt::format("specific force {}", axis_letter(ax)), [&, ax](std::size_t k) { return r.f_body_mps2[k][ax]; });
   }
   sigs.emplace_back("time", [&](std::size_t k) { return r.t_s[k]; });
-  for (int s = 0; s < 2; ++s) {
+  for (int s = 0; s < res.sensors; ++s) {
     sigs.emplace_back(fmt::format("temperature {}", s + 1), [&, s](std::size_t k) { return res.pred[s].temp_c[k]; });
     sigs.emplace_back(fmt::format("time since flip {}", s + 1), [&, s](std::size_t k) { return std::min(10.0f, r.since_flip_s[s][k]); });
   }
   std::array<std::vector<double>, 6> rw;
-  for (int c = 0; c < 6; ++c) {
+  for (int c = 0; c < res.channels(); ++c) {
     std::vector<double> z = a.z[c];
     for (double& v : z) v = std::isfinite(v) ? v : 0.0;
     rw[c].resize(res.blocks);
@@ -146,7 +150,7 @@ void correlations(const Replay& r, const Residual& res, const Channels& ch, cons
   for (const auto& [name, f] : sigs) {
     for (std::size_t k = 0; k < res.n; ++k) tmp[k] = res.bmask[k] ? f(k) : 0.0;
     const std::vector<double> sb = block_series_of(res, tmp);
-    for (int c = 0; c < 6; ++c) {
+    for (int c = 0; c < res.channels(); ++c) {
       const BiasWhitener W(res.block_series, ch[c].noise);
       W.whiten(sb, sw);
       double sxy = 0, sxx = 0, syy = 0;

@@ -150,6 +150,24 @@ void read_header(const log::Metadata& meta, std::uint32_t fields, Replay& out) {
   out.encoder_readback = meta.get("platform_readback").value_or("") == "encoder";
   out.hinge_axis[0] = meta.hinge1_axis().normalized();
   out.hinge_axis[1] = meta.hinge2_axis().normalized();
+  out.sensors = (fields & kLayoutSingleSensor) != 0 ? 1 : 2;
+}
+
+// the single-sensor form: one IMU fixed to the body (or on platform 1) against motion capture.
+// Without ref_q there is nothing to compare it with (a static body's Earth rate alone cannot
+// tell a scale or cross-axis error from the turn-on bias). There is no second platform: it is
+// held at 0 deg (no flips) so that only sensor 1's samples decide what is usable
+void single_sensor(std::vector<Raw>& raw, Replay& out) {
+  if (out.sensors != 1) return;
+  if (!out.has_ref_q) {
+    throw std::runtime_error(fmt::format(
+        "{}: a single-sensor log ('sensors: 1') without ref_q (ref_qw, ref_qx, ref_qy, ref_qz); compare and diagnose "
+        "need the body's reference attitude to predict one IMU (join motion capture or a trajectory with "
+        "'driftless convert --ref'; docs/log-format.md)", out.log_path));
+  }
+  for (Raw& r : raw) r.plat[1] = 0.0;
+  out.notes.push_back("a single-sensor log: one IMU against the reference attitude (ref_q); the sensor-2 channels, "
+                      "platform flips and end stops take no part");
 }
 
 // the sample rate: metadata, else the median interval; resampled when asked
@@ -382,7 +400,7 @@ void sensor_truth(const std::vector<Raw>& raw, const Eigen::Vector3d& dearth_dla
       out.w_radps[s][k] = Rt * out.w_body_radps[k] + (std::isfinite(rate) ? rate : 0.0) * kRadPerDeg * axis;
       out.f_mps2[s][k] = out.has_accel && raw[k].a[s].allFinite() ? raw[k].a[s] : Eigen::Vector3d(Rt * out.f_body_mps2[k]);
       out.dw_dlat_radps[s][k] = Rt * (quat(raw[k]).conjugate() * dearth_dlat_enu);
-      if (!raw[k].g[s].allFinite()) out.usable[k] = 0;
+      if (s < out.sensors && !raw[k].g[s].allFinite()) out.usable[k] = 0;
     }
     for (std::size_t k = 0; k < n; ++k) {
       const std::size_t a = k == 0 ? 0 : k - 1, b = k + 1 < n ? k + 1 : n - 1;
@@ -402,6 +420,7 @@ Replay build(std::vector<Raw> raw, const log::Metadata& meta, std::uint32_t fiel
     throw std::runtime_error(fmt::format("{}: only {} samples; compare needs at least 10", where, raw.size()));
   }
   read_header(meta, fields, out);
+  single_sensor(raw, out);
   set_rate(raw, opt, out);
   double lat = meta.latitude_deg();
   if (!std::isfinite(lat)) {
@@ -448,7 +467,10 @@ Replay replay_samples(const std::vector<Sample>& samples, const log::Metadata& m
 }
 
 Replay replay_log(const std::filesystem::path& path, const ReplayOptions& opt) {
-  log::LogReader reader(path);
+  log::ReaderOptions ro;
+  ro.accept_single_sensor = true;
+  ro.fields = kFieldAccel | kFieldTemp | kFieldRefQ | kFieldRefP;  // the truth columns are never read here
+  log::LogReader reader(path, ro);
   std::vector<Raw> raw;
   Sample s;
   while (reader.next(s)) raw.push_back(to_raw(s));

@@ -63,14 +63,18 @@ struct Replay {
   bool resampled = false;
   bool encoder_readback = false;  // metadata platform_readback: encoder (angles are true angles)
   bool has_ref_q = false, has_ref_p = false, has_accel = false, has_temp = false;
+  // 1: the single-sensor form (one IMU on a rigid body against ref_q; docs/log-format.md):
+  // sensor 2's series are NaN and its channels take no part in the fits
+  int sensors = 2;
   log::Metadata meta;
   std::string log_path;
   std::size_t rows_missing_gyro = 0;
   std::vector<std::string> notes;  // assumptions and conversions, said in the report
 };
 
-/// Replays a log file. Throws std::runtime_error with an actionable message when the log
-/// cannot be replayed (moving box without ref_q, a ref_q that is not a rotation, ...).
+/// Replays a log file, the single-sensor form included (it needs ref_q). Throws
+/// std::runtime_error with an actionable message when the log cannot be replayed (moving box
+/// without ref_q, a single-sensor log without ref_q, a ref_q that is not a rotation, ...).
 Replay replay_log(const std::filesystem::path& path, const ReplayOptions& opt);
 
 /// Replays samples already in memory (tests, bridges); `where` names the source in messages.

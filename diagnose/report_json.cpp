@@ -131,7 +131,7 @@ std::string diagnosis_json(const CompareResult& r, const ReportExtras& x) {
   o << "  \"log\": " << q(r.log_path) << ",\n  \"model\": " << q(r.model_source) << ",\n";
   o << "  \"verdict\": " << q(verdict_id(r.verdict)) << ",\n  \"statement\": " << q(r.statement) << ",\n";
   o << "  \"evidence_threshold\": " << n(r.threshold) << ", \"samples\": " << r.samples << ", \"samples_used\": " << r.samples_used
-    << ", \"duration_s\": " << n(r.duration_s) << ", \"sample_rate_hz\": " << n(r.sample_rate_hz) << ", \"block_s\": " << n(r.block_s)
+    << ", \"duration_s\": " << n(r.duration_s) << ", \"sample_rate_hz\": " << n(r.sample_rate_hz) << ", \"sensors\": " << r.sensors << ", \"block_s\": " << n(r.block_s)
     << ", \"resampled\": " << (r.resampled ? "true" : "false") << ",\n  \"notes\": ";
   strings_json(o, r.notes);
   o << ",\n";

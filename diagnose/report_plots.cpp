@@ -21,75 +21,74 @@ using report_text::gnuplot_png;
 std::string n(double v) { return report::json_number(v); }
 
 // a long log has more blocks than the plot has pixels (1 h at 0.1 s: 36 000 per channel, and
-// gnuplot took over a second on them): above kPlotBuckets * 2 blocks each bucket of blocks is
-// drawn as two rows, its smallest and largest residual per channel (the envelope the eye sees)
-// with the bucket's mean smoothed bias
+// gnuplot took over a second on them): above kPlotBuckets * 2 blocks the residual is drawn as a
+// band per channel, from the smallest to the largest block mean of each of kPlotBuckets time
+// bins (the cloud the points would make), with the bin's mean smoothed bias
 constexpr std::size_t kPlotBuckets = 1500;
 
 struct PlotRow {
   double t_s;
-  std::array<double, 6> residual_dps, bias_dps;
+  std::array<double, 6> lo_dps, hi_dps, bias_dps;  // lo = hi = the block mean when not binned
 };
 
-std::vector<PlotRow> residual_rows(const CompareResult& r) {
-  const std::size_t m = r.block_t_s.size();
-  std::vector<PlotRow> rows;
-  if (m <= 2 * kPlotBuckets) {
-    for (std::size_t b = 0; b < m; ++b) {
-      PlotRow row{r.block_t_s[b], {}, {}};
-      for (int c = 0; c < 6; ++c) row.residual_dps[c] = r.block_residual_dps[c][b], row.bias_dps[c] = r.block_bias_dps[c][b];
-      rows.push_back(row);
-    }
-    return rows;
-  }
+PlotRow bin_row(const CompareResult& r, std::size_t a, std::size_t e) {
   constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-  for (std::size_t k = 0; k < kPlotBuckets; ++k) {
-    const std::size_t a = k * m / kPlotBuckets, e = (k + 1) * m / kPlotBuckets;
-    PlotRow lo{r.block_t_s[(a + e - 1) / 2], {}, {}};
-    PlotRow hi = lo;
-    for (int c = 0; c < 6; ++c) {
-      double mn = kNaN, mx = kNaN, bias = 0.0;
-      for (std::size_t b = a; b < e; ++b) {
-        const double v = r.block_residual_dps[c][b];
-        bias += r.block_bias_dps[c][b];
-        if (!std::isfinite(v)) continue;
-        mn = std::isfinite(mn) ? std::min(mn, v) : v;
-        mx = std::isfinite(mx) ? std::max(mx, v) : v;
-      }
-      lo.residual_dps[c] = mn, hi.residual_dps[c] = mx;
-      lo.bias_dps[c] = hi.bias_dps[c] = bias / static_cast<double>(e - a);
+  PlotRow row{r.block_t_s[(a + e - 1) / 2], {}, {}, {}};
+  for (int c = 0; c < 6; ++c) {
+    double mn = kNaN, mx = kNaN, bias = 0.0;
+    for (std::size_t b = a; b < e; ++b) {
+      const double v = r.block_residual_dps[c][b];
+      bias += r.block_bias_dps[c][b];
+      if (!std::isfinite(v)) continue;
+      mn = std::isfinite(mn) ? std::min(mn, v) : v;
+      mx = std::isfinite(mx) ? std::max(mx, v) : v;
     }
-    rows.push_back(lo);
-    rows.push_back(hi);
+    row.lo_dps[c] = mn, row.hi_dps[c] = mx, row.bias_dps[c] = bias / static_cast<double>(e - a);
   }
+  return row;
+}
+
+// rows of the residual plot; true in `binned` when they are bins (a band), false for blocks
+std::vector<PlotRow> residual_rows(const CompareResult& r, bool* binned) {
+  const std::size_t m = r.block_t_s.size();
+  *binned = m > 2 * kPlotBuckets;
+  const std::size_t bins = *binned ? kPlotBuckets : m;
+  std::vector<PlotRow> rows;
+  for (std::size_t k = 0; k < bins; ++k) rows.push_back(bin_row(r, k * m / bins, (k + 1) * m / bins));
   return rows;
 }
 
-// residual after the selected effects and the smoothed bias (points), per sensor; the smoothed
-// bias itself below (it is a nuisance, drawn so its size is visible)
+// residual after the selected effects and the smoothed bias (points, or bands on a long log),
+// per sensor; the smoothed bias itself below (it is a nuisance, drawn so its size is visible)
 Plot residual_plot(const CompareResult& r, const std::filesystem::path& dir) {
   const auto dat = dir / "residual.dat";
+  bool binned = false;
   {
     std::ostringstream d;
-    for (const PlotRow& row : residual_rows(r)) {
+    for (const PlotRow& row : residual_rows(r, &binned)) {
       d << fmt::format("{:.3f}", row.t_s);
-      for (int c = 0; c < 6; ++c) d << ' ' << n(row.residual_dps[c]) << ' ' << n(row.bias_dps[c]);
+      for (int c = 0; c < 6; ++c) d << ' ' << n(row.lo_dps[c]) << ' ' << n(row.hi_dps[c]) << ' ' << n(row.bias_dps[c]);
       d << '\n';
     }
     io::write_file(dat, d.str());  // before gnuplot reads it
   }
-  std::string s = "set termoption noenhanced\nset multiplot layout 3,1\nset xlabel 't (s)'\nset key outside right\n"
-                  "set datafile missing 'null'\n";
-  for (int sn = 0; sn < 2; ++sn) {
+  // a single-sensor log draws sensor 1 only (sensor 2's columns are null)
+  const std::string file = dat.filename().string();
+  std::string s = fmt::format("set termoption noenhanced\nset multiplot layout {},1\nset xlabel 't (s)'\nset key outside right\n"
+                              "set datafile missing 'null'\nset style fill transparent solid 0.35 noborder\n", r.sensors + 1);
+  for (int sn = 0; sn < r.sensors; ++sn) {
     s += fmt::format("set ylabel 'deg/s'\nset title 'sensor {}: block-mean residual after the selected effects and the "
-                     "smoothed bias'\nplot ", sn + 1);
+                     "smoothed bias{}'\nplot ", sn + 1, binned ? fmt::format(" (band: its range in each of {} time bins)", kPlotBuckets) : "");
     for (int a = 0; a < 3; ++a) {
-      const int c = sn * 3 + a;
-      s += fmt::format("'{}' u 1:{} w p pt 7 ps 0.25 t '{}'{}", dat.filename().string(), 2 + 2 * c, channel_name(c), a < 2 ? ", " : "\n");
+      const int c = sn * 3 + a, col = 2 + 3 * c;
+      s += binned ? fmt::format("'{}' u 1:{}:{} w filledcurves lc {} t '{}'", file, col, col + 1, a + 1, channel_name(c))
+                  : fmt::format("'{}' u 1:{} w p pt 7 ps 0.25 lc {} t '{}'", file, col, a + 1, channel_name(c));
+      s += a < 2 ? ", " : "\n";
     }
   }
   s += "set title 'smoothed bias (nuisance: turn-on bias and drift)'\nplot ";
-  for (int c = 0; c < 6; ++c) s += fmt::format("'{}' u 1:{} w l t '{}'{}", dat.filename().string(), 3 + 2 * c, channel_name(c), c < 5 ? ", " : "\n");
+  const int nc = 3 * r.sensors;
+  for (int c = 0; c < nc; ++c) s += fmt::format("'{}' u 1:{} w l t '{}'{}", file, 4 + 3 * c, channel_name(c), c < nc - 1 ? ", " : "\n");
   s += "unset multiplot\n";
   return {"Residual over time", gnuplot_png(dir, "residual", s, 900, 720)};
 }
@@ -107,9 +106,10 @@ Plot windows_plot(const CompareResult& r, const std::filesystem::path& dir) {
   }
   std::string s = "set termoption noenhanced\nset xlabel 't (s)'\nset ylabel 'rms (deg/s)'\nset yrange [0:*]\nset key outside right\n"
                   "set title 'windowed residual rms after the selected effects (dashed: the model noise floor)'\nplot ";
-  for (int c = 0; c < 6; ++c) {
+  const int nc = 3 * r.sensors;
+  for (int c = 0; c < nc; ++c) {
     s += fmt::format("'{0}' u 1:{1} w lp lc {3} t '{2}', '' u 1:{4} w l dt 2 lc {3} notitle{5}", dat.filename().string(), 2 + 2 * c,
-                     channel_name(c), c + 1, 3 + 2 * c, c < 5 ? ", " : "\n");
+                     channel_name(c), c + 1, 3 + 2 * c, c < nc - 1 ? ", " : "\n");
   }
   return {"Windowed residual RMS", gnuplot_png(dir, "windows", s)};
 }
@@ -137,9 +137,10 @@ Plot allan_plot(const CompareResult& r, const std::filesystem::path& dir) {
     }
     io::write_file(dat, d.str());  // before gnuplot reads it
   }
-  std::string s = "set termoption noenhanced\nset multiplot layout 1,2\nset logscale xy\nset xlabel 'tau (s)'\nset ylabel 'ADEV (deg/s)'\n"
-                  "set key bottom left\nset datafile missing 'null'\nset style fill transparent solid 0.2 noborder\n";
-  for (int sn = 0; sn < 2; ++sn) {
+  std::string s = fmt::format("set termoption noenhanced\nset multiplot layout 1,{}\nset logscale xy\nset xlabel 'tau (s)'\n"
+                              "set ylabel 'ADEV (deg/s)'\nset key bottom left\nset datafile missing 'null'\n"
+                              "set style fill transparent solid 0.2 noborder\n", r.sensors);
+  for (int sn = 0; sn < r.sensors; ++sn) {
     s += fmt::format("set title 'sensor {}: residual (95 % CI) and model (95 % band)'\nplot ", sn + 1);
     for (int a = 0; a < 3; ++a) {
       const int c = sn * 3 + a, o = 7 * c;
@@ -169,7 +170,8 @@ Plot regimes_plot(const CompareResult& r, const std::filesystem::path& dir) {
                   "set style fill solid 0.8\n"
                   "set yrange [0:*]\nset xtics rotate by -30\nset ylabel 'rms (deg/s)'\nset key outside right\n"
                   "set title 'residual rms by regime, after the selected effects (during flips: table only, no truth there)'\nplot ";
-  for (int c = 0; c < 6; ++c) s += fmt::format("'{}' u {}:xtic(1) t '{}'{}", dat.filename().string(), 2 + c, channel_name(c), c < 5 ? ", " : "\n");
+  const int nc = 3 * r.sensors;
+  for (int c = 0; c < nc; ++c) s += fmt::format("'{}' u {}:xtic(1) t '{}'{}", dat.filename().string(), 2 + c, channel_name(c), c < nc - 1 ? ", " : "\n");
   return {"Residual by regime", gnuplot_png(dir, "regimes", s, 900, 480)};
 }
 

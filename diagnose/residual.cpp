@@ -83,6 +83,7 @@ Residual make_residual(const Replay& r, const CompareModel& model, double block_
   Residual res;
   res.n = r.size();
   res.fs_hz = r.sample_rate_hz;
+  res.sensors = r.sensors;
   // platforms resting on stops: the model's stop errors plus the servo's press into the stop
   // (the MuJoCo box settled on them); logs with an encoder read the true angle instead
   const Eigen::Matrix2d settled = r.encoder_readback ? Eigen::Matrix2d::Zero() : settled_stop_offsets_deg(model.box);
@@ -99,7 +100,7 @@ Residual make_residual(const Replay& r, const CompareModel& model, double block_
       res.e_dps[c][k] = r.usable[k] ? r.gyro_dps[s][k][j] - res.pred[s].gyro_dps[k][j] : kNaN;
     }
   }
-  for (int s = 0; s < 2; ++s) {
+  for (int s = 0; s < res.sensors; ++s) {
     const std::size_t cnt = mask_hinge_bursts(r, s, res);
     if (cnt == 0) continue;
     res.notes.push_back(fmt::format(
@@ -114,7 +115,7 @@ Residual make_residual(const Replay& r, const CompareModel& model, double block_
   }
   lay_out_blocks(r, block_s, res);
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-  for (int s = 0; s < 2; ++s) {
+  for (int s = 0; s < res.sensors; ++s) {
     for (std::size_t k = 0; k < res.n; k += 10) {
       lo = std::min(lo, res.pred[s].temp_c[k]);
       hi = std::max(hi, res.pred[s].temp_c[k]);

@@ -26,6 +26,9 @@ struct Residual {
   std::vector<std::uint8_t> bmask;  // ... and its block has enough data
   BlockSeries block_series;         // block times and sample counts (0 = block left out)
   double temp_span_c = 0.0;         // spread of the temperature over the log, degC
+  int sensors = 2;                  // 1: a single-sensor log; channels 3..5 (sensor 2) are absent
+  /// The channels with data: 0..2, or 0..5.
+  int channels() const { return 3 * sensors; }
   std::size_t samples_used = 0;
   std::vector<std::string> notes;   // what was left out and why
 };

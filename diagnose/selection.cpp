@@ -46,6 +46,7 @@ bool lowpass_taken(const Terms& S, const ParamRef& x) {
 // every parameter the log excites: per channel, per sensor, box-wide
 std::vector<ParamRef> make_universe(const Channels& ch) {
   std::vector<ParamRef> u;
+  const bool single = !ch[3].present;  // a single-sensor log
   auto add = [&](Param p, int s, int row, int col) {
     const ParamRef ref{p, static_cast<std::int8_t>(s), static_cast<std::int8_t>(row), static_cast<std::int8_t>(col)};
     for (const ColumnUse& cu : columns_of(ref)) {
@@ -69,9 +70,11 @@ std::vector<ParamRef> make_universe(const Channels& ch) {
     for (int k = 0; k < 3; ++k) add(Param::kMountingDeg, s, k, -1);
     for (int side = 0; side < 2; ++side) add(Param::kStopErrorDeg, s, -1, side);
     add(Param::kLowpassDelayS, s, -1, -1);
-    add(Param::kSampleDelayS, s, -1, -1);
+    if (!single) add(Param::kSampleDelayS, s, -1, -1);
   }
-  add(Param::kLowpassDelayS, -1, -1, -1);  // both sensors' filter at once (one chip configuration)
+  // both sensors' filter at once (one chip configuration); with one sensor it is sensor 1's, and
+  // that sensor's sample delay is the box time offset: the same signals, one is tested
+  if (!single) add(Param::kLowpassDelayS, -1, -1, -1);
   add(Param::kLatitudeErrorDeg, -1, -1, -1);
   add(Param::kTimeOffsetS, -1, -1, -1);
   return u;
@@ -365,7 +368,7 @@ bool Selector::refit_noise(const Terms& S) {
   FitResult fit;
   const FitSpec spec = solve(S, &fit);
   std::array<double, 6> change{};
-  for_each_index(6, [&](int c) {
+  for_each_index(in_.res.channels(), [&](int c) {
     const Eigen::VectorXd coef = channel_coefficients(in_.ch[c], c, spec, fit);
     const std::vector<double> z = block_residual(in_.ch[c], coef);
     change[static_cast<std::size_t>(c)] = refit_white(in_.ch[c], in_.res.block_series, z);

@@ -122,6 +122,12 @@ AfterFit residual_after(const Channels& ch, const ColumnInputs& in, const Residu
   const std::size_t L = res.block_len;
   for (int c = 0; c < 6; ++c) {
     const ChannelData& C = ch[c];
+    if (!C.present) {  // sensor 2 of a single-sensor log: NaN throughout
+      a.z[c].assign(res.blocks, kNaN);
+      a.bias[c].assign(res.blocks, kNaN);
+      if (per_sample) a.e_drift[c].assign(res.n, std::numeric_limits<float>::quiet_NaN()), a.e[c] = a.e_drift[c];
+      continue;
+    }
     const Eigen::VectorXd coef = channel_coefficients(C, c, spec, fit);
     a.z[c] = block_residual(C, coef);
     a.bias[c] = BiasWhitener(res.block_series, C.noise).smooth(a.z[c]);
@@ -153,7 +159,7 @@ AfterFit residual_after(const Channels& ch, const ColumnInputs& in, const Residu
 void summarise_channels(const Channels& ch, const Residual& res, const CompareModel& model,
                         const CompareModel& selected_model, const AfterFit& before, const AfterFit& after,
                         const CompareOptions& opt, CompareResult& out) {
-  for (int c = 0; c < 6; ++c) {
+  for (int c = 0; c < res.channels(); ++c) {
     const ChannelData& C = ch[c];
     ChannelSummary& cs = out.channels[c];
     const twin::SensorParams& p = model.sensor[C.s];
@@ -175,6 +181,13 @@ void summarise_channels(const Channels& ch, const Residual& res, const CompareMo
       if (res.block_series.count[b]) bsum += after.bias[c][b], ++bn;
     cs.turn_on_bias_dps = bn ? bsum / static_cast<double>(bn) : 0.0;
     allan_against_model(res, p_sel, C.j, white_noise_floor_dps(p_sel, C.j, res.fs_hz), after, c, cs);
+  }
+  for (int c = res.channels(); c < 6; ++c) {  // sensor 2 of a single-sensor log: null in the report
+    ChannelSummary& cs = out.channels[c];
+    for (double* v : {&cs.raw_mean_dps, &cs.raw_rms_dps, &cs.mean_dps, &cs.rms_dps, &cs.rms_after_dps, &cs.noise_floor_dps,
+                      &cs.systematic_rms_dps, &cs.systematic_after_dps, &cs.white_fit_dps_rthz, &cs.ljung_box_q,
+                      &cs.ljung_box_p, &cs.autocorrelation_excess, &cs.turn_on_bias_dps, &cs.turn_on_sigma_dps})
+      *v = kNaN;
   }
 }
 

@@ -62,6 +62,7 @@ const fields::Table<C>& config_table() {
       fields::number<C>("r_override_dps2", "", &C::r_override_dps2),
       fields::number<C>("settle", "s", &C::settle_s),
       fields::number<C>("standstill_period", "s", &C::standstill_period_s),
+      fields::number<C>("temp_coef_sigma", "dps_per_degc", &C::temp_coef_sigma_dps_per_degc),
       fields::number<C>("variance_floor_dps2", "", &C::variance_floor_dps2),
       fields::number<C>("calibration_match_tolerance", "deg",
                         [](auto& c) -> auto& { return c.calibration.match_tolerance_deg; }),

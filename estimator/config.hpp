@@ -76,6 +76,10 @@ struct EstimatorConfig {
   double bias_instability_tau_s = 100.0;   // s, where the Allan minimum lies (paper: ~100 s)
   double q_override_dps2_per_s = 0.0;      // (deg/s)^2/s, > 0 replaces the spec-derived Q rate
   double r_override_dps2 = 0.0;            // (deg/s)^2 per sample and axis, > 0 replaces R
+  // the bias moves with the chip's temperature (temp1, temp2 columns): b_i += k_i dT_i, with
+  // k_i three states per sensor (deg/s per degC) of this prior sigma; 0 = no temperature states.
+  // MPU6050: ZRO variation +-20 deg/s over -40..85 degC taken as 3 sigma
+  double temp_coef_sigma_dps_per_degc = 20.0 / 125.0 / 3.0;
   double initial_bias_dps = 0.0;           // deg/s, every component of x0
   double initial_sigma_dps = 20.0;         // deg/s, sqrt of P0's diagonal (MPU6050 turn-on +-20)
   double variance_floor_dps2 = 1e-14;      // (deg/s)^2, P's diagonal never drops below this

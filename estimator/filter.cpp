@@ -76,6 +76,7 @@ void EstimatorConfig::validate() const {
   positive(bias_instability_tau_s, "bias_instability_tau_s", "s");
   non_negative(q_override_dps2_per_s, "q_override_dps2_per_s", "(deg/s)^2/s (0 = from spec)");
   non_negative(r_override_dps2, "r_override_dps2", "(deg/s)^2 (0 = from noise density)");
+  non_negative(temp_coef_sigma_dps_per_degc, "temp_coef_sigma_dps_per_degc", "deg/s per degC (0 = no temperature states)");
   if (!finite(initial_bias_dps)) throw std::invalid_argument("estimator config: initial_bias_dps must be a number");
   positive(initial_sigma_dps, "initial_sigma_dps", "deg/s");
   positive(variance_floor_dps2, "variance_floor_dps2", "(deg/s)^2");
@@ -112,6 +113,7 @@ EstimatorConfig paper_config() {
   EstimatorConfig c;
   c.mode = FilterMode::kPaper;
   c.covariance_update = CovarianceUpdate::kPrinted;
+  c.temp_coef_sigma_dps_per_degc = 0.0;  // the paper's model: bias + noise, eq. (3)
   return c;
 }
 
@@ -134,8 +136,12 @@ const char* to_string(PushStatus s) {
 DriftlessFilter::DriftlessFilter(const EstimatorConfig& cfg, const BoxGeometry& box)
     : cfg_(cfg), box_(box), standstill_((cfg_.validate(), cfg_), (box_.validate(), box_)) {
   q_rate_dps2_per_s_ = cfg_.q_dps2_per_s();
-  x_.setConstant(cfg_.initial_bias_dps);
-  P_ = Matrix6d::Identity() * (cfg_.initial_sigma_dps * cfg_.initial_sigma_dps);
+  x_.setZero();
+  x_.head<kStateDim>().setConstant(cfg_.initial_bias_dps);
+  P_.setZero();
+  P_.diagonal().head<kStateDim>().setConstant(cfg_.initial_sigma_dps * cfg_.initial_sigma_dps);
+  // the temperature coefficients start at 0 with the spec's sigma; off, they stay exactly 0
+  P_.diagonal().tail<6>().setConstant(cfg_.temp_coef_sigma_dps_per_degc * cfg_.temp_coef_sigma_dps_per_degc);
   gate3_ = cfg_.nis_gate_probability < 1.0 ? chi2_quantile(cfg_.nis_gate_probability, 3.0)
                                            : std::numeric_limits<double>::infinity();
   gate6_ = cfg_.nis_gate_probability < 1.0 ? chi2_quantile(cfg_.nis_gate_probability, 6.0)
@@ -178,18 +184,52 @@ Eigen::Matrix3d DriftlessFilter::body_from_sensor(int sensor, double plat_deg) c
 void DriftlessFilter::predict_to(double t_s) {
   // A = I: the bias random walk only grows P (eq. (3)); Q = K^2 dt per axis
   if (finite(t_filter_s_) && t_s > t_filter_s_) {
-    P_.diagonal().array() += q_rate_dps2_per_s_ * (t_s - t_filter_s_);
+    P_.diagonal().head<kStateDim>().array() += q_rate_dps2_per_s_ * (t_s - t_filter_s_);
   }
   t_filter_s_ = t_s;
+}
+
+// the bias follows the temperature: b_i += k_i dT_i, so x <- F x, P <- F P F^T with
+// F = [I D; 0 I], D = diag(dT_1 I3, dT_2 I3) (a sensor whose temperature is unknown keeps its own)
+void DriftlessFilter::predict_temperature(double temp1_c, double temp2_c) {
+  if (!has_temp_states()) return;
+  const std::array<double, 2> temp{temp1_c, temp2_c};
+  Eigen::Matrix<double, 6, 1> d = Eigen::Matrix<double, 6, 1>::Zero();
+  for (std::size_t i = 0; i < 2; ++i) {
+    if (!finite(temp[i])) continue;
+    if (finite(temp_ref_c_[i])) d.segment<3>(3 * static_cast<Eigen::Index>(i)).setConstant(temp[i] - temp_ref_c_[i]);
+    temp_ref_c_[i] = temp[i];
+  }
+  if (d.isZero(0.0)) return;
+  x_.head<kStateDim>() += d.cwiseProduct(x_.tail<6>());
+  // P <- F P F^T, written out per block: with B = bias, K = coefficient block
+  const Matrix6d Pbk = P_.topRightCorner<6, 6>(), Pkk = P_.bottomRightCorner<6, 6>();
+  const auto D = d.asDiagonal();
+  P_.topLeftCorner<6, 6>() += D * Pbk.transpose() + Pbk * D + D * Pkk * D;
+  P_.topRightCorner<6, 6>() = Pbk + D * Pkk;
+  P_.bottomLeftCorner<6, 6>() = P_.topRightCorner<6, 6>().transpose();
+}
+
+Vector6d DriftlessFilter::bias_at(const Sample& s) const {
+  Vector6d b = x_.head<kStateDim>();
+  if (!has_temp_states()) return b;
+  const std::array<double, 2> temp{s.temp1_c, s.temp2_c};
+  for (std::size_t i = 0; i < 2; ++i) {
+    if (!finite(temp[i]) || !finite(temp_ref_c_[i])) continue;
+    const Eigen::Index o = 3 * static_cast<Eigen::Index>(i);
+    b.segment<3>(o) += (temp[i] - temp_ref_c_[i]) * x_.segment<3>(6 + o);
+  }
+  return b;
 }
 
 template <int D>
 bool DriftlessFilter::update(const Eigen::Matrix<double, D, 1>& r, const Eigen::Matrix<double, D, 6>& H,
                              const Eigen::Matrix<double, D, D>& R, UpdateRecord& rec) {
   // P here is P_k + Q_k (predict_to ran); the recursion of section 2, S^-1 through a Cholesky solve
-  const Eigen::Matrix<double, D, D> S = R + H * P_ * H.transpose();
+  const Eigen::Matrix<double, kFullStateDim, D> PHt = P_.template leftCols<kStateDim>() * H.transpose();
+  const Eigen::Matrix<double, D, D> S = R + H * PHt.template topRows<kStateDim>();
   Eigen::LLT<Eigen::Matrix<double, D, D>> llt(S);
-  const Eigen::Matrix<double, D, 1> innov = r - H * x_;
+  const Eigen::Matrix<double, D, 1> innov = r - H * x_.head<kStateDim>();
   rec.dim = D;
   rec.innovation_dps.setZero();
   rec.innovation_dps.head(D) = innov;
@@ -199,6 +239,7 @@ bool DriftlessFilter::update(const Eigen::Matrix<double, D, 1>& r, const Eigen::
     return false;
   }
   rec.nis = innov.dot(llt.solve(innov));
+  // the rows of H touch the bias only: H_a = [H 0], so H_a P H_a^T = H P_bb H^T above
   if (!(rec.nis <= rec.nis_gate)) {
     // an outlier is rejected once or twice; a run of rejections means the state lost lock
     // (a bias step, another sensor after a source switch): widen P by the innovation, re-lock
@@ -207,23 +248,24 @@ bool DriftlessFilter::update(const Eigen::Matrix<double, D, 1>& r, const Eigen::
         !std::isfinite(rec.nis)) {
       return false;
     }
-    P_.diagonal().array() += innov.squaredNorm();
+    P_.diagonal().head<kStateDim>().array() += innov.squaredNorm();
     ++counters_.relocks;
     rec.relocked = true;
     return update<D>(r, H, R, rec);
   }
   consecutive_rejections_ = 0;
   // W = (P + Q) H^T S^-1
-  const Eigen::Matrix<double, 6, D> W = llt.solve(H * P_).transpose();
+  const Eigen::Matrix<double, kFullStateDim, D> W = llt.solve(PHt.transpose()).transpose();
   x_ += W * innov;
-  const Matrix6d IKH = Matrix6d::Identity() - W * H;
+  Matrix12d IKH = Matrix12d::Identity();
+  IKH.template leftCols<kStateDim>() -= W * H;
   if (cfg_.covariance_update == CovarianceUpdate::kJoseph) {
     P_ = IKH * P_ * IKH.transpose() + W * R * W.transpose();
   } else {
     P_ = IKH * P_;  // as printed
   }
   P_ = (0.5 * (P_ + P_.transpose())).eval();  // eval: no aliasing with the transpose
-  for (int i = 0; i < 6; ++i) P_(i, i) = std::max(P_(i, i), cfg_.variance_floor_dps2);
+  for (int i = 0; i < kStateDim; ++i) P_(i, i) = std::max(P_(i, i), cfg_.variance_floor_dps2);
   return true;
 }
 
@@ -231,7 +273,7 @@ void DriftlessFilter::emit_update(const UpdateRecord& in, bool accepted) {
   last_update_ = in;
   last_update_.index = counters_.updates;
   last_update_.accepted = accepted;
-  last_update_.bias_dps = x_;
+  last_update_.bias_dps = bias_dps();
   last_update_.sigma_dps = sigma_dps();
   ++counters_.updates;
   if (!accepted) ++counters_.rejected;
@@ -277,8 +319,11 @@ int DriftlessFilter::use_segment(const StandstillSegment& s) {
   rec.plat1_deg = p1;
   rec.plat2_deg = p2;
   rec.at_end = s.end == SegmentEnd::kFinish;
-  // the average measures the bias at the standstill's midpoint: update there, then carry P on
+  // the average measures the bias at the standstill's midpoint: update there, then carry P on.
+  // Its temperature part is k (mean T - reference T) exactly (linear in T): the state moves to
+  // the standstill's mean temperatures and stays referred to them after the update
   const double t_mid = 0.5 * (s.t_first_s + s.t_last_s);
+  if (s.n_temp > 0) predict_temperature(s.sum_temp1_c / double(s.n_temp), s.sum_temp2_c / double(s.n_temp));
   predict_to(std::max(t_mid, finite(t_filter_s_) ? t_filter_s_ : t_mid));
   int result = 0;
   if (cfg_.mode == FilterMode::kGeneral) {
@@ -306,8 +351,10 @@ int DriftlessFilter::use_segment(const StandstillSegment& s) {
 }
 
 void DriftlessFilter::fuse_rate(const Sample& s, const StandstillStep& st) {
-  out_.y1c_dps = s.gyro1_dps - x_.segment<3>(kBias1.start);
-  out_.y2c_dps = s.gyro2_dps - x_.segment<3>(kBias2.start);
+  // between updates the correction follows the sample's temperature (b + k dT)
+  const Vector6d b = bias_at(s);
+  out_.y1c_dps = s.gyro1_dps - b.segment<3>(kBias1.start);
+  out_.y2c_dps = s.gyro2_dps - b.segment<3>(kBias2.start);
   out_.plat1_deg = st.plat1_deg;
   out_.plat2_deg = st.plat2_deg;
   out_.at_rest = st.plat1_rest && st.plat2_rest && finite(st.plat1_deg) && finite(st.plat2_deg);
@@ -381,7 +428,14 @@ PushStatus DriftlessFilter::push_corrected(const Sample& s) {
     if (r != 0) result = r;
   }
   counters_.standstills_too_short = standstill_.too_short();
-  if (result != 0) out_.status = result > 0 ? PushStatus::kUpdated : PushStatus::kRejected;
+  if (result != 0) {
+    out_.status = result > 0 ? PushStatus::kUpdated : PushStatus::kRejected;
+    // the update referred the bias to the standstill's mean temperatures; refer it to this
+    // sample's, so bias_dps() is the bias now (an exact linear move, no process noise)
+    predict_temperature(s.temp1_c, s.temp2_c);
+    last_update_.bias_dps = bias_dps();
+    last_update_.sigma_dps = sigma_dps();
+  }
 
   // 3. outputs with the estimate now in force
   fuse_rate(s, st);

@@ -20,6 +20,8 @@ namespace driftless::est {
 
 using Vector6d = Eigen::Matrix<double, 6, 1>;
 using Matrix6d = Eigen::Matrix<double, 6, 6>;
+using Vector12d = Eigen::Matrix<double, 12, 1>;
+using Matrix12d = Eigen::Matrix<double, 12, 12>;
 
 /// A named slice of the state vector (like PX4's State::gyro_bias.idx).
 struct StateSlice {
@@ -28,7 +30,13 @@ struct StateSlice {
 };
 inline constexpr StateSlice kBias1{0, 3};  // b1, deg/s, sensor-1 axes
 inline constexpr StateSlice kBias2{3, 3};  // b2, deg/s, sensor-2 axes
-inline constexpr int kStateDim = 6;
+inline constexpr int kStateDim = 6;        // the bias [b1; b2]
+// the bias temperature coefficients k_i, deg/s per degC, sensor-i axes: b_i moves by k_i dT_i
+// when sensor i's temperature changes (docs/estimator.md section 1a); frozen at their prior
+// while no temperature is known or temp_coef_sigma_dps_per_degc is 0
+inline constexpr StateSlice kTempCoef1{6, 3};
+inline constexpr StateSlice kTempCoef2{9, 3};
+inline constexpr int kFullStateDim = 12;
 
 /// What push() did with a sample. It never throws per sample.
 enum class PushStatus {
@@ -115,13 +123,23 @@ class DriftlessFilter {
   /// own state is not touched.
   void set_fixed_bias_dps(const Vector6d& b) { fixed_bias_ = b; }
 
-  /// Bias estimate [b1; b2], deg/s (b_i in sensor-i axes).
-  const Vector6d& bias_dps() const { return x_; }
+  /// Bias estimate [b1; b2], deg/s (b_i in sensor-i axes), at the temperatures of the last
+  /// update (temperature_ref_c()).
+  Vector6d bias_dps() const { return x_.head<kStateDim>(); }
   Eigen::Vector3d bias1_dps() const { return x_.segment<3>(kBias1.start); }
   Eigen::Vector3d bias2_dps() const { return x_.segment<3>(kBias2.start); }
   /// Its covariance, (deg/s)^2.
-  const Matrix6d& covariance_dps2() const { return P_; }
-  Vector6d sigma_dps() const { return P_.diagonal().cwiseSqrt(); }
+  Matrix6d covariance_dps2() const { return P_.topLeftCorner<kStateDim, kStateDim>(); }
+  Vector6d sigma_dps() const { return covariance_dps2().diagonal().cwiseSqrt(); }
+  /// Temperature coefficients [k1; k2], deg/s per degC, their sigma, and whether they are states.
+  Vector6d temp_coef_dps_per_degc() const { return x_.tail<6>(); }
+  Vector6d temp_coef_sigma_dps_per_degc() const { return P_.diagonal().tail<6>().cwiseSqrt(); }
+  bool has_temp_states() const { return cfg_.temp_coef_sigma_dps_per_degc > 0.0; }
+  /// The whole state [b1; b2; k1; k2] and its covariance (units as above).
+  const Vector12d& state() const { return x_; }
+  const Matrix12d& full_covariance() const { return P_; }
+  /// Temperatures (degC) the bias estimate refers to; NaN until the first one is known.
+  const std::array<double, 2>& temperature_ref_c() const { return temp_ref_c_; }
   /// The latest update (has_update() false before the first).
   const UpdateRecord& last_update() const { return last_update_; }
   bool has_update() const { return counters_.updates > 0; }
@@ -139,6 +157,8 @@ class DriftlessFilter {
   PushStatus push_corrected(const Sample& s);
   int use_segment(const StandstillSegment& seg);
   void predict_to(double t_s);
+  void predict_temperature(double temp1_c, double temp2_c);
+  Vector6d bias_at(const Sample& s) const;
   template <int D>
   bool update(const Eigen::Matrix<double, D, 1>& r, const Eigen::Matrix<double, D, 6>& H,
               const Eigen::Matrix<double, D, D>& R, UpdateRecord& rec);
@@ -150,9 +170,10 @@ class DriftlessFilter {
   BoxGeometry box_;
   double q_rate_dps2_per_s_ = 0.0;
 
-  Vector6d x_ = Vector6d::Zero();
+  Vector12d x_ = Vector12d::Zero();
   Vector6d fixed_bias_ = Vector6d::Zero();  // deg/s, for rate_body_fixed_dps only
-  Matrix6d P_ = Matrix6d::Identity();
+  Matrix12d P_ = Matrix12d::Identity();
+  std::array<double, 2> temp_ref_c_{kNaN, kNaN};  // degC, temperatures x_'s bias refers to
   int consecutive_rejections_ = 0;
   double t_filter_s_ = kNaN;  // time P and x refer to
   double last_t_s_ = kNaN;

@@ -240,6 +240,10 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
   add_filter_warnings(filter, sum);
   sum.bias_dps = filter.bias_dps();
   sum.sigma_dps = filter.sigma_dps();
+  sum.temp_states = filter.has_temp_states();
+  sum.temp_coef_dps_per_degc = filter.temp_coef_dps_per_degc();
+  sum.temp_coef_sigma_dps_per_degc = filter.temp_coef_sigma_dps_per_degc();
+  sum.temp_ref_c = filter.temperature_ref_c();
   add_attitude_results(att, filter, opt, sum);
   score.finish();
   if (use_window) window.finish(filter);

@@ -4,6 +4,7 @@
 // (EstimateSink). Eigen + std only.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -96,6 +97,12 @@ struct EstimateSummary {
   FilterCounters counters;
   Vector6d bias_dps = Vector6d::Constant(kNaN);
   Vector6d sigma_dps = Vector6d::Constant(kNaN);
+  // the bias temperature coefficients [k1; k2] (deg/s per degC) and their sigma; states only
+  // with temp_coef_sigma_dps_per_degc > 0, learned only from temperature changes
+  bool temp_states = false;
+  Vector6d temp_coef_dps_per_degc = Vector6d::Constant(kNaN);
+  Vector6d temp_coef_sigma_dps_per_degc = Vector6d::Constant(kNaN);
+  std::array<double, 2> temp_ref_c{kNaN, kNaN};  // degC, the temperatures bias_dps refers to
   double t_first_s = kNaN, t_last_s = kNaN;
   bool attitude_available = false;   // the log has ref_q
   double drift_corrected_deg_per_h = kNaN;

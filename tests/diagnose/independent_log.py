@@ -11,6 +11,10 @@ effects planted at datasheet magnitude. The compare/diagnose acceptance tests ru
   /usr/bin/python3 independent_log.py --out log.csv --seed 3 --rate 100 --duration 180 \
       --motion pan_tilt --noise-scale 1.5 --dlpf none --plant scale:1:x:3 --lag 2:0.015
 
+With --single it writes the single-sensor form (docs/log-format.md, 'sensors: 1'): one IMU fixed
+to the moving body (no platforms, no flips) against the body's reference attitude ref_q, as a
+motion-capture recording gives it; --accel adds its accelerometer (accel1_*, with noise).
+
 Planted effects (repeatable --plant): scale:S:AX:PCT, misalign:S:ROW:COL:PCT,
 gsens:S:ROW:COL:DPS_PER_G, mount:S:AX:DEG, stop:P:minus|plus:DEG, tempco:S:AX:DPS_PER_DEGC,
 quant:LSB_PER_DPS. Units: deg/s, deg, s, %, degC.
@@ -201,6 +205,25 @@ def sensor_errors(plants, s):
     return (np.eye(3) + M) @ np.diag(1 + scale), Gs, small_rotation(mount), tempco
 
 
+def write_single(args, t_out, gyro, accel, q_out, temp_out):
+    """The single-sensor form: t, gyro1_*, ref_q, [accel1_*], [temp1]."""
+    with open(args.out, "w") as f:
+        f.write("# format: driftless-log 1\n# complete: true\n# sensors: 1\n")
+        f.write(f"# sample_rate_hz: {args.rate:g}\n# latitude_deg: {args.latitude:g}\n")
+        f.write("# source: independent generator (tests/diagnose), one IMU against motion capture\n")
+        f.write(f"# seed: {args.seed}\n")
+        cols = "t,gyro1_x,gyro1_y,gyro1_z,ref_qw,ref_qx,ref_qy,ref_qz"
+        cols += ",accel1_x,accel1_y,accel1_z" if args.accel else ""
+        f.write(cols + (",temp1\n" if args.temperature else "\n"))
+        for k in range(len(t_out)):
+            row = [f"{t_out[k]:.6f}"] + [f"{v:.7f}" for v in gyro[k]] + [f"{v:.10f}" for v in q_out[k]]
+            if args.accel:
+                row += [f"{v:.5f}" for v in accel[k]]
+            if args.temperature:
+                row += [f"{temp_out[k]:.3f}"]
+            f.write(",".join(row) + "\n")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--out", required=True)
@@ -216,6 +239,8 @@ def main():
     ap.add_argument("--flip-period", type=float, default=10.0, help="s between flips of each platform")
     ap.add_argument("--latitude", type=float, default=48.1)
     ap.add_argument("--temperature", action="store_true", help="log temp1/temp2 (a 6 degC warm-up)")
+    ap.add_argument("--single", action="store_true", help="one IMU fixed to the body, no platforms ('sensors: 1')")
+    ap.add_argument("--accel", action="store_true", help="log the accelerometer (accel1_*, m/s^2; --single only)")
     args = ap.parse_args()
     rng = np.random.default_rng(args.seed)
 
@@ -248,6 +273,9 @@ def main():
     plat_true, plat_rate, plat_moving, plat_side = [], [], [], []
     for i in range(2):
         ang, rate, moving, side = flips(t_int, args.flip_period, 1.0, 2.0 + i * args.flip_period / 2)
+        if args.single:  # the IMU is fixed to the body: no platform
+            z = np.zeros_like(t_int)
+            ang, rate, moving, side = z, z, z.astype(bool), z
         ang = ang + np.where(moving, 0.0, np.where(side > 0, stop_err[i, 1], stop_err[i, 0]))
         plat_true.append(ang), plat_rate.append(rate), plat_moving.append(moving), plat_side.append(side)
 
@@ -264,8 +292,8 @@ def main():
             lsb = 1.0 / float(p.split(":")[1])
     N = 0.005 * args.noise_scale
 
-    gyro = []
-    for i in range(2):
+    gyro, accel = [], []
+    for i in range(1 if args.single else 2):
         R_i = rot_axis(hinges[i], plat_true[i] * D2R)
         w_s = np.einsum("nji,nj->ni", R_i, w_body) + (plat_rate[i] * D2R)[:, None] * hinges[i][None, :]
         f_s = np.einsum("nji,nj->ni", R_i, f_body)
@@ -286,6 +314,9 @@ def main():
             yo += rng.normal(0.0, N * math.sqrt(fs), yo.shape)
         yo = np.clip(np.round(yo / lsb) * lsb, -250.0, 250.0)
         gyro.append(yo)
+        # accelerometer: specific force in sensor axes, sampled with the gyro, 0.004 m/s^2 noise
+        fo = sample_at(f_s, t_int, t_out - lags[i] - args.time_offset)
+        accel.append(fo + rng.normal(0.0, 0.004, fo.shape))
 
     # what the log says: platform at +-90 at rest (end-stop switches), empty while moving
     plat_log = []
@@ -302,6 +333,9 @@ def main():
     q_out = np.array(q_out)
     temp_out = np.interp(t_out, t_int, temp)
 
+    if args.single:
+        write_single(args, t_out, gyro[0], accel[0], q_out, temp_out)
+        return 0
     with open(args.out, "w") as f:
         f.write("# format: driftless-log 1\n# complete: true\n")
         f.write(f"# sample_rate_hz: {fs:g}\n# latitude_deg: {args.latitude:g}\n")

@@ -31,6 +31,8 @@ struct Source {
   double lag_s = 0.0;
   double time_offset_s = 0.0;
   bool temperature = false;
+  bool single = false;               // the single-sensor form: one IMU fixed to the body, ref_q
+  bool accel = false;                // (single) its accelerometer columns accel1_*
   std::vector<std::string> plants;   // scale:1:x:3, ...
 };
 
@@ -44,6 +46,8 @@ inline std::filesystem::path generate(const Source& src, const std::string& tag)
   if (src.lag_sensor > 0) cmd += fmt::format(" --lag {}:{}", src.lag_sensor, src.lag_s);
   if (src.time_offset_s != 0.0) cmd += fmt::format(" --time-offset {}", src.time_offset_s);
   if (src.temperature) cmd += " --temperature";
+  if (src.single) cmd += " --single";
+  if (src.accel) cmd += " --accel";
   for (const auto& p : src.plants) cmd += " --plant " + p;
   const int rc = std::system(cmd.c_str());
   EXPECT_EQ(rc, 0) << "generator failed: " << cmd;
