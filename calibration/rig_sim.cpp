@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <memory>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -13,8 +14,6 @@
 
 #include "calibration/yaml_io.hpp"
 #include "estimator/geometry.hpp"
-#include "estimator/log_metadata.hpp"
-#include "estimator/random.hpp"
 #include "twin/flip_schedule.hpp"
 #include "twin/motion.hpp"
 #include "twin/sensor/sensor_model.hpp"
@@ -26,12 +25,8 @@ namespace driftless::calib {
 using twin::Scenario;
 using twin::World;
 using twin::BoxParams;
-using twin::MotionState;
 using twin::TrapezoidProfile;
-using twin::SensorTruth;
-using twin::SensorReading;
 using twin::SensorParams;
-using twin::SensorModel;
 using twin::SensorInstance;
 using twin::Carrier;
 using twin::Motion;
@@ -137,8 +132,9 @@ class RigMotion final : public Motion {
 struct PlatformPlan {
   struct Flip {
     double t0_s;
+    int sign;                // the stop it goes to, +1 / -1
     TrapezoidProfile profile;
-    double known_from_s;  // the system knows the new angle again from here
+    double known_from_s;  // the system knows the new angle again from here (at the latest)
   };
   double initial_sign = -1.0;
   std::vector<Flip> flips;
@@ -164,29 +160,78 @@ PlatformPlan platform_plan(const RigPlan& plan, const RigParams& rig, const BoxP
           "the gap is {:.1f} s; raise calibration.gap_s", known - prev.t_end_s, prev.name,
           plan.segments[k].t_start_s - prev.t_end_s));
     }
-    pp.flips.push_back({t0, prof, known});
+    pp.flips.push_back({t0, want > 0 ? 1 : -1, prof, known});
     sign = want;
   }
   return pp;
 }
 
-double reference_rad(const PlatformPlan& pp, const BoxParams& box, double t) {
-  const double press_rad = (box.end_stop_deg + box.motor.overtravel_deg) * kRadPerDeg;
-  double ref = pp.initial_sign * press_rad;
-  for (const auto& f : pp.flips)
-    if (t >= f.t0_s) ref = f.profile.angle_rad(t);
-  return ref;
+// the rig's platform commander: it starts each planned flip through the simulator's external
+// flip control (twin::FlipController runs the motor profile and knows the angles from the stops)
+class RigCommander {
+ public:
+  explicit RigCommander(const PlatformPlan (&pp)[2]) : pp_{&pp[0], &pp[1]} {}
+  /// Commands every flip due before the sample at t_next_s (it starts at the next physics step,
+  /// at most one sample period ahead of its planned time).
+  void before_sample(twin::Simulator& sim, double t_next_s) {
+    for (int i = 0; i < 2; ++i) {
+      const auto& flips = pp_[i]->flips;
+      for (std::size_t& k = next_[i]; k < flips.size() && flips[k].t0_s <= t_next_s; ++k) {
+        sim.command_platform(i + 1, flips[k].sign);
+      }
+    }
+  }
+
+ private:
+  const PlatformPlan* pp_[2];
+  std::size_t next_[2] = {0, 0};
+};
+
+// the calibration scenario as the simulator runs it: the plan's length, the platforms pressed
+// onto their end stops and known from the stops' switches (the rig plan's +-90)
+Scenario rig_scenario(const Scenario& sc, const RigPlan& plan) {
+  Scenario r = sc;
+  r.duration_s = plan.segments.back().t_end_s + 1.0;
+  r.flip_schedule.flip_angle_deg = r.model.box.end_stop_deg;
+  r.platform_readback = twin::PlatformReadback::end_stops;
+  return r;
 }
 
-// the angle the system knows (end-stop switches): +-90 at rest, NaN while a flip runs
-double known_deg(const PlatformPlan& pp, const BoxParams& box, double t) {
-  double sign = pp.initial_sign;
-  for (const auto& f : pp.flips) {
-    if (t < f.t0_s) break;
-    if (t < f.known_from_s) return kNaN;
-    sign = f.profile.target_rad() > 0 ? 1.0 : -1.0;
+// where the platforms really rest during the fit's plateaus, and the sensors' mean temperature
+struct RigTruthSums {
+  double rest_sum[2][2] = {{0, 0}, {0, 0}}, rest_n[2][2] = {{0, 0}, {0, 0}}, temp_sum[2] = {0, 0};
+  double samples = 0;
+
+  void add(const RigPlan& plan, const Sample& s) {
+    const double plat_deg[2] = {s.true_plat1_deg, s.true_plat2_deg};
+    for (const auto& seg : plan.segments) {
+      if (!seg.on_plateau(s.t_s)) continue;
+      for (int i = 0; i < 2; ++i) {
+        rest_sum[i][seg.position(i)] += plat_deg[i];
+        rest_n[i][seg.position(i)] += 1;
+      }
+    }
+    temp_sum[0] += s.temp1_c;
+    temp_sum[1] += s.temp2_c;
+    samples += 1;
   }
-  return sign * box.end_stop_deg;
+};
+
+// the true M: sensor calibration C from the realised model, T from the rest angles (M^-1 = C T^T)
+void true_matrices(const twin::Simulator& sim, const BoxParams& box, const RigTruthSums& sums, RigRun& run) {
+  const Eigen::Vector3d hinge[2] = {box.hinge_axis(1), box.hinge_axis(2)};
+  for (int i = 0; i < 2; ++i) {
+    const SensorInstance& inst = sim.sensor(i + 1).instance();
+    const SensorParams& p = sim.sensor(i + 1).params();
+    const double dT = sums.temp_sum[i] / sums.samples - p.temperature.reference_degc;
+    const Eigen::Vector3d k = inst.scale + inst.scale_tc_per_degc * dT;
+    const Eigen::Matrix3d C = inst.misalignment * k.asDiagonal() * inst.R_sensor_from_nominal;
+    for (int pos = 0; pos < 2; ++pos) {
+      run.rest_angle_deg[i][pos] = sums.rest_n[i][pos] > 0 ? sums.rest_sum[i][pos] / sums.rest_n[i][pos] : kNaN;
+      run.true_M.M(i, pos) =
+          (C * geo::rot_about_axis_deg(hinge[i], run.rest_angle_deg[i][pos]).transpose()).inverse();
+    }
+  }
 }
 
 // ---- scenario file: a normal scenario plus a `calibration:` block -----------------------------
@@ -284,113 +329,40 @@ CalibScenario load_calib_scenario(const std::filesystem::path& path) {
 }
 
 RigRun run_rig(const CalibScenario& cs, const std::function<bool(double)>& progress) {
-  const Scenario& sc = cs.scenario;
-  sc.validate();
+  cs.scenario.validate();
   cs.rig.validate();
   RigRun run;
   run.plan = standard_plan(cs.rig.procedure);
-  const BoxParams& box = sc.model.box;
+  const BoxParams& box = cs.scenario.model.box;
   const PlatformPlan pp[2] = {platform_plan(run.plan, cs.rig, box, 1),
                               platform_plan(run.plan, cs.rig, box, 2)};
-  const RigMotion motion(run.plan, cs.rig.table_accel_dps2, cs.rig.remount_s);
-  World world(box, sc.physics_dt_s);
-  const Eigen::Vector3d earth = geo::earth_rate_enu_radps(sc.latitude_deg);
+  const Scenario sc = rig_scenario(cs.scenario, run.plan);
 
-  // sensors: the scenario's sensor blocks over the MPU6050 preset
-  SensorModel sensor[2] = {
-      SensorModel(sc.model.sensor1, sc.sample_rate_hz,
-                  rnd::stream_seed(sc.seed, rnd::Stream::kSensor1)),
-      SensorModel(sc.model.sensor2, sc.sample_rate_hz,
-                  rnd::stream_seed(sc.seed, rnd::Stream::kSensor2))};
-
-  // initial state: the box on the table, platforms pressed onto their first stops
-  const MotionState m0 = motion.at(0.0);
-  world.set_base(m0.p_enu_m, m0.q_enu_from_body, m0.v_enu_mps, m0.w_body_radps);
-  for (int i = 1; i <= 2; ++i) {
-    world.set_platform(i, box.stop_rad(i, pp[i - 1].initial_sign > 0 ? 1 : -1), 0.0);
-    world.set_motor_reference(i, reference_rad(pp[i - 1], box, 0.0));
-  }
-  world.pose_carrier(Carrier::pan_tilt, m0.p_enu_m, m0.q_enu_from_body);
-  mj_forward(world.model(), world.data());
-
-  log::LogInfo info;
-  info.sample_rate_hz = sc.sample_rate_hz;
-  info.latitude_deg = sc.latitude_deg;
-  info.hinge1_axis = box.hinge_axis(1);
-  info.hinge2_axis = box.hinge_axis(2);
-  info.source = "twin";
-  info.scenario = sc.name;
-  info.seed = sc.seed;
-  info.motion = "calibration_rig";
-  info.carrier = "pan_tilt";
-  log::write_log_info(run.meta, info);
-
-  const double duration_s = run.plan.segments.back().t_end_s + 1.0;
-  const long steps_per_sample = sc.steps_per_sample();
-  const auto n_samples = static_cast<std::uint64_t>(std::floor(duration_s * sc.sample_rate_hz));
-  double rest_sum[2][2] = {{0, 0}, {0, 0}}, rest_n[2][2] = {{0, 0}, {0, 0}}, temp_sum[2] = {0, 0};
+  // the twin's simulator on the rate table: MuJoCo steps every physics step (the rig measures
+  // where the platforms really rest), the platforms start on the first segment's stops
+  twin::SimOptions opt;
+  opt.fast_rest = false;
+  opt.external_flips = true;
+  opt.initial_sign = {pp[0].initial_sign > 0 ? 1 : -1, pp[1].initial_sign > 0 ? 1 : -1};
+  twin::Simulator sim(sc, std::make_unique<RigMotion>(run.plan, cs.rig.table_accel_dps2, cs.rig.remount_s),
+                      "calibration_rig", opt);
+  run.meta = sim.metadata();
+  RigCommander commander(pp);
+  RigTruthSums sums;
+  const double sample_period_s = static_cast<double>(sc.steps_per_sample()) * sc.physics_dt_s;
+  const std::uint64_t n_samples = sim.total_samples();
   run.samples.reserve(n_samples);
-  std::uint64_t step = 0;
-  for (std::uint64_t k = 0; k < n_samples; ++k) {
+  Sample s;
+  for (std::uint64_t k = 0;; ++k) {
     if (progress && k % 1000 == 0 && !progress(static_cast<double>(k) / static_cast<double>(n_samples)))
       throw std::runtime_error("calibration rig stopped by the user");
-    Sample out;
-    for (long j = 0; j < steps_per_sample; ++j, ++step) {
-      const bool output = j == 0;
-      const double t = static_cast<double>(step) * sc.physics_dt_s;
-      const MotionState ms = motion.at(t);
-      const Eigen::Vector2d ref_rad(reference_rad(pp[0], box, t), reference_rad(pp[1], box, t));
-      const twin::HingeState hinge_state = world.step_driven(t, ms, ref_rad, output);
-      if (!output) continue;
-      const double* plat_rad = hinge_state.angle_rad;
-      out.t_s = t;
-      out.set_q_enu_from_body(ms.q_enu_from_body);
-      out.ref_p_enu_m = ms.p_enu_m;
-      out.true_plat1_deg = plat_rad[0] * kDegPerRad;
-      out.true_plat2_deg = plat_rad[1] * kDegPerRad;
-      out.true_rate_body_dps = (ms.w_body_radps + ms.q_enu_from_body.conjugate() * earth) * kDegPerRad;
-      out.plat1_deg = known_deg(pp[0], box, t);
-      out.plat2_deg = known_deg(pp[1], box, t);
-      for (int i = 0; i < 2; ++i) {
-        const Eigen::Matrix3d R = world.R_enu_from_sensor(i + 1);
-        SensorTruth truth;
-        truth.t_s = t;
-        truth.w_radps = world.mj_gyro(i + 1) + R.transpose() * earth;
-        truth.f_mps2 = world.mj_accel(i + 1);
-        const SensorReading r = sensor[i].step(truth);
-        (i == 0 ? out.gyro1_dps : out.gyro2_dps) = r.gyro_radps * kDegPerRad;
-        (i == 0 ? out.accel1_mps2 : out.accel2_mps2) = r.accel_mps2;
-        (i == 0 ? out.true_bias1_dps : out.true_bias2_dps) = r.bias_radps * kDegPerRad;
-        (i == 0 ? out.temp1_c : out.temp2_c) = r.temp_c;
-        temp_sum[i] += r.temp_c;
-      }
-      // where the platforms really rest during the fit's plateaus
-      for (const auto& s : run.plan.segments) {
-        if (!s.on_plateau(t)) continue;
-        for (int i = 0; i < 2; ++i) {
-          rest_sum[i][s.position(i)] += plat_rad[i] * kDegPerRad;
-          rest_n[i][s.position(i)] += 1;
-        }
-      }
-    }
-    run.samples.push_back(out);
+    commander.before_sample(sim, static_cast<double>(k) * sample_period_s);
+    if (!sim.next(s)) break;
+    sums.add(run.plan, s);
+    run.samples.push_back(s);
   }
   if (progress) progress(1.0);
-
-  // the true M: sensor calibration C from the realised model, T from the rest angles
-  const Eigen::Vector3d hinge[2] = {box.hinge_axis(1), box.hinge_axis(2)};
-  for (int i = 0; i < 2; ++i) {
-    const SensorInstance& inst = sensor[i].instance();
-    const SensorParams& p = sensor[i].params();
-    const double dT = temp_sum[i] / static_cast<double>(n_samples) - p.temperature.reference_degc;
-    const Eigen::Vector3d k = inst.scale + inst.scale_tc_per_degc * dT;
-    const Eigen::Matrix3d C = inst.misalignment * k.asDiagonal() * inst.R_sensor_from_nominal;
-    for (int pos = 0; pos < 2; ++pos) {
-      run.rest_angle_deg[i][pos] = rest_n[i][pos] > 0 ? rest_sum[i][pos] / rest_n[i][pos] : kNaN;
-      run.true_M.M(i, pos) =
-          (C * geo::rot_about_axis_deg(hinge[i], run.rest_angle_deg[i][pos]).transpose()).inverse();
-    }
-  }
+  true_matrices(sim, box, sums, run);
   return run;
 }
 

@@ -46,13 +46,19 @@ double TrapezoidProfile::angle_rad(double t) const {
   return from_ + dir_ * s;
 }
 
-FlipController::FlipController(const FlipScheduleParams& p, const BoxParams& box)
-    : p_(p), box_(box), flip_rad_(p.flip_angle_deg * kRadPerDeg),
+FlipController::FlipController(const FlipScheduleParams& p, const BoxParams& box, std::array<int, 2> initial_sign)
+    : initial_sign_(initial_sign), p_(p), box_(box), flip_rad_(p.flip_angle_deg * kRadPerDeg),
       on_stops_(std::abs(p.flip_angle_deg - box.end_stop_deg) < 1e-9),
       next_flip_s_(p.enabled ? p.standstill_s : std::numeric_limits<double>::infinity()) {
   p_.validate(box.end_stop_deg);
   for (int i = 1; i <= 2; ++i) {
-    ref_[i - 1] = target_for(i, +1);
+    const int sign = initial_sign_[i - 1];
+    if (sign != 1 && sign != -1) {
+      throw std::invalid_argument("flip controller: platform " + std::to_string(i) + " must start at sign +1 or -1, got " +
+                                  std::to_string(sign));
+    }
+    sign_[i - 1] = sign;
+    ref_[i - 1] = target_for(i, sign);
     profile_[i - 1] = TrapezoidProfile(0, ref_[i - 1], ref_[i - 1], 1, 1);
   }
 }
@@ -64,7 +70,8 @@ double FlipController::target_for(int, int sign) const {
 }
 
 double FlipController::initial_angle_rad(int i) const {
-  return on_stops_ ? box_.stop_rad(i, +1) : flip_rad_;
+  const int sign = initial_sign_[i - 1];
+  return on_stops_ ? box_.stop_rad(i, sign) : sign * flip_rad_;
 }
 
 double FlipController::reference_rad(int i) const { return ref_[i - 1]; }

@@ -4,6 +4,8 @@
 // along a speed- and acceleration-limited (trapezoidal) reference.
 #pragma once
 
+#include <array>
+
 #include <Eigen/Core>
 
 #include "twin/world.hpp"
@@ -39,7 +41,10 @@ class TrapezoidProfile {
 /// knows the platform angles as the system does (the commanded rest angle, unknown while moving).
 class FlipController {
  public:
-  FlipController(const FlipScheduleParams& p, const BoxParams& box);
+  /// `initial_sign`: the rest side each platform starts on (+1 / -1; the schedule's eq. (5)
+  /// sequence starts at (+,+), so another start needs take_external_control(): the calibration
+  /// rig's first segments rest at (-,-)). Throws std::invalid_argument on a sign other than +-1.
+  FlipController(const FlipScheduleParams& p, const BoxParams& box, std::array<int, 2> initial_sign = {1, 1});
 
   /// Advances to time t (s) given the platforms' current rates (rad/s, index 0 = platform 1).
   /// Call once per physics step with non-decreasing t.
@@ -60,7 +65,7 @@ class FlipController {
   long flips() const { return flips_; }
   /// True when the platforms rest on their end stops (flip angle = end stop), pressed by the motor.
   bool on_stops() const { return on_stops_; }
-  /// Initial platform angle (rad) for platform i: on its + stop, or at +flip angle.
+  /// Initial platform angle (rad) for platform i: on its initial stop, or at +-flip angle.
   double initial_angle_rad(int i) const;
 
   /// Hands the flips to an outside commander (the HIL bridge's motor interface): from now on
@@ -74,6 +79,7 @@ class FlipController {
 
  private:
   double target_for(int i, int sign) const;
+  std::array<int, 2> initial_sign_;
 
   FlipScheduleParams p_;
   BoxParams box_;

@@ -19,14 +19,25 @@ namespace {
 // platforms settle on their stops for this long before t = 0, s
 constexpr double kWarmupS = 1.0;
 
+std::unique_ptr<Motion> required(std::unique_ptr<Motion> motion) {
+  if (!motion) throw std::invalid_argument("simulator: no motion given");
+  return motion;
+}
+
 }  // namespace
 
 Simulator::Simulator(const Scenario& scenario, SimOptions options)
+    : Simulator(scenario, make_motion((scenario.validate(), scenario.motion), scenario.duration_s, scenario.seed, scenario.base_dir),
+                motion_type_name(scenario.motion.type), options) {}
+
+Simulator::Simulator(const Scenario& scenario, std::unique_ptr<Motion> motion, std::string motion_name,
+                     SimOptions options)
     : scenario_((scenario.validate(), scenario)),
       options_(options),
       world_(scenario.model.box, scenario.physics_dt_s, ModelScope::physics),
-      motion_(make_motion(scenario.motion, scenario.duration_s, scenario.seed, scenario.base_dir)),
-      flips_(scenario.flip_schedule, scenario.model.box),
+      motion_(required(std::move(motion))),
+      motion_name_(std::move(motion_name)),
+      flips_(scenario.flip_schedule, scenario.model.box, options.initial_sign),
       gate_(scenario.model.box, motion_->is_static(), scenario.sample_rate_hz),
       earth_enu_radps_(geo::earth_rate_enu_radps(scenario.latitude_deg)),
       steps_per_sample_(scenario.steps_per_sample()),
@@ -37,6 +48,11 @@ Simulator::Simulator(const Scenario& scenario, SimOptions options)
         "(offset >= 0) only; compare and diagnose honour negative offsets",
         scenario.model.time_offset_s));
   }
+  if (options.initial_sign != std::array<int, 2>{1, 1} && !options.external_flips) {
+    throw std::invalid_argument("simulator: platforms starting anywhere but (+,+) need external flip control "
+                                "(the flip schedule's eq. (5) sequence starts at (+,+))");
+  }
+  if (options.external_flips) flips_.take_external_control();
   // each sensor draws its run-to-run values and noise from its own stream of the seed
   sensors_.emplace_back(scenario.model.sensor1, scenario.sample_rate_hz, rnd::stream_seed(scenario.seed, rnd::Stream::kSensor1));
   sensors_.emplace_back(scenario.model.sensor2, scenario.sample_rate_hz, rnd::stream_seed(scenario.seed, rnd::Stream::kSensor2));
@@ -82,7 +98,7 @@ log::Metadata Simulator::metadata() const {
   info.scenario = scenario_.name;
   info.seed = scenario_.seed;
   info.duration_s = scenario_.duration_s;
-  info.motion = motion_type_name(scenario_.motion.type);
+  info.motion = motion_name_;
   info.carrier = carrier_name(motion_->carrier());
   info.platform_readback = readback_name(scenario_.platform_readback);
   info.flip_angle_deg = scenario_.flip_schedule.flip_angle_deg;

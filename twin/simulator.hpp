@@ -4,11 +4,13 @@
 // analytically (MuJoCo's world is the non-rotating local ENU frame).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <deque>
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -43,12 +45,22 @@ struct SimOptions {
   /// of the base motion; MuJoCo steps every flip, its settling, and every base load that could
   /// lift a platform off its stop. false: MuJoCo steps the whole run.
   bool fast_rest = true;
+  /// The platforms answer to an outside commander from the start (command_platform(); as after
+  /// take_flip_control(), but before the warm-up): the scenario's flip schedule never runs.
+  bool external_flips = false;
+  /// The rest side each platform starts (and warms up) on, +1 / -1; anything but (+,+) needs
+  /// external_flips (the schedule's eq. (5) sequence starts at (+,+)).
+  std::array<int, 2> initial_sign = {1, 1};
 };
 
 /// A running simulation of one scenario.
 class Simulator {
  public:
   explicit Simulator(const Scenario& scenario, SimOptions options = {});
+  /// A run along an outside motion (the calibration rig's rate table) instead of the scenario's
+  /// `motion:` block; `motion_name` is logged as the log's `motion`.
+  Simulator(const Scenario& scenario, std::unique_ptr<Motion> motion, std::string motion_name,
+            SimOptions options = {});
   ~Simulator();
   Simulator(const Simulator&) = delete;
   Simulator& operator=(const Simulator&) = delete;
@@ -107,6 +119,7 @@ class Simulator {
   SimOptions options_;
   World world_;
   std::unique_ptr<Motion> motion_;
+  std::string motion_name_;
   FlipController flips_;
   RestGate gate_;
   FlipReplay replays_;

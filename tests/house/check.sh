@@ -56,7 +56,8 @@ else
 fi
 
 # 3. one definition each: "home file | what | extended regex of a copy"
-# (homes are space-separated; a hit inside a // comment does not count)
+# (homes are space-separated; a hit inside a // comment does not count; compare_model.cpp settles
+# the platforms on their stops once, a measurement, not a simulation loop)
 while IFS='|' read -r homes what regex; do
   [[ -z $homes || $homes == \#* ]] && continue
   while IFS= read -r hit; do
@@ -77,6 +78,7 @@ estimator/mpu6050.hpp|the MPU6050 sensitivities|131\.0, 65\.5|16384\.0|/ 340\.0|
 estimator/output_file.hpp estimator/output_file.cpp|writing a file (use the output helper: partial name, checked writes, rename)|std::ofstream|fmt::output_file|fopen\(.*"[wa]
 estimator/random.hpp estimator/random.cpp|the random generators|std::(normal|uniform_real)_distribution|std::mt19937|0x9E3779B97F4A7C15
 estimator/attitude.hpp estimator/attitude.cpp estimator/attitude_comparison.hpp estimator/attitude_comparison.cpp|strapdown attitude integration (compare through est::run_estimate / AttitudeComparison)|AttitudeIntegrator
+twin/world.cpp twin/world.hpp twin/simulator.cpp diagnose/compare_model.cpp|stepping the MuJoCo world (run the twin's Simulator with a Motion and, for outside flips, command_platform)|step_driven\(|mj_step[12]?\(
 estimator/pipeline.cpp|NEES against the truth (score through est::run_estimate)|\.(llt|ldlt)\(\)\.solve\(e\)
 RULES
 exit $bad

@@ -73,6 +73,22 @@ TEST(FlipController, DisabledScheduleNeverFlips) {
   EXPECT_FALSE(fc.any_moving());
 }
 
+TEST(FlipController, StartsOnTheGivenStopsAndRefusesOtherSigns) {
+  // GIVEN the calibration rig's start: both platforms on their - stops
+  FlipScheduleParams p;
+  BoxParams box;
+  FlipController fc(p, box, {-1, -1});
+  // THEN they start there, the motor presses them onto those stops, the system knows -90
+  for (int i = 1; i <= 2; ++i) {
+    EXPECT_EQ(fc.initial_angle_rad(i), box.stop_rad(i, -1));
+    EXPECT_NEAR(fc.reference_rad(i), -(box.end_stop_deg + box.motor.overtravel_deg) * kRadPerDeg, 1e-15);
+    EXPECT_NEAR(fc.commanded_rest_rad(i), -90.0 * kRadPerDeg, 1e-15);
+    EXPECT_EQ(fc.sign(i), -1);
+  }
+  EXPECT_THROW(FlipController(p, box, {0, 1}), std::invalid_argument);
+  EXPECT_THROW(FlipController(p, box, {1, 2}), std::invalid_argument);
+}
+
 TEST(FlipScheduleParams, RejectsAnglesBeyondTheStop) {
   FlipScheduleParams p;
   p.flip_angle_deg = 95;

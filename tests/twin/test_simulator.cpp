@@ -231,6 +231,35 @@ TEST_F(SimulatorTest, KnownPlatformAnglesFollowTheReadbackMode) {
   EXPECT_GT(empty, 100);  // a flip of ~1.7 s leaves the end-stop read-back empty
 }
 
+// GIVEN a static box whose platforms start on their - stops under an outside commander
+TEST_F(SimulatorTest, AnOutsideCommanderStartsThePlatformsWhereItSaysAndFlipsThem) {
+  Scenario sc = short_static(6);
+  SimOptions opt;
+  opt.external_flips = true;
+  opt.initial_sign = {-1, -1};
+  Simulator sim(sc, opt);
+  Sample s;
+  ASSERT_TRUE(sim.next(s));
+  // THEN the run starts settled on the - stops (their planted errors included; the warm-up held
+  // them there, 0.01 deg for the stops' compliance), the schedule never flips
+  const BoxParams& box = sc.model.box;
+  const auto stop_deg = [&](int i, int sign) { return box.stop_rad(i, sign) * kDegPerRad; };
+  EXPECT_NEAR(s.true_plat1_deg, stop_deg(1, -1), 0.01);
+  EXPECT_NEAR(s.true_plat2_deg, stop_deg(2, -1), 0.01);
+  EXPECT_EQ(s.plat1_deg, -90.0);
+  EXPECT_EQ(sim.metadata().get("flip_control").value_or(""), "external");
+  // WHEN the commander flips platform 1 at 1 s, THEN it arrives on its + stop; platform 2 stays
+  while (sim.next(s) && s.t_s < 1.0) {}
+  sim.command_platform(1, +1);
+  while (sim.next(s)) {}
+  EXPECT_NEAR(s.true_plat1_deg, stop_deg(1, +1), 0.01);
+  EXPECT_EQ(s.plat1_deg, 90.0);
+  EXPECT_NEAR(s.true_plat2_deg, stop_deg(2, -1), 0.01);
+  // AND a start other than (+,+) under the eq. (5) schedule is refused
+  opt.external_flips = false;
+  EXPECT_THROW(Simulator(sc, opt), std::invalid_argument);
+}
+
 std::string slurp(const std::filesystem::path& p) {
   std::ifstream in(p, std::ios::binary);
   std::stringstream ss;
