@@ -178,11 +178,11 @@ double column_value(const ColumnInputs& in, int s, int j, int col, std::size_t k
       const double u = in.pred[s].gyro_dps[k][j] / fs;
       return fs * (col == kNonlin2 ? u * u : u * u * u) / 100.0;
     }
-    case kDelay: return -r.dw_radps2[s][k][j] * kDegPerRad;
+    case kDelay: return -r.dw_radps2(s, k)[j] * kDegPerRad;
     case kDelay2: {
       const std::size_t a = k == 0 ? 0 : k - 1, b = k + 1 < r.size() ? k + 1 : k;
       if (b == a) return 0.0;
-      return (r.dw_radps2[s][b][j] - r.dw_radps2[s][a][j]) / (r.t_s[b] - r.t_s[a]) * kDegPerRad;
+      return (r.dw_radps2(s, b)[j] - r.dw_radps2(s, a)[j]) / (r.t_s[b] - r.t_s[a]) * kDegPerRad;
     }
     case kEndPlus: case kEndMinus: {
       if (r.rest_side[s][k] != (col == kEndPlus ? 1 : -1)) return 0.0;

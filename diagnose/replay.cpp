@@ -382,7 +382,6 @@ void sensor_truth(const std::vector<Raw>& raw, const Eigen::Vector3d& dearth_dla
     out.gyro_dps[s].resize(n);
     out.w_radps[s].resize(n);
     out.f_mps2[s].resize(n);
-    out.dw_radps2[s].resize(n);
     out.dw_dlat_radps[s].resize(n);
     const Eigen::Vector3d& axis = out.hinge_axis[s];
     for (std::size_t k = 0; k < n; ++k) {
@@ -401,11 +400,6 @@ void sensor_truth(const std::vector<Raw>& raw, const Eigen::Vector3d& dearth_dla
       out.f_mps2[s][k] = out.has_accel && raw[k].a[s].allFinite() ? raw[k].a[s] : Eigen::Vector3d(Rt * out.f_body_mps2[k]);
       out.dw_dlat_radps[s][k] = Rt * (quat(raw[k]).conjugate() * dearth_dlat_enu);
       if (s < out.sensors && !raw[k].g[s].allFinite()) out.usable[k] = 0;
-    }
-    for (std::size_t k = 0; k < n; ++k) {
-      const std::size_t a = k == 0 ? 0 : k - 1, b = k + 1 < n ? k + 1 : n - 1;
-      out.dw_radps2[s][k] = (out.w_radps[s][b] - out.w_radps[s][a]) / (out.t_s[b] - out.t_s[a]);
-      if (!out.dw_radps2[s][k].allFinite()) out.dw_radps2[s][k].setZero();
     }
   }
   out.rows_missing_gyro = static_cast<std::size_t>(std::count(out.usable.begin(), out.usable.end(), 0));
@@ -439,6 +433,14 @@ Replay build(std::vector<Raw> raw, const log::Metadata& meta, std::uint32_t fiel
 }
 
 }  // namespace
+
+Eigen::Vector3d Replay::dw_radps2(int s, std::size_t k) const {
+  const std::size_t n = size();
+  const std::size_t a = k == 0 ? 0 : k - 1, b = k + 1 < n ? k + 1 : n - 1;
+  Eigen::Vector3d d = (w_radps[s][b] - w_radps[s][a]) / (t_s[b] - t_s[a]);
+  if (!d.allFinite()) d.setZero();
+  return d;
+}
 
 void ReplayOptions::validate() const {
   auto positive = [](double v, const char* name) {

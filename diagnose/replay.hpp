@@ -36,12 +36,14 @@ struct ReplayOptions {
 /// Per-sample truth rebuilt from a log, plus what was measured. Sensor index s = 0, 1.
 struct Replay {
   std::size_t size() const { return t_s.size(); }
+  /// d(w_radps)/dt of sensor s at sample k by central differences (one-sided at the ends, 0
+  /// where unknown), rad/s^2, sensor axes: computed when asked (a stored copy was 17 MB an hour)
+  Eigen::Vector3d dw_radps2(int s, std::size_t k) const;
 
   std::vector<double> t_s;                               // s, log time
   std::array<std::vector<Eigen::Vector3d>, 2> gyro_dps;  // measured, sensor axes, deg/s
   std::array<std::vector<Eigen::Vector3d>, 2> w_radps;   // ideal inertial rate y_i, sensor axes
   std::array<std::vector<Eigen::Vector3d>, 2> f_mps2;    // specific force, sensor axes
-  std::array<std::vector<Eigen::Vector3d>, 2> dw_radps2; // d(w_radps)/dt, sensor axes
   // d(y_i)/d(latitude) per rad of latitude: the Earth-rate part's sensitivity, sensor axes
   std::array<std::vector<Eigen::Vector3d>, 2> dw_dlat_radps;
   std::vector<Eigen::Vector3d> w_body_radps;             // box inertial rate, box axes

@@ -1,6 +1,8 @@
 // Synthetic dual-gyro samples from the closed-form sensor equation of docs/log-format.md:
 //   y_i = R_i^T w_body + thetadot_i a_i + b_i + n_i,   R_i = Rot(a_i, theta_i)
 // Test-only; independent of the twin. Flips follow eq. (5)'s sequence (+,+) (+,-) (-,-) (-,+).
+// The one Eigen-only generator of the estimator tests (filter, pipeline, FDI, tuning, health);
+// twin-side tests use twin::FastBox.
 #pragma once
 
 #include <cmath>
@@ -39,6 +41,10 @@ struct SynthParams {
   std::function<Eigen::Vector3d(double)> body_rate_dps;
   // extra noise per sample (deg/s, sensor axes) from outside, e.g. a real recording's: (sensor 1|2, index)
   std::function<Eigen::Vector3d(int, std::size_t)> extra_noise_dps;
+  double bias_walk_dps = 0.0;       // random-walk step of both biases per sample, deg/s (0: none)
+  double lsb_dps = 0.0;             // readings quantised to this step, deg/s (MPU6050: 1/131; 0: not)
+  // a last change to each sample's readings before they are quantised (planted faults)
+  std::function<void(Sample&)> before_quantise;
   bool earth_rate = true;
   double latitude_deg = 52.0;
   std::uint64_t seed = 1;
@@ -75,6 +81,7 @@ inline void synth_samples(const SynthParams& p, const std::function<void(const S
   static constexpr int kS1[4] = {+1, +1, -1, -1};
   static constexpr int kS2[4] = {+1, -1, -1, +1};
   Eigen::Vector3d gm1 = Eigen::Vector3d::Zero(), gm2 = Eigen::Vector3d::Zero();
+  Eigen::Vector3d walk1 = Eigen::Vector3d::Zero(), walk2 = Eigen::Vector3d::Zero();
   const double gm_phi = std::exp(-dt / p.gm_tau_s);
   const double drive = p.gm_sigma_dps * std::sqrt(1.0 - gm_phi * gm_phi);
   if (p.gm_sigma_dps > 0.0) {
@@ -117,8 +124,8 @@ inline void synth_samples(const SynthParams& p, const std::function<void(const S
     const Eigen::Vector3d w = w_nb + q.conjugate() * w_ie_enu_dps;  // inertial, box axes
     const Eigen::Matrix3d R1 = Eigen::AngleAxisd(t1 * kRadPerDeg, p.hinge1.normalized()).toRotationMatrix();
     const Eigen::Matrix3d R2 = Eigen::AngleAxisd(t2 * kRadPerDeg, p.hinge2.normalized()).toRotationMatrix();
-    const Eigen::Vector3d b1 = p.b1_dps + gm1;
-    const Eigen::Vector3d b2 = p.b2_dps + gm2 + (t2 < 0.0 ? p.b2_extra_at_negative_plat2_dps : Eigen::Vector3d::Zero());
+    const Eigen::Vector3d b1 = p.b1_dps + gm1 + walk1;
+    const Eigen::Vector3d b2 = p.b2_dps + gm2 + walk2 + (t2 < 0.0 ? p.b2_extra_at_negative_plat2_dps : Eigen::Vector3d::Zero());
     Sample s;
     s.t_s = t;
     s.gyro1_dps = R1.transpose() * w + w1 * p.hinge1.normalized() + b1;
@@ -142,6 +149,13 @@ inline void synth_samples(const SynthParams& p, const std::function<void(const S
     s.true_bias2_dps = b2;
     s.true_rate_body_dps = w;
     s.set_q_enu_from_body(q);
+    if (p.before_quantise) p.before_quantise(s);  // the truth columns are set
+    if (p.lsb_dps > 0.0) {
+      for (int i = 0; i < 3; ++i) {
+        s.gyro1_dps[i] = std::round(s.gyro1_dps[i] / p.lsb_dps) * p.lsb_dps;
+        s.gyro2_dps[i] = std::round(s.gyro2_dps[i] / p.lsb_dps) * p.lsb_dps;
+      }
+    }
     sink(s);
     // truth attitude q_enu_from_body follows the rate relative to ENU
     const Eigen::Vector3d wr = w_nb * kRadPerDeg * dt;
@@ -150,6 +164,12 @@ inline void synth_samples(const SynthParams& p, const std::function<void(const S
       for (int i = 0; i < 3; ++i) {
         gm1[i] = gm_phi * gm1[i] + drive * g(rng);
         gm2[i] = gm_phi * gm2[i] + drive * g(rng);
+      }
+    }
+    if (p.bias_walk_dps > 0.0) {
+      for (int i = 0; i < 3; ++i) {
+        walk1[i] += p.bias_walk_dps * g(rng);
+        walk2[i] += p.bias_walk_dps * g(rng);
       }
     }
   }

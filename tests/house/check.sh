@@ -4,7 +4,8 @@
 #     nothing above it; nothing includes cli/);
 #  2. no function in the product is over 150 lines;
 #  3. each piece of shared physics is defined once: the old copies do not come back; every file
-#     the program writes goes through the one output helper (estimator/output_file.hpp).
+#     the program writes goes through the one output helper (estimator/output_file.hpp);
+#  4. the estimator tests have one closed-form generator.
 # Usage: check.sh SOURCE_DIR. Prints every violation with file:line and exits 1 if there is one.
 set -uo pipefail
 src=${1:?usage: check.sh SOURCE_DIR}
@@ -81,4 +82,9 @@ estimator/attitude.hpp estimator/attitude.cpp estimator/attitude_comparison.hpp 
 twin/world.cpp twin/world.hpp twin/simulator.cpp diagnose/compare_model.cpp|stepping the MuJoCo world (run the twin's Simulator with a Motion and, for outside flips, command_platform)|step_driven\(|mj_step[12]?\(
 estimator/pipeline.cpp|NEES against the truth (score through est::run_estimate)|\.(llt|ldlt)\(\)\.solve\(e\)
 RULES
+
+# 4. one closed-form generator for the estimator tests (tests/estimator/synth.hpp, Eigen only):
+#    no other header there draws its own samples
+while IFS= read -r f; do say "a second closed-form generator: $f (extend tests/estimator/synth.hpp)"; done \
+  < <(grep -lE "std::mt19937|normal_distribution" tests/estimator/*.hpp 2>/dev/null | grep -vx 'tests/estimator/synth.hpp')
 exit $bad
