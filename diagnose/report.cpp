@@ -78,7 +78,7 @@ void before_after(std::ostringstream& h, const CompareResult& r, const ReportExt
                    html_escape(x.after->statement));
   h << "<table><tr><th>channel</th><th>rms before (deg/s)</th><th>rms after</th><th>systematic before</th>"
        "<th>systematic after</th><th>noise floor</th></tr>";
-  for (int c = 0; c < 6; ++c)
+  for (int c = 0; c < 3 * r.sensors; ++c)
     h << fmt::format("<tr><td class=l>{}</td><td>{:.5f}</td><td>{:.5f}</td><td>{:.5f}</td><td>{:.5f}</td><td>{:.5f}</td></tr>",
                      channel_name(c), r.channels[c].rms_dps, x.after->channels[c].rms_dps, r.channels[c].systematic_rms_dps,
                      x.after->channels[c].systematic_rms_dps, r.channels[c].noise_floor_dps);
@@ -89,7 +89,7 @@ void channel_table(std::ostringstream& h, const CompareResult& r) {
   h << "<h2>Residual per channel</h2><table><tr><th>channel</th><th>raw mean</th><th>raw rms</th><th>rms (nuisance "
        "fit)</th><th>rms after the selected effects</th><th>noise floor</th><th>systematic before / after</th>"
        "<th>N fit (deg/s/&radic;Hz)</th><th>Ljung-Box p</th><th>white</th><th>turn-on bias</th></tr>";
-  for (int c = 0; c < 6; ++c) {
+  for (int c = 0; c < 3 * r.sensors; ++c) {
     const auto& ch = r.channels[c];
     h << fmt::format("<tr><td class=l>{}</td><td>{:.4f}</td><td>{:.4f}</td><td>{:.5f}</td><td>{:.5f}</td><td>{:.5f}</td>"
                      "<td>{:.5f} / {:.5f}</td><td>{:.5f}</td><td>{:.3g}</td><td>{}</td><td>{:.4f}</td></tr>",
@@ -107,11 +107,11 @@ void where_tables(std::ostringstream& h, const CompareResult& r) {
     h << fmt::format("<tr><td>{:.1f}</td><td>{:.1f}</td><td class=l>{}</td><td>{:.2f}</td></tr>", w.t0_s, w.t1_s,
                      channel_name(w.worst_channel), w.worst_ratio);
   h << "</table>\n<h2>By regime</h2><table><tr><th>regime</th><th>samples</th>";
-  for (int c = 0; c < 6; ++c) h << "<th>" << channel_name(c) << " rms</th>";
+  for (int c = 0; c < 3 * r.sensors; ++c) h << "<th>" << channel_name(c) << " rms</th>";
   h << "</tr>";
   for (const auto& g : r.regimes) {
     h << "<tr><td class=l>" << html_escape(g.group + ": " + g.name) << "</td><td>" << g.samples << "</td>";
-    for (int c = 0; c < 6; ++c) h << fmt::format("<td>{:.5f}</td>", g.rms_dps[c]);
+    for (int c = 0; c < 3 * r.sensors; ++c) h << fmt::format("<td>{:.5f}</td>", g.rms_dps[c]);
     h << "</tr>";
   }
   h << "</table>\n";

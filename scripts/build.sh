@@ -8,5 +8,8 @@ jobs=$(nproc 2>/dev/null || echo 2)
 # ccache (when installed) keys on paths relative to the checkout, so a second clone or a second
 # build folder of the same sources reuses the objects instead of compiling them again
 export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$root} CCACHE_NOHASHDIR=${CCACHE_NOHASHDIR:-1}
+# the tests share a precompiled header; ccache caches the files compiled with it only when told
+# that the header's definitions and time stamps do not change the result
+export CCACHE_SLOPPINESS=${CCACHE_SLOPPINESS:-pch_defines,time_macros,include_file_mtime,include_file_ctime}
 cmake -S "$root" -B "$build_dir" -DCMAKE_BUILD_TYPE=${BUILD_TYPE:-Release} "$@" >/dev/null
 cmake --build "$build_dir" -j "$jobs"

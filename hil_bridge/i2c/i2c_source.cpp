@@ -45,6 +45,9 @@ void I2cSourceParams::validate() const {
   if (!(poll_timeout_s > 0.0 && stall_timeout_s > 0.0)) {
     throw std::invalid_argument("i2c: poll_timeout_s and stall_timeout_s must be > 0 s");
   }
+  if (!(wake_margin_s >= 0.0 && repoll_interval_s > 0.0)) {
+    throw std::invalid_argument("i2c: wake_margin_s must be >= 0 s and repoll_interval_s > 0 s");
+  }
   if (max_consecutive_errors < 1) throw std::invalid_argument("i2c: max_consecutive_errors must be >= 1");
   if (max_records_per_read < 1 || max_records_per_read * kRecordBytes > kFifoSizeBytes) {
     throw std::invalid_argument("i2c: max_records_per_read must be 1..73");
@@ -324,8 +327,8 @@ ReadStatus I2cSource::read(Sample& out) {
       return ReadStatus::kPending;
     }
     // sleep until the next sample is due (a little after, so it is there)
-    const double due = t0_host_s_ + (static_cast<double>(expected_index()) + 1.1) / p_.sample_rate_hz;
-    clock_.sleep_until(std::min(deadline, std::max(due, now + 1e-4)));
+    const double due = t0_host_s_ + static_cast<double>(expected_index() + 1) / p_.sample_rate_hz + p_.wake_margin_s;
+    clock_.sleep_until(std::min(deadline, std::max(due, now + p_.repoll_interval_s)));
   }
 }
 

@@ -30,6 +30,10 @@ struct I2cSourceParams {
   int max_consecutive_errors = 5; // failed transactions in a row before the device counts as gone
   int max_records_per_read = 18;  // FIFO records per I2C read (18 x 14 = 252 bytes)
   double reset_wait_s = 0.1;      // wait after DEVICE_RESET (datasheet: 100 ms), s
+  // polling: wake this long after a sample is due on the host clock (the chip's clock runs
+  // slightly apart), and when the FIFO has nothing yet, poll again this long later
+  double wake_margin_s = 2e-5;    // s
+  double repoll_interval_s = 2e-5; // s
 
   /// SMPLRT_DIV for the sample rate (throws if the rate is not reachable exactly).
   int smplrt_div() const;

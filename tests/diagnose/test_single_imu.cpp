@@ -4,8 +4,11 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <iterator>
+#include <string>
 #include <stdexcept>
 
+#include "diagnose/report.hpp"
 #include "tests/diagnose/independent_logs.hpp"
 
 namespace driftless::diagnose {
@@ -98,6 +101,15 @@ TEST(SingleImu, CleanLogIsConsistentOrOnlyItsSignalChain) {
   EXPECT_TRUE(r.verdict == Verdict::kConsistent || others_signal_chain(r, Effect::kCount)) << r.statement;
   EXPECT_NE(r.verdict, Verdict::kUnexplained) << r.statement;
   EXPECT_TRUE(nothing_on_sensor_2(r)) << r.statement;
+  // AND report.html has no row for the absent sensor's channels (no 'nan' cells)
+  const auto dir = std::filesystem::temp_directory_path() / "driftless-single-clean-report";
+  write_report(r, dir);
+  std::ifstream in(dir / "report.html");
+  const std::string html((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(html.find("gyro1_x"), std::string::npos);
+  EXPECT_EQ(html.find("gyro2_"), std::string::npos);
+  EXPECT_EQ(html.find(">nan<"), std::string::npos);
+  std::filesystem::remove_all(dir);
   // AND the candidates a single IMU cannot show are not tested: end stops and flips need
   // platforms; sensor 1's sample delay is the box time offset (one of them is tested)
   for (const auto& c : r.not_supported) {
