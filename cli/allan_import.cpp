@@ -72,6 +72,8 @@ Loaded load_imported(const InputArgs& a) {
   bool first = true;
   std::size_t nan_rows = 0;
   std::vector<bool> pending(out.channels.size(), false);
+  // one allocation per channel (growing a 40 MB vector by doubling costs more than parsing it)
+  for (auto& ch : out.channels) ch.x.reserve(reader->info().rows_estimate + reader->info().rows_estimate / 16);
   while (reader->read(b, kBlockRows)) {
     if (first && reader->info().has_time) mon.learn(b.t_s);
     first = false;

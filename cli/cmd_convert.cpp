@@ -16,6 +16,7 @@
 #include "estimator/input_error.hpp"
 #include "estimator/log.hpp"
 #include "estimator/log_metadata.hpp"
+#include "importers/ground_truth.hpp"
 #include "importers/imu_reader.hpp"
 #include "importers/stamps.hpp"
 
@@ -32,6 +33,8 @@ struct ConvertArgs {
   std::string time = "auto";       // auto | stamps | uniform
   double full_scale_dps = 0.0;     // deg/s, the gyro's range for the log's plausibility check
   std::string source_name;         // free text for the log's 'source' key
+  std::string ref;                 // ground truth to join into ref_q / ref_p (EuRoC / Vicon layout)
+  double ref_max_gap_s = 0.0;      // s, a longer ground-truth step is a gap (0: 10 median steps)
 };
 
 /// Where each log column comes from in the importer's channels (-1: absent).
@@ -119,6 +122,10 @@ TimePlan plan_time(const ConvertArgs& a, const importers::StreamInfo& info, cons
                                  fmt::join(st.describe("line"), "; ")));
   }
   if (info.has_time) p.t0_s = st.first_t_s;
+  if (info.has_time && info.epoch_s != 0) {
+    p.notes.push_back(fmt::format("t counts from the epoch {} s (the first stamp floored to whole seconds): "
+                                  "t = stamp - {} s, formed in integer ns", info.epoch_s, info.epoch_s));
+  }
   if (!p.uniform) {
     p.notes.push_back("t = the stamps");
   } else if (!info.has_time) {
@@ -156,6 +163,65 @@ Sample sample_of(const importers::ImuBlock& b, std::size_t r, const ChannelMap& 
   return s;
 }
 
+/// The ground truth joined onto the rows (--ref): the attitude by slerp, the position linearly;
+/// rows outside its span are trimmed, rows inside a gap of it get no reference (empty ref_*).
+struct RefJoin {
+  importers::GroundTruth gt;
+  std::unique_ptr<importers::PoseInterpolator> at;
+  std::uint64_t before = 0, after = 0, in_gaps = 0;
+  std::vector<std::string> notes;
+  /// Fills the sample's ref_q / ref_p; false when the row is to be trimmed.
+  bool attach(Sample& s);
+};
+
+std::unique_ptr<RefJoin> open_ref(const ConvertArgs& a, const importers::StreamInfo& info,
+                                  const importers::StampReport& st, const TimePlan& tp) {
+  if (a.ref.empty()) return nullptr;
+  if (!info.has_time) {
+    throw InputError(info.source, 0, "--ref", "the rows carry no time, so a ground truth cannot be joined onto them");
+  }
+  auto j = std::make_unique<RefJoin>();
+  j->gt = importers::read_ground_truth(a.ref);
+  const auto max_gap_ns = a.ref_max_gap_s > 0.0 ? static_cast<std::int64_t>(std::llround(a.ref_max_gap_s * 1e9))
+                                                : 10 * j->gt.median_step_ns;
+  j->at = std::make_unique<importers::PoseInterpolator>(j->gt, info.epoch_s, max_gap_ns);
+  const double imu_last_s = tp.uniform ? tp.t0_s + static_cast<double>(st.rows - 1) / tp.rate_hz : st.last_t_s;
+  if (j->at->last_s() < tp.t0_s || j->at->first_s() > imu_last_s) {
+    throw InputError(a.ref, 0, "--ref",
+                     fmt::format("the ground truth spans {:.6f}..{:.6f} s and the IMU rows {:.6f}..{:.6f} s "
+                                 "(s since the epoch {} s): they do not overlap",
+                                 j->at->first_s(), j->at->last_s(), tp.t0_s, imu_last_s, info.epoch_s));
+  }
+  j->notes.push_back(fmt::format(
+      "ref_q, ref_p = {} ({} poses, median step {:.6g} ms): attitude by slerp, position linearly, onto the IMU times; "
+      "its frame is taken as the log's reference frame (q_enu_from_body)",
+      a.ref, j->gt.poses.size(), 1e-6 * static_cast<double>(j->gt.median_step_ns)));
+  j->notes.push_back(fmt::format("IMU rows outside the ground truth's span {:.6f}..{:.6f} s are trimmed (left out); "
+                                 "rows inside a gap of more than {:.6g} s get no reference",
+                                 j->at->first_s(), j->at->last_s(), 1e-9 * static_cast<double>(max_gap_ns)));
+  return j;
+}
+
+bool RefJoin::attach(Sample& s) {
+  const importers::PoseAt p = at->at(s.t_s);
+  switch (p.where) {
+    case importers::PoseAt::Where::kBefore: return ++before, false;
+    case importers::PoseAt::Where::kAfter: return ++after, false;
+    case importers::PoseAt::Where::kGap: return ++in_gaps, true;  // ref_* stay NaN: written empty
+    case importers::PoseAt::Where::kInside: break;
+  }
+  s.set_q_enu_from_body(p.q_ref_from_body);
+  s.ref_p_enu_m = p.p_ref_m;
+  return true;
+}
+
+/// What the join did, once the rows are written.
+std::string ref_summary(const RefJoin& j) {
+  return fmt::format("ref: {} rows trimmed before the ground truth's first stamp, {} after its last; {} rows in "
+                     "its gaps without a reference",
+                     j.before, j.after, j.in_gaps);
+}
+
 int run_convert(const ConvertArgs& a) {
   const auto opt = a.input.import_options();
   auto reader = importers::open_imu(a.input.in, opt);
@@ -163,9 +229,11 @@ int run_convert(const ConvertArgs& a) {
   const ChannelMap map = map_channels(info);
   const importers::StampReport st = info.has_time ? survey_stamps(a.input.in, opt) : importers::StampReport{};
   const TimePlan tp = plan_time(a, info, st);
+  const auto ref = open_ref(a, info, st, tp);
   std::uint32_t fields = kLayoutSingleSensor;
   if (map.has_accel()) fields |= kFieldAccel;
   if (map.temp >= 0) fields |= kFieldTemp;
+  if (ref) fields |= kFieldRefQ | kFieldRefP;
   const std::filesystem::path out(a.out);
   if (out.has_parent_path()) std::filesystem::create_directories(out.parent_path());
   const double rows_estimate = st.rows > 0 ? static_cast<double>(st.rows) : 0.0;
@@ -174,16 +242,25 @@ int run_convert(const ConvertArgs& a) {
   log::LogWriter writer(out, convert_metadata(a, info, tp), fields);
   for (const auto& s : info.assumptions) writer.event(tp.t0_s, "assumed: " + s);
   for (const auto& s : tp.notes) writer.event(tp.t0_s, "time: " + s);
+  if (ref) {
+    for (const auto& s : ref->notes) writer.event(tp.t0_s, "ref: " + s);
+  }
   importers::ImuBlock block;
-  std::uint64_t k = 0;
+  std::uint64_t k = 0, written = 0;
+  double last_t = tp.t0_s;
   Progress progress("convert");
   while (!stop_requested() && reader->read(block, 65536)) {
     for (std::size_t r = 0; r < block.rows(); ++r, ++k) {
       const double t = tp.uniform ? tp.t0_s + static_cast<double>(k) / tp.rate_hz : block.t_s[r];
-      writer.write(sample_of(block, r, map, t));
+      Sample s = sample_of(block, r, map, t);
+      if (ref && !ref->attach(s)) continue;
+      writer.write(s);
+      last_t = t;
+      ++written;
     }
     if (st.rows > 0) progress.update(static_cast<double>(k) / static_cast<double>(st.rows));
   }
+  if (ref) writer.event(last_t, ref_summary(*ref));
   if (stop_requested()) {
     writer.finish(false, fmt::format("interrupted after {} rows", k));
     fmt::print(stderr, "driftless convert: interrupted; {} holds {} rows and says complete: false\n", a.out, k);
@@ -191,11 +268,15 @@ int run_convert(const ConvertArgs& a) {
   }
   writer.finish(true);
   progress.done();
-  fmt::print("{} ({}): {} rows, gyro{}{} -> {} (single-sensor log, {:.6g} Hz)\n", info.source,
+  fmt::print("{} ({}): {} rows, gyro{}{}{} -> {} (single-sensor log, {:.6g} Hz, {} rows)\n", info.source,
              importers::to_string(info.format), k, map.has_accel() ? ", accel" : "", map.temp >= 0 ? ", temperature" : "",
-             a.out, tp.rate_hz);
+             ref ? ", reference attitude" : "", a.out, tp.rate_hz, written);
   for (const auto& s : info.assumptions) fmt::print("  assumed: {}\n", s);
   for (const auto& s : tp.notes) fmt::print("  time: {}\n", s);
+  if (ref) {
+    for (const auto& s : ref->notes) fmt::print("  ref: {}\n", s);
+    fmt::print("  {}\n", ref_summary(*ref));
+  }
   for (const auto& s : st.describe("line")) fmt::print("  stamps: {}\n", s);
   return kExitOk;
 }
@@ -218,6 +299,12 @@ const bool registered = register_command(
                                                          "(MPU6050 default: 250)")
           ->check(positive_number("deg/s"));
       cmd->add_option("--source", a->source_name, "Text for the log's 'source' key (default: the file and its format)");
+      cmd->add_option("--ref", a->ref, "Ground truth to join into ref_q/ref_p (EuRoC state_groundtruth_estimate0 or "
+                                       "vicon0 data.csv: ns stamp, p x y z, q w x y z); rows outside its span are trimmed")
+          ->check(CLI::ExistingFile);
+      cmd->add_option("--ref-max-gap", a->ref_max_gap_s, "s: a longer step of the ground truth is a gap, rows in it get "
+                                                         "no reference (default: 10 of its median steps)")
+          ->check(positive_number("s"));
       return [a] { return run_convert(*a); };
     },
     Interrupt::kPolls);

@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <stdexcept>
+#include <thread>
 
 #include "estimator/allan_terms.hpp"
 
@@ -50,34 +52,84 @@ std::vector<std::size_t> explicit_sizes(std::size_t m_max, const AllanOptions& o
   return ms;
 }
 
+// one gap-free segment's phase: the cumulative sum of the mean-removed rate, S[0] = 0 (not
+// zero-filled first: every value is written once)
+struct Phase {
+  std::unique_ptr<double[]> v;
+  std::size_t size = 0;
+  const double* data() const { return v.get(); }
+};
+
+Phase phase_of(const double* r, std::size_t n, double mean) {
+  Phase S{std::make_unique_for_overwrite<double[]>(n + 1), n + 1};
+  double acc = 0.0;
+  S.v[0] = 0.0;
+  for (std::size_t i = 0; i < n; ++i) S.v[i + 1] = acc += r[i] - mean;
+  return S;
+}
+
+// the mean of the rate, refusing a NaN or an infinity by its index (four partial sums, so the
+// adds do not wait on each other)
+double finite_mean(std::span<const double> rate) {
+  const std::size_t n = rate.size();
+  double s[4] = {0.0, 0.0, 0.0, 0.0};
+  bool finite = true;
+  std::size_t i = 0;
+  for (; i + 4 <= n; i += 4) {
+    for (std::size_t k = 0; k < 4; ++k) {
+      s[k] += rate[i + k];
+      finite &= std::isfinite(rate[i + k]);
+    }
+  }
+  for (; i < n; ++i) s[0] += rate[i], finite &= std::isfinite(rate[i]);
+  if (!finite) {
+    const auto bad = std::find_if(rate.begin(), rate.end(), [](double v) { return !std::isfinite(v); });
+    throw std::invalid_argument("allan: sample " + std::to_string(bad - rate.begin()) +
+                                " is not a finite number (drop or fill NaN samples first)");
+  }
+  return ((s[0] + s[1]) + (s[2] + s[3])) / static_cast<double>(n);
+}
+
 // the non-overlapping m-averages (mean removed) of a segment from its phase, at most
 // kMaxIdClusters of them
-std::vector<double> cluster_means(const std::vector<double>& S, std::size_t m) {
-  const std::size_t k = std::min((S.size() - 1) / m, kMaxIdClusters);
+std::vector<double> cluster_means(const Phase& S, std::size_t m) {
+  const std::size_t k = std::min((S.size - 1) / m, kMaxIdClusters);
   std::vector<double> out(k);
   const double inv_m = 1.0 / static_cast<double>(m);
-  for (std::size_t c = 0; c < k; ++c) out[c] = (S[(c + 1) * m] - S[c * m]) * inv_m;
+  for (std::size_t c = 0; c < k; ++c) out[c] = (S.v[(c + 1) * m] - S.v[c * m]) * inv_m;
   return out;
 }
 
-// every level's terms over one phase array; overlapping Allan and Hadamard sums run block by
-// block across the levels, so the stretches of S one level reads are still cached for the next
-// (octave m: S[i + 2m] of one level is S[i + m'] of the next)
-void accumulate_levels(Deviation dev, const std::vector<double>& S, const std::vector<std::size_t>& ms,
-                       std::size_t stride, std::vector<TermSum>& sums) {
-  if (dev == Deviation::kModifiedAllan || stride != 1) {
-    for (std::size_t j = 0; j < ms.size(); ++j) accumulate_terms(dev, S.data(), S.size(), ms[j], stride, sums[j]);
+// the levels j = first, first + step, ... of one phase array; overlapping Allan and Hadamard sums
+// run block by block across the levels, so the stretches of S one level reads are still cached
+// for the next (octave m: S[i + 2m] of one level is S[i + m'] of the next)
+void accumulate_some_levels(Deviation dev, const Phase& S, const std::vector<std::size_t>& ms, std::size_t first,
+                            std::size_t step, std::vector<TermSum>& sums) {
+  if (dev == Deviation::kModifiedAllan) {
+    for (std::size_t j = first; j < ms.size(); j += step) accumulate_terms(dev, S.data(), S.size, ms[j], 1, sums[j]);
     return;
   }
   constexpr std::size_t kBlock = 2048;
   const std::size_t span = span_in_m(dev);
-  for (std::size_t i0 = 0; i0 < S.size(); i0 += kBlock) {
-    for (std::size_t j = 0; j < ms.size(); ++j) {
-      if (S.size() <= span * ms[j]) break;
-      const std::size_t i1 = std::min(i0 + kBlock, S.size() - span * ms[j]);
+  for (std::size_t i0 = 0; i0 < S.size; i0 += kBlock) {
+    for (std::size_t j = first; j < ms.size(); j += step) {
+      if (S.size <= span * ms[j]) break;
+      const std::size_t i1 = std::min(i0 + kBlock, S.size - span * ms[j]);
       if (i0 < i1) accumulate_range(dev, S.data(), i0, i1, ms[j], 1, sums[j]);
     }
   }
+}
+
+// every level's overlapping terms; a long record shares the levels between this thread and one
+// more (every level's sum is formed in the same order either way: the result does not depend on
+// the threads)
+constexpr std::size_t kThreadFromTerms = 1u << 21;
+
+void accumulate_levels(Deviation dev, const Phase& S, const std::vector<std::size_t>& ms, std::vector<TermSum>& sums) {
+  if (S.size * ms.size() < kThreadFromTerms || ms.size() < 2) return accumulate_some_levels(dev, S, ms, 0, 1, sums);
+  std::thread helper([&] { accumulate_some_levels(dev, S, ms, 1, 2, sums); });
+  accumulate_some_levels(dev, S, ms, 0, 2, sums);
+  helper.join();
 }
 
 struct Segments {
@@ -176,26 +228,14 @@ AllanCurve allan_deviation(std::span<const double> rate, const AllanOptions& opt
   const std::size_t n = rate.size();
   if (n < 3) throw std::invalid_argument("allan: need at least 3 samples, got " + std::to_string(n));
   // subtract the mean first: keeps the cumulative sum small, so its rounding stays far below noise
-  double mean = 0.0;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (!std::isfinite(rate[i])) {
-      throw std::invalid_argument("allan: sample " + std::to_string(i) +
-                                  " is not a finite number (drop or fill NaN samples first)");
-    }
-    mean += rate[i];
-  }
-  mean /= static_cast<double>(n);
+  const double mean = finite_mean(rate);
   const Segments segs = split_segments(n, segment_starts);
 
-  // each segment's phase (cumulative sum, starting at 0), stored one after the other
-  std::vector<std::vector<double>> phase(segs.begin.size());
+  // each segment's phase (cumulative sum, starting at 0)
+  std::vector<Phase> phase;
   std::size_t longest = 0;
-  for (std::size_t s = 0; s < phase.size(); ++s) {
-    auto& S = phase[s];
-    S.resize(segs.length[s] + 1);
-    S[0] = 0.0;
-    const double* r = rate.data() + segs.begin[s];
-    for (std::size_t i = 0; i < segs.length[s]; ++i) S[i + 1] = S[i] + (r[i] - mean);
+  for (std::size_t s = 0; s < segs.begin.size(); ++s) {
+    phase.push_back(phase_of(rate.data() + segs.begin[s], segs.length[s], mean));
     if (segs.length[s] > segs.length[longest]) longest = s;
   }
 
@@ -212,10 +252,10 @@ AllanCurve allan_deviation(std::span<const double> rate, const AllanOptions& opt
   const std::vector<std::size_t> ms = cluster_sizes(segs.length[longest], opt, &curve.notes);
   std::vector<TermSum> sums(ms.size());
   if (curve.overlapping) {
-    for (const auto& S : phase) accumulate_levels(opt.deviation, S, ms, 1, sums);
+    for (const auto& S : phase) accumulate_levels(opt.deviation, S, ms, sums);
   } else {
     for (std::size_t j = 0; j < ms.size(); ++j) {
-      for (const auto& S : phase) accumulate_terms(opt.deviation, S.data(), S.size(), ms[j], ms[j], sums[j]);
+      for (const auto& S : phase) accumulate_terms(opt.deviation, S.data(), S.size, ms[j], ms[j], sums[j]);
     }
   }
   for (std::size_t j = 0; j < ms.size(); ++j) {

@@ -6,6 +6,7 @@
 
 #include "importers/imu_reader.hpp"
 #include "importers/reader_factories.hpp"
+#include "importers/stamp_ns.hpp"
 #include "importers/units.hpp"
 
 #ifdef DRIFTLESS_HAVE_ROSBAG
@@ -31,6 +32,8 @@ class BagReader : public ImuReader {
 
  private:
   std::string choose_topic(const ImportOptions& opt);
+  void set_epoch();
+  static std::int64_t ns_of(const ros::Time& t) { return static_cast<std::int64_t>(t.sec) * 1'000'000'000 + t.nsec; }
   rosbag::Bag bag_;
   std::string topic_;
   std::unique_ptr<rosbag::View> view_;
@@ -64,6 +67,20 @@ std::string BagReader::choose_topic(const ImportOptions& opt) {
                                                 : ": several sensor_msgs/Imu topics: give --topic (the bag has: " + list + ")"));
 }
 
+// the first message's stamp (or receive time when the stamps are zero), floored to whole seconds
+void BagReader::set_epoch() {
+  if (it_ == view_->end()) return;
+  try {
+    const auto m = it_->instantiate<sensor_msgs::Imu>();
+    if (!m) return;
+    receive_time_ = m->header.stamp.isZero();
+    if (receive_time_) info_.assumptions.push_back("header stamps are zero: the bag's receive times are used");
+    info_.epoch_s = epoch_s_of(ns_of(receive_time_ ? it_->getTime() : m->header.stamp));
+  } catch (const std::exception& e) {
+    throw ImportError(where(1) + ": cannot read (" + e.what() + ")");
+  }
+}
+
 BagReader::BagReader(const std::filesystem::path& path, const ImportOptions& opt) {
   info_.source = path.string();
   info_.format = Format::kBag;
@@ -75,6 +92,8 @@ BagReader::BagReader(const std::filesystem::path& path, const ImportOptions& opt
   topic_ = choose_topic(opt);
   view_ = std::make_unique<rosbag::View>(bag_, rosbag::TopicQuery(topic_));
   it_ = view_->begin();
+  info_.rows_estimate = view_->size();
+  set_epoch();
   info_.has_time = true;
   if (!opt.units.empty()) {
     rate_scale_ = parse_rate_unit(opt.units, "--units").scale;
@@ -94,11 +113,7 @@ bool BagReader::read(ImuBlock& out, std::size_t max_rows) {
       ++index_;
       const auto m = it_->instantiate<sensor_msgs::Imu>();
       if (!m) throw ImportError(where(index_) + ": not a sensor_msgs/Imu message");
-      if (index_ == 1 && m->header.stamp.isZero()) {
-        receive_time_ = true;
-        info_.assumptions.push_back("header stamps are zero: the bag's receive times are used");
-      }
-      out.t_s.push_back(receive_time_ ? it_->getTime().toSec() : m->header.stamp.toSec());
+      out.t_s.push_back(seconds_since(ns_of(receive_time_ ? it_->getTime() : m->header.stamp), info_.epoch_s));
       const double w[3] = {m->angular_velocity.x, m->angular_velocity.y, m->angular_velocity.z};
       const double a[3] = {m->linear_acceleration.x, m->linear_acceleration.y, m->linear_acceleration.z};
       for (int k = 0; k < 3; ++k) {

@@ -51,11 +51,16 @@ struct StreamInfo {
   Format format = Format::kText;          // the format read (after detection)
   std::vector<ChannelInfo> channels;
   bool has_time = false;                  // rows carry a timestamp (s)
+  std::int64_t epoch_s = 0;               // s, whole: the first stamp floored; ImuBlock::t_s counts from it
+                                          // (the difference formed in integers, so ns epoch stamps keep ns)
   double nominal_rate_hz = 0.0;           // Hz, from the file's own metadata (0: none)
+  std::uint64_t rows_estimate = 0;        // rows to expect: exact for .npy and bags, from the size and
+                                          // the first lines for text (0: unknown); for reserving memory
   std::vector<std::string> assumptions;   // what was detected or assumed, one sentence each
 };
 
-/// A block of rows, channel-major: values[c][r]; t_s[r] (NaN when no time); loc[r] the source
+/// A block of rows, channel-major: values[c][r]; t_s[r] in s since StreamInfo::epoch_s (NaN when no
+/// time); loc[r] the source
 /// line (text) or message number (bag), 1-based, for messages.
 struct ImuBlock {
   std::vector<double> t_s;

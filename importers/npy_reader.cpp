@@ -4,12 +4,14 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <algorithm>
 #include <cstring>
 #include <limits>
 #include <string>
 
 #include "importers/imu_reader.hpp"
 #include "importers/reader_factories.hpp"
+#include "importers/stamp_ns.hpp"
 #include "importers/units.hpp"
 
 namespace driftless::importers {
@@ -18,6 +20,14 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 enum class Dtype { kF8, kF4, kI2, kI4, kI8 };
+
+// a little-endian element of type T at p, as a double
+template <class T>
+double load_as(const unsigned char* p) {
+  T v;
+  std::memcpy(&v, p, sizeof v);
+  return static_cast<double>(v);
+}
 
 struct NpyHeader {
   Dtype dtype = Dtype::kF8;
@@ -85,7 +95,9 @@ class NpyReader : public ImuReader {
   std::string where(std::uint64_t loc) const override { return info_.source + ": row " + std::to_string(loc); }
 
  private:
-  double value(const unsigned char* p) const;
+  void column(std::size_t offset, std::size_t rows, double scale, double* out) const;
+  void stamps(std::size_t rows, double* t_s) const;
+  void set_epoch();
   std::FILE* f_ = nullptr;
   NpyHeader h_;
   std::vector<int> pick_;      // channel -> column
@@ -120,6 +132,7 @@ NpyReader::NpyReader(const std::filesystem::path& path, const ImportOptions& opt
   info_.format = Format::kNpy;
   if (!opt.time_column.empty() && opt.time_column != "none") time_col_ = column_index(opt.time_column, h_.cols, file, "--time-column");
   info_.has_time = time_col_ >= 0;
+  info_.rows_estimate = h_.rows;
   if (time_col_ >= 0) time_scale_ = opt.time_units.empty() ? 1.0 : parse_time_unit(opt.time_units, "--time-units").scale;
   const Unit ru = opt.units.empty() ? Unit{1.0, "deg/s"} : parse_rate_unit(opt.units, "--units");
   for (const auto& c : opt.columns) pick_.push_back(column_index(c, h_.cols, file, "--columns"));
@@ -137,17 +150,58 @@ NpyReader::NpyReader(const std::filesystem::path& path, const ImportOptions& opt
                                                 : "rates in " + ru.name + " (as given)");
   if (time_col_ < 0) info_.assumptions.push_back("no time column: the rate must come from --rate");
   std::fseek(f_, h_.data_offset, SEEK_SET);
+  set_epoch();
+  std::fseek(f_, h_.data_offset, SEEK_SET);
 }
 
-double NpyReader::value(const unsigned char* p) const {
+// one column of a block of rows, scaled: the element type chosen once per column, not per value
+void NpyReader::column(std::size_t offset, std::size_t rows, double scale, double* out) const {
+  const std::size_t stride = h_.item * h_.cols;
+  const unsigned char* p = raw_.data() + offset;
+  auto copy = [&]<class T>(T) {
+    for (std::size_t r = 0; r < rows; ++r) out[r] = load_as<T>(p + r * stride) * scale;
+  };
   switch (h_.dtype) {
-    case Dtype::kF8: { double v; std::memcpy(&v, p, 8); return v; }
-    case Dtype::kF4: { float v; std::memcpy(&v, p, 4); return v; }
-    case Dtype::kI2: { std::int16_t v; std::memcpy(&v, p, 2); return v; }
-    case Dtype::kI4: { std::int32_t v; std::memcpy(&v, p, 4); return v; }
-    case Dtype::kI8: { std::int64_t v; std::memcpy(&v, p, 8); return static_cast<double>(v); }
+    case Dtype::kF8: return copy(double{});
+    case Dtype::kF4: return copy(float{});
+    case Dtype::kI2: return copy(std::int16_t{});
+    case Dtype::kI4: return copy(std::int32_t{});
+    case Dtype::kI8: return copy(std::int64_t{});
   }
-  return kNaN;
+}
+
+// the stamps of a block in s from the epoch: integer stamps (ns counts) subtracted in integers
+void NpyReader::stamps(std::size_t rows, double* t_s) const {
+  const std::size_t stride = h_.item * h_.cols;
+  const unsigned char* p = raw_.data() + static_cast<std::size_t>(time_col_) * h_.item;
+  const std::int64_t ns_per_unit = ns_per_unit_of(time_scale_);
+  if (h_.dtype == Dtype::kI8 && ns_per_unit > 0) {
+    for (std::size_t r = 0; r < rows; ++r) {
+      std::int64_t v;
+      std::memcpy(&v, p + r * stride, sizeof v);
+      t_s[r] = seconds_since(v * ns_per_unit, info_.epoch_s);
+    }
+    return;
+  }
+  column(static_cast<std::size_t>(time_col_) * h_.item, rows, time_scale_, t_s);
+  for (std::size_t r = 0; r < rows; ++r) t_s[r] -= static_cast<double>(info_.epoch_s);
+}
+
+// the epoch: the first row's stamp floored to whole seconds
+void NpyReader::set_epoch() {
+  if (time_col_ < 0 || h_.rows == 0) return;
+  raw_.resize(h_.item * h_.cols);
+  if (std::fread(raw_.data(), 1, raw_.size(), f_) != raw_.size()) return;
+  const std::int64_t ns_per_unit = ns_per_unit_of(time_scale_);
+  if (h_.dtype == Dtype::kI8 && ns_per_unit > 0) {
+    std::int64_t v;
+    std::memcpy(&v, raw_.data() + static_cast<std::size_t>(time_col_) * h_.item, sizeof v);
+    info_.epoch_s = epoch_s_of(v * ns_per_unit);
+  } else {
+    double t = 0.0;
+    column(static_cast<std::size_t>(time_col_) * h_.item, 1, time_scale_, &t);
+    if (std::isfinite(t)) info_.epoch_s = static_cast<std::int64_t>(std::floor(t));
+  }
 }
 
 bool NpyReader::read(ImuBlock& out, std::size_t max_rows) {
@@ -156,21 +210,22 @@ bool NpyReader::read(ImuBlock& out, std::size_t max_rows) {
   const std::uint64_t rows = std::min<std::uint64_t>(max_rows, h_.rows - next_);
   if (rows == 0) return false;
   const std::size_t row_bytes = h_.item * h_.cols;
-  raw_.resize(static_cast<std::size_t>(rows) * row_bytes);
+  const auto n = static_cast<std::size_t>(rows);
+  raw_.resize(n * row_bytes);
   const std::size_t got = std::fread(raw_.data(), 1, raw_.size(), f_);
   if (got != raw_.size()) {
     throw ImportError(where(next_ + got / row_bytes + 1) + ": the file ends before the " + std::to_string(h_.rows) +
                       " rows its header promises");
   }
-  for (auto& v : out.values) v.resize(static_cast<std::size_t>(rows));
-  out.t_s.resize(static_cast<std::size_t>(rows));
-  out.loc.resize(static_cast<std::size_t>(rows));
-  for (std::size_t r = 0; r < rows; ++r) {
-    const unsigned char* row = raw_.data() + r * row_bytes;
-    for (std::size_t c = 0; c < pick_.size(); ++c) out.values[c][r] = value(row + static_cast<std::size_t>(pick_[c]) * h_.item) * scale_[c];
-    out.t_s[r] = time_col_ >= 0 ? value(row + static_cast<std::size_t>(time_col_) * h_.item) * time_scale_ : kNaN;
-    out.loc[r] = next_ + r + 1;
+  for (std::size_t c = 0; c < pick_.size(); ++c) {
+    out.values[c].resize(n);
+    column(static_cast<std::size_t>(pick_[c]) * h_.item, n, scale_[c], out.values[c].data());
   }
+  out.t_s.resize(n);
+  if (time_col_ >= 0) stamps(n, out.t_s.data());
+  else std::fill(out.t_s.begin(), out.t_s.end(), kNaN);
+  out.loc.resize(n);
+  for (std::size_t r = 0; r < n; ++r) out.loc[r] = next_ + r + 1;
   next_ += rows;
   return true;
 }

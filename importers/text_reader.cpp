@@ -2,12 +2,17 @@
 // streamed in 8 MB chunks, only the used fields parsed (fast_float).
 #include "importers/text_reader.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <exception>
 #include <limits>
+#include <thread>
 
 #include <fast_float/fast_float.h>
+
+#include "importers/stamp_ns.hpp"
 
 namespace driftless::importers {
 namespace {
@@ -27,6 +32,23 @@ bool parse_span(const char* b, const char* e, double& out) {
   return parse_field(std::string_view(b, static_cast<std::size_t>(e - b)), out);  // "nan" spellings
 }
 
+// rows in the file if every line is as long as those of the first chunk
+std::uint64_t estimate_rows(std::string_view head, std::uintmax_t file_bytes) {
+  const auto lines = static_cast<std::size_t>(std::count(head.begin(), head.end(), '\n'));
+  if (lines == 0 || head.empty()) return 0;
+  const double bytes_per_line = static_cast<double>(head.size()) / static_cast<double>(lines);
+  return static_cast<std::uint64_t>(static_cast<double>(file_bytes) / bytes_per_line) + 1;
+}
+
+// the rows of `from` behind those of `to`
+void append_block(ImuBlock& to, const ImuBlock& from) {
+  to.t_s.insert(to.t_s.end(), from.t_s.begin(), from.t_s.end());
+  to.loc.insert(to.loc.end(), from.loc.begin(), from.loc.end());
+  for (std::size_t c = 0; c < to.values.size(); ++c) {
+    to.values[c].insert(to.values[c].end(), from.values[c].begin(), from.values[c].end());
+  }
+}
+
 }  // namespace
 
 TextReader::TextReader(const std::filesystem::path& path, const ImportOptions& opt, bool euroc) : path_(path.string()) {
@@ -43,6 +65,7 @@ TextReader::TextReader(const std::filesystem::path& path, const ImportOptions& o
   info_.format = euroc ? Format::kEuroc : Format::kText;
   info_.has_time = layout_.time_index >= 0;
   info_.nominal_rate_hz = layout_.nominal_rate_hz;
+  info_.rows_estimate = estimate_rows(head, std::filesystem::file_size(path));
   info_.assumptions = layout_.assumptions;
   slot_.assign(layout_.fields, -1);
   for (std::size_t c = 0; c < layout_.picks.size(); ++c) {
@@ -50,6 +73,7 @@ TextReader::TextReader(const std::filesystem::path& path, const ImportOptions& o
     slot_[static_cast<std::size_t>(layout_.picks[c].index)] = static_cast<int>(c);
   }
   if (layout_.time_index >= 0) slot_[static_cast<std::size_t>(layout_.time_index)] = kTimeSlot;
+  if (info_.has_time) set_epoch(head);
   std::rewind(file_);
 }
 
@@ -59,37 +83,89 @@ TextReader::~TextReader() {
 
 std::string ImuReader::where(std::uint64_t loc) const { return info_.source + ":" + std::to_string(loc); }
 
+// the unread tail moved to the front, then one more chunk read behind it
+void TextReader::refill() {
+  const std::size_t carry = len_ - pos_;
+  if (carry + kChunk > cap_) {
+    const std::size_t cap = std::max(2 * kChunk, carry + kChunk);
+    auto bigger = std::make_unique_for_overwrite<char[]>(cap);
+    if (carry > 0) std::memcpy(bigger.get(), buf_.get() + pos_, carry);
+    buf_ = std::move(bigger);
+    cap_ = cap;
+  } else if (carry > 0) {
+    std::memmove(buf_.get(), buf_.get() + pos_, carry);
+  }
+  pos_ = 0;
+  len_ = carry;
+  const std::size_t got = std::fread(buf_.get() + len_, 1, kChunk, file_);
+  len_ += got;
+  if (got == 0) {
+    if (std::ferror(file_)) throw ImportError(path_ + ": read error: " + std::strerror(errno));
+    eof_ = true;
+  }
+}
+
 bool TextReader::next_line(std::string_view& line) {
   for (;;) {
-    const void* nl = pos_ < buf_.size() ? std::memchr(buf_.data() + pos_, '\n', buf_.size() - pos_) : nullptr;
+    const char* base = buf_.get();
+    const void* nl = pos_ < len_ ? std::memchr(base + pos_, '\n', len_ - pos_) : nullptr;
     if (nl != nullptr) {
-      const std::size_t end = static_cast<std::size_t>(static_cast<const char*>(nl) - buf_.data());
-      line = std::string_view(buf_.data() + pos_, end - pos_);
+      const std::size_t end = static_cast<std::size_t>(static_cast<const char*>(nl) - base);
+      line = std::string_view(base + pos_, end - pos_);
       pos_ = end + 1;
       ++line_no_;
       return true;
     }
     if (eof_) {
-      if (pos_ >= buf_.size()) return false;
-      line = std::string_view(buf_.data() + pos_, buf_.size() - pos_);
-      pos_ = buf_.size();
+      if (pos_ >= len_) return false;
+      line = std::string_view(base + pos_, len_ - pos_);
+      pos_ = len_;
       ++line_no_;
       return true;
     }
-    buf_.erase(0, pos_);
-    pos_ = 0;
-    const std::size_t old = buf_.size();
-    buf_.resize(old + kChunk);
-    const std::size_t got = std::fread(buf_.data() + old, 1, kChunk, file_);
-    buf_.resize(old + got);
-    if (got == 0) {
-      if (std::ferror(file_)) throw ImportError(path_ + ": read error: " + std::strerror(errno));
-      eof_ = true;
+    refill();
+  }
+}
+
+// the epoch: the first data row's stamp, floored to whole seconds (docs/import.md, time)
+void TextReader::set_epoch(std::string_view head) {
+  ns_per_unit_ = ns_per_unit_of(layout_.time_scale);
+  std::size_t line_no = 0, b = 0;
+  std::vector<std::string_view> fields;
+  for (std::size_t e = 0; b < head.size(); b = e + 1) {
+    e = std::min(head.find('\n', b), head.size());
+    if (++line_no < layout_.data_line) continue;
+    split_fields(head.substr(b, e - b), layout_.separator, fields);
+    if (fields.size() != layout_.fields) continue;
+    const auto& f = fields[static_cast<std::size_t>(layout_.time_index)];
+    std::int64_t ns = 0;
+    double v = 0.0;
+    if (ns_per_unit_ > 0 && parse_stamp_ns(f.data(), f.data() + f.size(), ns_per_unit_, ns)) {
+      info_.epoch_s = epoch_s_of(ns);
+      return;
+    }
+    if (parse_field(f, v) && std::isfinite(v)) {
+      info_.epoch_s = static_cast<std::int64_t>(std::floor(v * layout_.time_scale));
+      return;
     }
   }
 }
 
-void TextReader::parse_row(std::string_view line, ImuBlock& out) {
+bool TextReader::stamp_s(const char* b, const char* e, double& t_s) const {
+  while (b < e && (*b == ' ' || *b == '\t')) ++b;
+  while (e > b && (e[-1] == ' ' || e[-1] == '\t' || e[-1] == '\r')) --e;
+  std::int64_t ns = 0;
+  if (ns_per_unit_ > 0 && parse_stamp_ns(b, e, ns_per_unit_, ns)) {
+    t_s = seconds_since(ns, info_.epoch_s);
+    return true;
+  }
+  double v = 0.0;
+  if (!parse_span(b, e, v)) return false;
+  t_s = v * layout_.time_scale - static_cast<double>(info_.epoch_s);
+  return true;
+}
+
+void TextReader::parse_row(std::string_view line, std::uint64_t line_no, ImuBlock& out) const {
   const char sep = layout_.separator;
   const char* p = line.data();
   const char* e = p + line.size();
@@ -112,36 +188,89 @@ void TextReader::parse_row(std::string_view line, ImuBlock& out) {
     }
     if (k < slot_.size() && slot_[k] != -1) {
       double v = 0.0;
-      if (!parse_span(p, q, v)) {
+      const bool ok = slot_[k] == kTimeSlot ? stamp_s(p, q, t) : parse_span(p, q, v);
+      if (!ok) {
         const std::string name = slot_[k] == kTimeSlot ? "time" : info_.channels[static_cast<std::size_t>(slot_[k])].name;
-        throw ImportError(where(line_no_) + ": column '" + name + "' (" + std::to_string(k + 1) +
+        throw ImportError(where(line_no) + ": column '" + name + "' (" + std::to_string(k + 1) +
                           "): expected a number, got '" + std::string(p, q) + "'");
       }
-      if (slot_[k] == kTimeSlot) t = v * layout_.time_scale;
-      else out.values[static_cast<std::size_t>(slot_[k])][row] = v * layout_.picks[static_cast<std::size_t>(slot_[k])].scale;
+      if (slot_[k] != kTimeSlot) {
+        out.values[static_cast<std::size_t>(slot_[k])][row] = v * layout_.picks[static_cast<std::size_t>(slot_[k])].scale;
+      }
     }
     ++k;
     if (q == e) break;
     p = q + 1;
   }
   if (k != layout_.fields) {
-    throw ImportError(where(line_no_) + ": expected " + std::to_string(layout_.fields) + " fields as in line " +
+    throw ImportError(where(line_no) + ": expected " + std::to_string(layout_.fields) + " fields as in line " +
                       std::to_string(layout_.data_line) + ", got " + std::to_string(k));
   }
   out.t_s.push_back(t);
-  out.loc.push_back(line_no_);
+  out.loc.push_back(line_no);
+}
+
+void TextReader::take_line(std::string_view line, std::uint64_t line_no, ImuBlock& out) const {
+  if (line_no < layout_.data_line) return;
+  std::size_t i = 0;
+  while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == '\r')) ++i;
+  if (i == line.size() || line[i] == '#' || line[i] == '%') return;
+  parse_row(line, line_no, out);
+}
+
+void TextReader::parse_lines(const char* b, const char* e, std::uint64_t first_line, ImuBlock& out) const {
+  for (std::uint64_t no = first_line; b < e; ++no) {
+    const char* nl = static_cast<const char*>(std::memchr(b, '\n', static_cast<std::size_t>(e - b)));
+    const char* end = nl == nullptr ? e : nl;
+    take_line(std::string_view(b, static_cast<std::size_t>(end - b)), no, out);
+    b = end + 1;
+  }
+}
+
+bool TextReader::parse_buffered_in_two(ImuBlock& out, std::size_t room) {
+  constexpr std::size_t kMinBytes = 1u << 20;
+  if (!eof_ && len_ - pos_ < kChunk / 2) refill();
+  // whole lines only, and no more bytes than rows may still come (a line holds at most one row)
+  const char* b = buf_.get() + pos_;
+  const char* e = b + std::min(len_ - pos_, room);
+  while (e > b && e[-1] != '\n') --e;
+  if (static_cast<std::size_t>(e - b) < kMinBytes) return false;
+  const char* half = b + (e - b) / 2;
+  const char* mid = static_cast<const char*>(std::memchr(half, '\n', static_cast<std::size_t>(e - half))) + 1;
+  const auto first_half_lines = static_cast<std::uint64_t>(std::count(b, mid, '\n'));
+  const auto lines = first_half_lines + static_cast<std::uint64_t>(std::count(mid, e, '\n'));
+  side_.clear();
+  side_.values.resize(out.values.size());
+  std::exception_ptr side_error;
+  std::thread helper([&] {
+    try {
+      parse_lines(mid, e, line_no_ + first_half_lines + 1, side_);
+    } catch (...) {
+      side_error = std::current_exception();
+    }
+  });
+  try {
+    parse_lines(b, mid, line_no_ + 1, out);
+  } catch (...) {
+    helper.join();  // the earlier line's error is the one reported
+    throw;
+  }
+  helper.join();
+  if (side_error) std::rethrow_exception(side_error);
+  append_block(out, side_);
+  pos_ += static_cast<std::size_t>(e - b);
+  line_no_ += lines;
+  return true;
 }
 
 bool TextReader::read(ImuBlock& out, std::size_t max_rows) {
   out.clear();
   out.values.resize(info_.channels.size());
   std::string_view line;
-  while (out.rows() < max_rows && next_line(line)) {
-    if (line_no_ < layout_.data_line) continue;
-    std::size_t i = 0;
-    while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == '\r')) ++i;
-    if (i == line.size() || line[i] == '#' || line[i] == '%') continue;
-    parse_row(line, out);
+  while (out.rows() < max_rows) {
+    if (parse_buffered_in_two(out, max_rows - out.rows())) continue;
+    if (!next_line(line)) break;
+    take_line(line, line_no_, out);
   }
   return out.rows() > 0;
 }

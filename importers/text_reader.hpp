@@ -4,6 +4,7 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -23,16 +24,29 @@ class TextReader : public ImuReader {
  private:
   static constexpr int kTimeSlot = -2;
   bool next_line(std::string_view& line);
-  void parse_row(std::string_view line, ImuBlock& out);
+  void refill();
+  /// Parses the whole lines of [b, e), the first being line `first_line`, into `out`.
+  void parse_lines(const char* b, const char* e, std::uint64_t first_line, ImuBlock& out) const;
+  /// One line: skipped (preamble, blank, comment) or parsed.
+  void take_line(std::string_view line, std::uint64_t line_no, ImuBlock& out) const;
+  void parse_row(std::string_view line, std::uint64_t line_no, ImuBlock& out) const;
+  /// Parses the buffered whole lines (at most `room` of them) in two halves on two threads;
+  /// false when too few are buffered to be worth a thread.
+  bool parse_buffered_in_two(ImuBlock& out, std::size_t room);
+  /// The stamp field [b, e) in s from the epoch; false when not a number.
+  bool stamp_s(const char* b, const char* e, double& t_s) const;
+  void set_epoch(std::string_view head);
 
   std::string path_;
   std::FILE* file_ = nullptr;
   TextLayout layout_;
   std::vector<int> slot_;  // field -> channel, kTimeSlot, or -1 (not read)
-  std::string buf_;
-  std::size_t pos_ = 0;
-  std::size_t line_no_ = 0;
+  std::unique_ptr<char[]> buf_;  // not zero-filled: each chunk is read over it
+  std::size_t cap_ = 0, len_ = 0, pos_ = 0;
+  std::uint64_t line_no_ = 0;
   bool eof_ = false;
+  std::int64_t ns_per_unit_ = 0;  // the time unit in ns (0: not a power of ten of s)
+  ImuBlock side_;                 // the second half of a two-thread parse
 };
 
 }  // namespace driftless::importers

@@ -1,4 +1,6 @@
-// Unit names of the importers and their factors to the project's units (docs/import.md, units).
+// The importers' units: the one unit table (estimator/units.hpp) read for rates, accelerations
+// and time, by key suffix or spelling, case-insensitive, with the factor to the project's unit
+// (deg/s, m/s^2, s); plus the raw-count form lsb:<LSB per unit>. docs/import.md, units.
 #pragma once
 
 #include <optional>

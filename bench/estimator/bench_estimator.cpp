@@ -1,4 +1,4 @@
-// Estimator speed: overlapping ADEV of 14 h at 100 Hz, `estimate` on a 14 h log (CSV parsing
+// Estimator speed (the Allan analysis: bench_allan.cpp): `estimate` on a 14 h log (CSV parsing
 // included), and the per-sample cost of the live push() path.
 #include <cmath>
 #include <filesystem>
@@ -7,7 +7,6 @@
 
 #include <benchmark/benchmark.h>
 
-#include "estimator/allan.hpp"
 #include "estimator/filter.hpp"
 #include "estimator/log.hpp"
 #include "estimator/pipeline.hpp"
@@ -17,22 +16,6 @@ namespace {
 
 using namespace driftless;
 
-constexpr std::size_t k14hSamples = 5'040'000;  // 14 h at 100 Hz
-
-void BM_AdevOctave14h(benchmark::State& state) {
-  std::mt19937_64 rng(1);
-  std::normal_distribution<double> g(0.0, 0.05);
-  std::vector<double> x(k14hSamples);
-  for (auto& v : x) v = 1.0 + g(rng);
-  est::AllanOptions opt;
-  opt.sample_rate_hz = 100.0;
-  for (auto _ : state) {
-    auto curve = est::allan_deviation(x, opt);
-    benchmark::DoNotOptimize(curve.points.data());
-  }
-  state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * k14hSamples));
-}
-BENCHMARK(BM_AdevOctave14h)->Unit(benchmark::kMillisecond)->Iterations(3);
 
 test::SynthParams live_params(double duration_s) {
   test::SynthParams p;

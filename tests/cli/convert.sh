@@ -45,13 +45,45 @@ awk -F, -v r="$row" 'BEGIN { split(r, c, ","); exit !(c[1] == 0.01 && c[2] + 408
 
 # 3. EuRoC: regular ns stamps are the log's time
 awk -F, 'NR == 1 { print "#timestamp [ns],w_RS_S_x [rad s^-1],w_RS_S_y [rad s^-1],w_RS_S_z [rad s^-1],a_RS_S_x [m s^-2],a_RS_S_y [m s^-2],a_RS_S_z [m s^-2]"; next }
-  NR < 2000 { printf "%.0f,%.17g,%.17g,%.17g,0,0,9.81\n", 1403636579758555392 + (NR - 2) * 5000000, $5 / 57.29577951308232, $6 / 57.29577951308232, $7 / 57.29577951308232 }' \
+  NR < 2000 { ns = 758555392 + (NR - 2) * 5000000  # the 1.4e18 ns stamp written exactly (awk numbers are doubles)
+    printf "%d%09d,%.17g,%.17g,%.17g,0,0,9.81\n", 1403636579 + int(ns / 1e9), ns % 1000000000, $5 / 57.29577951308232, $6 / 57.29577951308232, $7 / 57.29577951308232 }' \
   "$real" > "$t/data.csv"
 "$bin" convert --in "$t/data.csv" --out "$t/euroc.csv" > "$t/euroc.txt" || { cat "$t/euroc.txt"; fail "EuRoC"; }
 grep -q "t = the stamps" "$t/euroc.txt" || fail "EuRoC stamps not used: $(cat "$t/euroc.txt")"
-# (epoch stamps in ns held as double seconds resolve 2.4e-7 s: the median 5 ms step is good to 1e-4)
-awk -v r="$(meta "$t/euroc.csv" sample_rate_hz)" 'BEGIN { exit !(r > 199.98 && r < 200.02) }' ||
+# the epoch (first stamp floored to whole seconds) is subtracted in integer ns: the 5 ms steps stay
+# exact (as double seconds, 1.4e9 s resolves only 2.4e-7 s), the rate is 200 Hz to 1e-9
+grep -q "epoch 1403636579 s" "$t/euroc.txt" || fail "the epoch is not said: $(cat "$t/euroc.txt")"
+grep -q "^# event: .*epoch 1403636579 s" "$t/euroc.csv" || fail "the epoch is not in the log's events"
+awk -v r="$(meta "$t/euroc.csv" sample_rate_hz)" 'BEGIN { d = r - 200; exit !(d < 1e-7 && d > -1e-7) }' ||
   fail "EuRoC rate: $(meta "$t/euroc.csv" sample_rate_hz)"
+awk -F, '!/^#/ && !/^t,/ { if (n++ > 0) { d = $1 - p - 0.005; if (d > 1e-9 || d < -1e-9) { print "step " $1 - p " at t " $1; exit 1 } } p = $1 }
+' "$t/euroc.csv" || fail "EuRoC steps are not 5 ms"
+[[ $(awk -F, '!/^#/ && !/^t,/ { print $1; exit }' "$t/euroc.csv") == 0.758555 ]] || fail "EuRoC first t is not stamp - epoch"
+
+# 3b. --ref: a EuRoC ground truth (a rotation about z at 0.2 rad/s, stamps 2.5 ms off the IMU's)
+# covering IMU rows 100..1500 of 0..1997: ref_q by slerp, the other rows trimmed, and both said
+awk 'BEGIN { print "#timestamp, p_RS_R_x [m], p_RS_R_y [m], p_RS_R_z [m], q_RS_w [], q_RS_x [], q_RS_y [], q_RS_z [], v_RS_R_x [m s^-1]"
+  for (j = 0; j <= 1401; ++j) { ns = 758555392 + 500000000 - 2500000 + j * 5000000; a = 0.2 * ns / 1e9
+    printf "%d%09d,%.9f,0,0,%.17g,0,0,%.17g,0\n", 1403636579 + int(ns / 1e9), ns % 1000000000, ns / 1e9, cos(a / 2), sin(a / 2) } }' \
+  > "$t/gt.csv"
+"$bin" convert --in "$t/data.csv" --ref "$t/gt.csv" --out "$t/euroc_ref.csv" > "$t/euroc_ref.txt" ||
+  { cat "$t/euroc_ref.txt"; fail "convert --ref"; }
+grep -q "100 rows trimmed before the ground truth's first stamp, 497 after its last" "$t/euroc_ref.txt" ||
+  fail "the trimming is not said: $(cat "$t/euroc_ref.txt")"
+grep -q "^# event: .*100 rows trimmed before" "$t/euroc_ref.csv" || fail "the trimming is not in the log's events"
+[[ $(grep -vc '^#\|^t,' "$t/euroc_ref.csv") == 1401 ]] || fail "rows with a reference: $(grep -vc '^#\|^t,' "$t/euroc_ref.csv")"
+grep -q "^t,gyro1_x,.*ref_qw,ref_qx,ref_qy,ref_qz,ref_px,ref_py,ref_pz" "$t/euroc_ref.csv" ||
+  fail "ref columns: $(grep -m1 '^t,' "$t/euroc_ref.csv")"
+# every row's ref_q is the closed form at its t (slerp is exact for a constant axis and rate)
+awk -F, '/^t,/ { for (i = 1; i <= NF; ++i) c[$i] = i; next }
+  !/^#/ && c["t"] { a = 0.2 * $c["t"]; e = $c["ref_qw"] - cos(a / 2); f = $c["ref_qz"] - sin(a / 2)
+    if (e * e + f * f > 1e-12) { print "t " $1 ": " $c["ref_qw"] " " $c["ref_qz"]; bad = 1; exit } }
+  END { exit bad }' "$t/euroc_ref.csv" || fail "ref_q is not the slerp of the ground truth"
+"$bin" check --log "$t/euroc_ref.csv" > "$t/check_ref.txt" || { cat "$t/check_ref.txt"; fail "check refuses the log with ref_q"; }
+# a ground truth that does not overlap the IMU rows is refused, naming both spans
+awk 'NR <= 3 { sub(/^140363/, "140360"); print }' "$t/gt.csv" > "$t/gt_far.csv"
+out=$("$bin" convert --in "$t/data.csv" --ref "$t/gt_far.csv" --out "$t/far.csv" 2>&1) && fail "a ground truth far away was joined"
+echo "$out" | grep -q "gt_far.csv.*do not overlap" || fail "message for a ground truth that does not overlap: $out"
 
 # 4. refusals: a stamp that steps back with --time stamps; two triads without --columns
 printf 't,gx,gy,gz\n0.00,1,2,3\n0.01,1,2,3\n0.005,1,2,3\n0.02,1,2,3\n' > "$t/back.csv"

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "import_fixture.hpp"
+#include "importers/stamp_ns.hpp"
 #include "importers/stamps.hpp"
 
 namespace driftless::importers::test {
@@ -48,6 +49,29 @@ TEST(Stamps, RealBurstyArrivalStampsAreNotGaps) {
   EXPECT_EQ(r.gaps, 0u);
   EXPECT_NEAR(r.mean_rate_hz(), 99.3, 0.3);
   EXPECT_GT(r.largest_step_s, 0.3);
+}
+
+TEST(StampNs, DecimalStampsBecomeWholeNanosecondsExactly) {
+  auto ns_of = [](const std::string& s, std::int64_t per_unit) {
+    std::int64_t ns = -1;
+    return parse_stamp_ns(s.data(), s.data() + s.size(), per_unit, ns) ? ns : std::int64_t{-1};
+  };
+  // ns integers, seconds with 9 or 6 decimals, milliseconds with a fraction
+  EXPECT_EQ(ns_of("1403636579758555392", 1), 1403636579758555392LL);
+  EXPECT_EQ(ns_of("1403636579.758555392", 1'000'000'000), 1403636579758555392LL);
+  EXPECT_EQ(ns_of("1403636579.758555", 1'000'000'000), 1403636579758555000LL);
+  EXPECT_EQ(ns_of("12.5", 1'000'000), 12'500'000LL);
+  EXPECT_EQ(ns_of("-0.25", 1'000'000'000), -250'000'000LL);
+  // not plain decimals: refused, so the reader falls back to a double
+  EXPECT_EQ(ns_of("1.4e9", 1'000'000'000), -1);
+  EXPECT_EQ(ns_of("nan", 1), -1);
+  EXPECT_EQ(ns_of("99999999999999999999", 1), -1);  // 20 digits: not 64-bit
+  // the epoch floors (also below zero), and the difference is formed in integers
+  EXPECT_EQ(epoch_s_of(1403636579758555392LL), 1403636579);
+  EXPECT_EQ(epoch_s_of(-1), -1);
+  EXPECT_NEAR(seconds_since(1403636579758555392LL + 5'000'000LL * 1000, 1403636579), 5.758555392, 1e-15);
+  EXPECT_EQ(ns_per_unit_of(1e-3), 1'000'000);
+  EXPECT_EQ(ns_per_unit_of(0.5), 0);
 }
 
 }  // namespace

@@ -132,7 +132,11 @@ TEST(TextImport, ColumnsByIndexSeparatorAndTimeUnitsFromTheStep) {
   write_text(dir / "b.csv", n);
   auto rb = open_imu(dir / "b.csv", {});
   const Table tb = read_all(*rb);
-  EXPECT_NEAR(tb.t[1] - tb.t[0], 0.005, 1e-6);
+  // and the 1.4e18 ns stamps keep their 5 ms steps to 1e-9 s (as double seconds they resolve only
+  // 2.4e-7 s): the epoch, the first stamp floored to whole seconds, is subtracted in integers
+  EXPECT_EQ(rb->info().epoch_s, 1403636579);
+  EXPECT_NEAR(tb.t[0], 0.758555392, 1e-12);
+  for (std::size_t i = 1; i < tb.t.size(); ++i) EXPECT_NEAR(tb.t[i] - tb.t[i - 1], 0.005, 1e-9) << i;
 }
 
 TEST(TextImport, MissingValuesAreNaNAndBadRowsNameFileAndLine) {
@@ -174,6 +178,46 @@ TEST(TextImport, MissingValuesAreNaNAndBadRowsNameFileAndLine) {
   o.columns = {"9"};
   EXPECT_THROW(open_imu(dir / "ok.csv", o), ImportError);
   EXPECT_THROW(open_imu(dir / "absent.csv", {}), ImportError);
+}
+
+}  // namespace
+}  // namespace driftless::importers::test
+
+namespace driftless::importers::test {
+namespace {
+
+TEST(TextImport, LongFilesParsedOnTwoThreadsGiveTheSameRowsAndLineNumbers) {
+  // GIVEN a 3 MB file (the reader parses whole buffered stretches of 1 MB and more on two threads)
+  const auto dir = scratch("two_threads");
+  std::string text = "# a comment line\nt,gx,gy,gz\n";
+  for (int i = 0; i < 120000; ++i) {
+    text += std::to_string(i) + "." + std::to_string(100 + i % 900) + "," + std::to_string(i % 7) + ",0.5,-1\n";
+    if (i == 70000) text += "# a comment between rows\n";
+  }
+  write_text(dir / "long.csv", text);
+  // WHEN it is read in large blocks (two threads) and in small ones (line by line)
+  ImportOptions o;
+  o.time_units = "s";
+  auto big = open_imu(dir / "long.csv", o);
+  auto small = open_imu(dir / "long.csv", o);
+  const Table a = read_all(*big, 1u << 20), b = read_all(*small, 1000);
+  // THEN both hold every row with the same values, stamps and line numbers
+  ASSERT_EQ(a.t.size(), 120000u);
+  ASSERT_EQ(b.t.size(), 120000u);
+  EXPECT_EQ(a.t, b.t);
+  EXPECT_EQ(a.ch, b.ch);
+  EXPECT_EQ(a.loc, b.loc);
+  EXPECT_EQ(a.loc[70001], 70001u + 2 + 2);  // after the header, the first comment and the one between rows
+  // and a bad value late in the file is named by its own line, whichever thread parsed it
+  text.replace(text.rfind(",0.5,"), 5, ",x.5,");
+  write_text(dir / "bad.csv", text);
+  try {
+    auto r = open_imu(dir / "bad.csv", o);
+    read_all(*r, 1u << 20);
+    FAIL() << "junk accepted";
+  } catch (const ImportError& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.csv:120003: column 'gy' (3)"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace
