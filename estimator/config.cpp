@@ -64,6 +64,7 @@ const fields::Table<C>& config_table() {
       fields::number<C>("noise_density", "dps_rthz", &C::noise_density_dps_rthz),
       fields::number<C>("q_override_dps2_per_s", "", &C::q_override_dps2_per_s),
       fields::number<C>("r_override_dps2", "", &C::r_override_dps2),
+      fields::number<C>("scale_misalign_sigma", "frac", &C::scale_misalign_sigma_frac),
       fields::number<C>("settle", "s", &C::settle_s),
       fields::number<C>("standstill_period", "s", &C::standstill_period_s),
       fields::number<C>("temp_coef_sigma", "dps_per_degc", &C::temp_coef_sigma_dps_per_degc),

@@ -9,6 +9,8 @@
 
 #include <Eigen/Core>
 
+#include "estimator/mpu6050.hpp"
+
 namespace driftless::est {
 
 /// paper: H_k switches by k mod 4 as in eq. (5), 6-dim stacked residuals of consecutive
@@ -100,6 +102,10 @@ struct EstimatorConfig {
   // the rms row norm). General mode only.
   bool self_calibration = false;
   double gsens_sigma_dps_per_g = 0.1 / 1.7320508075688772;
+  // ... and each sensor's scale-factor and misalignment error E_i (9 states, y_i = (I + E_i) w_i),
+  // driven by the fused body rate over each standstill; prior sigma per element (fraction):
+  // mpu6050::kScaleMisalignSigmaFrac. 0 = off (E_i stays 0).
+  double scale_misalign_sigma_frac = mpu6050::kScaleMisalignSigmaFrac;
   // a box known to stand still on the Earth (a lab test like the paper's Fig. 4/5 runs): each
   // standstill also measures the fused rate about "up" (from the accel columns, else ref_q) as the
   // vertical Earth rate, Omega sin(latitude); that observes the bias common to both sensors about

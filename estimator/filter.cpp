@@ -82,6 +82,7 @@ void EstimatorConfig::validate() const {
   non_negative(q_override_dps2_per_s, "q_override_dps2_per_s", "(deg/s)^2/s (0 = from spec)");
   non_negative(r_override_dps2, "r_override_dps2", "(deg/s)^2 (0 = from noise density)");
   non_negative(gsens_sigma_dps_per_g, "gsens_sigma_dps_per_g", "deg/s per g");
+  non_negative(scale_misalign_sigma_frac, "scale_misalign_sigma_frac", "fraction");
   positive(box_rest_rate_sigma_dps, "box_rest_rate_sigma_dps", "deg/s");
   if (mode == FilterMode::kPaper && (self_calibration || box_at_rest)) {
     throw std::invalid_argument("estimator config: self_calibration and box_at_rest need mode: general");
@@ -165,6 +166,9 @@ DriftlessFilter::DriftlessFilter(const EstimatorConfig& cfg, const BoxGeometry& 
   // the g-sensitivities start at 0 with the spec's sigma in self-calibrating mode, else stay 0
   if (has_gsens_states()) {
     P_.diagonal().segment<18>(kGSens1.start).setConstant(cfg_.gsens_sigma_dps_per_g * cfg_.gsens_sigma_dps_per_g);
+  }
+  if (has_scale_states()) {
+    P_.diagonal().segment<18>(kScale1.start).setConstant(cfg_.scale_misalign_sigma_frac * cfg_.scale_misalign_sigma_frac);
   }
   gate3_ = cfg_.nis_gate_probability < 1.0 ? chi2_quantile(cfg_.nis_gate_probability, 3.0)
                                            : std::numeric_limits<double>::infinity();
@@ -276,6 +280,17 @@ Eigen::Matrix3d DriftlessFilter::g_sensitivity_dps_per_g(int sensor) const {
 
 Eigen::Matrix3d DriftlessFilter::g_sensitivity_sigma_dps_per_g(int sensor) const {
   const Eigen::Index o = sensor == 1 ? kGSens1.start : kGSens2.start;
+  const Eigen::Matrix<double, 9, 1> sd = P_.diagonal().segment<9>(o).cwiseSqrt();
+  return Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(sd.data());
+}
+
+Eigen::Matrix3d DriftlessFilter::scale_misalign(int sensor) const {
+  const Eigen::Index o = sensor == 1 ? kScale1.start : kScale2.start;
+  return Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(x_.data() + o);
+}
+
+Eigen::Matrix3d DriftlessFilter::scale_misalign_sigma(int sensor) const {
+  const Eigen::Index o = sensor == 1 ? kScale1.start : kScale2.start;
   const Eigen::Matrix<double, 9, 1> sd = P_.diagonal().segment<9>(o).cwiseSqrt();
   return Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(sd.data());
 }
@@ -443,6 +458,28 @@ void DriftlessFilter::residual_rows(const StandstillSegment& s, const Eigen::Mat
   // (its mean over the standstill scatters about its value at the midpoint)
   const double var = cfg_.sample_variance_dps2(rate_hz) / double(s.n) + q_rate_dps2_per_s_ * s.span_s() / 12.0;
   cur.R = var * (M1 * M1.transpose() + M2 * M2.transpose());
+  if (has_scale_states()) scale_rows(s, M1, M2, cur);
+}
+
+// self-calibration: y_i = (I + E_i) w_i + ..., so eq. (2) gains M1 E1 w1 - M2 E2 w2 with w_i the
+// true rate over the standstill in sensor-i axes. Averages are linear: the mean rate enters. It is
+// taken from the fused body rate w = (M1 (y1 - b1) + M2 (y2 - b2)) / 2 at the current estimate
+// (an error of the estimate times E is second order), w_i = M_i^T w. While the bias is not yet
+// known, that error is not small: each row of M_i E_i dw carries 3 terms of variance
+// sigma_E^2 sigma_b^2 per sensor, added to R (6 sigma_E^2 sigma_b^2, the largest sigmas). A box that barely turns
+// (w ~ the Earth rate) leaves E at its prior; a box turning through a standstill observes the
+// sensors' relative E along the axes it turns about (docs/estimator.md section 1c)
+void DriftlessFilter::scale_rows(const StandstillSegment& s, const Eigen::Matrix3d& M1, const Eigen::Matrix3d& M2,
+                                 Residual3& cur) {
+  const double sb = std::sqrt(P_.diagonal().head<kStateDim>().maxCoeff());
+  const double se = std::sqrt(P_.diagonal().segment<18>(kScale1.start).maxCoeff());
+  cur.R.diagonal().array() += 6.0 * se * se * sb * sb;
+  // each sensor's rate with the current E removed, (I - E_i)(y_i - b_i), fused in box axes
+  const Eigen::Vector3d u1 = s.mean_gyro1_dps() - bias1_dps(), u2 = s.mean_gyro2_dps() - bias2_dps();
+  const Eigen::Vector3d w_body = 0.5 * (M1 * (u1 - scale_misalign(1) * u1) + M2 * (u2 - scale_misalign(2) * u2));
+  last_w_dps_ = {M1.transpose() * w_body, M2.transpose() * w_body};
+  cur.H.block<3, 9>(0, kScale1.start) = gsens_jacobian(M1, last_w_dps_[0]);
+  cur.H.block<3, 9>(0, kScale2.start) = -gsens_jacobian(M2, last_w_dps_[1]);
 }
 
 // a box at rest: the mean of the two sensors' rates about "up" is the vertical Earth rate,
@@ -466,6 +503,10 @@ bool DriftlessFilter::rest_row(const StandstillSegment& s, const Eigen::Matrix3d
     h.segment<9>(kGSens1.start) = 0.5 * up.transpose() * gsens_jacobian(M1, last_f_g_[0]);
     h.segment<9>(kGSens2.start) = 0.5 * up.transpose() * gsens_jacobian(M2, last_f_g_[1]);
   }
+  if (has_scale_states()) {
+    h.segment<9>(kScale1.start) = 0.5 * up.transpose() * gsens_jacobian(M1, last_w_dps_[0]);
+    h.segment<9>(kScale2.start) = 0.5 * up.transpose() * gsens_jacobian(M2, last_w_dps_[1]);
+  }
   var_z = 0.25 * var_r + cfg_.box_rest_rate_sigma_dps * cfg_.box_rest_rate_sigma_dps;
   return true;
 }
@@ -475,6 +516,11 @@ void DriftlessFilter::fuse_rate(const Sample& s, const StandstillStep& st) {
   const Vector6d b = bias_at(s);
   out_.y1c_dps = s.gyro1_dps - b.segment<3>(kBias1.start);
   out_.y2c_dps = s.gyro2_dps - b.segment<3>(kBias2.start);
+  if (has_scale_states()) {
+    // w_i = (I + E_i)^-1 (y_i - o_i) = (I - E_i) (y_i - o_i) to first order in E
+    out_.y1c_dps -= scale_misalign(1) * out_.y1c_dps;
+    out_.y2c_dps -= scale_misalign(2) * out_.y2c_dps;
+  }
   out_.plat1_deg = st.plat1_deg;
   out_.plat2_deg = st.plat2_deg;
   out_.at_rest = st.plat1_rest && st.plat2_rest && finite(st.plat1_deg) && finite(st.plat2_deg);

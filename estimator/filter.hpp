@@ -39,7 +39,13 @@ inline constexpr StateSlice kTempCoef2{9, 3};
 // columns (docs/estimator.md section 1b); frozen at 0 (P = 0) unless self_calibration is on
 inline constexpr StateSlice kGSens1{12, 9};
 inline constexpr StateSlice kGSens2{21, 9};
-inline constexpr int kFullStateDim = 30;
+// self-calibrating mode: each sensor's scale-factor and misalignment error E_i (dimensionless,
+// sensor axes, row-major like G_i): y_i = (I + E_i) w_i + b_i + ..., w_i the true rate in sensor-i
+// axes; driven by the fused body rate averaged over each standstill (docs/estimator.md section
+// 1c); frozen at 0 (P = 0) unless self_calibration is on and scale_misalign_sigma_frac > 0
+inline constexpr StateSlice kScale1{30, 9};
+inline constexpr StateSlice kScale2{39, 9};
+inline constexpr int kFullStateDim = 48;
 using StateVector = Eigen::Matrix<double, kFullStateDim, 1>;
 using StateMatrix = Eigen::Matrix<double, kFullStateDim, kFullStateDim>;
 
@@ -144,11 +150,15 @@ class DriftlessFilter {
   Eigen::Matrix3d g_sensitivity_dps_per_g(int sensor) const;
   Eigen::Matrix3d g_sensitivity_sigma_dps_per_g(int sensor) const;
   bool has_gsens_states() const { return cfg_.self_calibration && cfg_.gsens_sigma_dps_per_g > 0.0; }
+  /// scale-factor and misalignment error E_i of sensor 1 or 2 (fraction) and each element's sigma.
+  Eigen::Matrix3d scale_misalign(int sensor) const;
+  Eigen::Matrix3d scale_misalign_sigma(int sensor) const;
+  bool has_scale_states() const { return cfg_.self_calibration && cfg_.scale_misalign_sigma_frac > 0.0; }
   /// Sigma of the correction the filter applies, o_i = b_i + G_i f_i at the specific force of
   /// the last update (deg/s): what "locked" means. The bias sigma without self-calibration; with
   /// it, b_i alone may stay unobservable (a g-sensitivity along a fixed gravity looks like bias).
   Vector6d correction_sigma_dps() const;
-  /// The whole state [b1; b2; k1; k2; G1; G2] and its covariance (units as above).
+  /// The whole state [b1; b2; k1; k2; G1; G2; E1; E2] and its covariance (units as above).
   const StateVector& state() const { return x_; }
   const StateMatrix& full_covariance() const { return P_; }
   /// Temperatures (degC) the bias estimate refers to; NaN until the first one is known.
@@ -189,6 +199,8 @@ class DriftlessFilter {
               const Eigen::Matrix<double, D, D>& R, UpdateRecord& rec);
   void emit_update(const UpdateRecord& rec, bool accepted);
   void fuse_rate(const Sample& s, const StandstillStep& st);
+  void scale_rows(const StandstillSegment& seg, const Eigen::Matrix3d& M1, const Eigen::Matrix3d& M2,
+                  Residual3& out);
   void skip_paper_step();
 
   EstimatorConfig cfg_;
@@ -200,6 +212,8 @@ class DriftlessFilter {
   StateMatrix P_ = StateMatrix::Identity();
   // specific force (g, sensor axes) of the last update that had accel columns, per sensor
   std::array<Eigen::Vector3d, 2> last_f_g_{Eigen::Vector3d::Constant(kNaN), Eigen::Vector3d::Constant(kNaN)};
+  // mean true rate (deg/s, sensor axes) of the last standstill, per sensor (scale states)
+  std::array<Eigen::Vector3d, 2> last_w_dps_{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
   std::array<double, 2> temp_ref_c_{kNaN, kNaN};  // degC, temperatures x_'s bias refers to
   int consecutive_rejections_ = 0;
   double t_filter_s_ = kNaN;  // time P and x refer to

@@ -64,4 +64,12 @@ inline double sample_rate_hz(int dlpf_cfg, int smplrt_div) {
 inline constexpr double kTempLsbPerDegC = 340.0;
 inline constexpr double kTempOffsetDegC = 36.53;
 
+/// Gyro sensitivity scale factor tolerance at 25 degC, +-3 % (datasheet table 6.1), and
+/// cross-axis sensitivity, +-2 %. As 3-sigma limits: 1 % and 0.67 % per element; the prior of the
+/// self-calibrating scale/misalignment states takes the larger, 1 % (fraction 0.01), for every
+/// element (the mounting's fraction of a degree adds about 0.35 % off the diagonal).
+inline constexpr double kGyroScaleTolerancePct = 3.0;
+inline constexpr double kGyroCrossAxisPct = 2.0;
+inline constexpr double kScaleMisalignSigmaFrac = kGyroScaleTolerancePct / 3.0 / 100.0;
+
 }  // namespace driftless::mpu6050
