@@ -175,8 +175,9 @@ CompareResult compare(const Replay& r, const CompareModel& model, const CompareO
   NoiseModelFindings nm;
   AfterFit after;
   for (int pass = 0; pass < 3; ++pass) {
+    after = AfterFit{};  // the last pass's per-sample series go before the selection runs again
     sel = select_effects(si);
-    after = residual_after(ch, in, res, sel.spec, sel.fit, true);
+    after = residual_after(ch, in, res, sel.spec, sel.fit, AfterDetail::kSamples);
     nm = noise_model_candidates(r, res, ch, model, after, opt.evidence_threshold);
     if (pass == 2 || !adopt_drift(nm, res, ch)) break;
     out.notes.push_back("the bias drifts otherwise than the model's noise processes say: the effects were selected "
@@ -185,7 +186,7 @@ CompareResult compare(const Replay& r, const CompareModel& model, const CompareO
   out.selected = std::move(sel.selected);
   out.not_supported = std::move(sel.not_supported);
   out.notes.insert(out.notes.end(), sel.notes.begin(), sel.notes.end());
-  const AfterFit before = residual_after(ch, in, res, FitSpec{}, FitResult{}, true);
+  const AfterFit before = residual_after(ch, in, res, FitSpec{}, FitResult{}, AfterDetail::kStats);
   out.noise_model = std::move(nm.supported);
   out.not_supported.insert(out.not_supported.end(), nm.not_supported.begin(), nm.not_supported.end());
   // 5: where it fails, and the verdict
