@@ -16,6 +16,7 @@
 #include "diagnose/selection.hpp"
 #include "diagnose/signal_chain.hpp"
 #include "diagnose/summary.hpp"
+#include "estimator/mpu6050.hpp"
 
 namespace driftless::diagnose {
 namespace {
@@ -69,6 +70,19 @@ bool adopt_drift(const NoiseModelFindings& nm, const Residual& res, Channels& ch
   for (ChannelData& C : ch)
     if (C.present) rebuild_gram(C, res.block_series);
   return true;
+}
+
+// a constant offset between gyro and reference larger than the sensor's zero-rate tolerance
+// (and 3 sigma of the model's turn-on spread: the MPU6050 default's 20/3 deg/s gives the
+// datasheet's +-20 deg/s) is no turn-on bias: the reference shows a rotation the gyro
+// does not (a drifting or mis-framed ref_q, a wrong Earth rate) or the gyro is in other units
+void flag_offsets_beyond_zro(const CompareModel& model, int channels, CompareResult& out) {
+  for (int c = 0; c < channels; ++c) {
+    const twin::ConstantBiasParams& cb = model.sensor[c / 3].constant_bias;
+    const double spread_dps = cb.enabled ? cb.sigma_dps[c % 3] : 0.0;
+    const double limit_dps = std::max(mpu6050::kGyroZroToleranceDps, 3.0 * spread_dps);
+    if (std::abs(out.channels[static_cast<std::size_t>(c)].turn_on_bias_dps) > limit_dps) out.offset_beyond_zro.push_back(c);
+  }
 }
 
 std::vector<int> axes_of(const Candidate& c, int s) {
@@ -194,6 +208,7 @@ CompareResult compare(const Replay& r, const CompareModel& model, const CompareO
   for (const auto& c : out.selected) apply_candidate(selected_model, c);
   summarise_channels(ch, res, model, selected_model, before, after, opt, out);
   summarise_regimes(r, res, ch, after, opt, out);
+  flag_offsets_beyond_zro(model, res.channels(), out);
   plot_series(res, after, out);
   decide_verdict(out);
   return out;
