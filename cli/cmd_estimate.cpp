@@ -251,9 +251,10 @@ const bool registered = register_command(30, [](CLI::App& app) {
                   "_dps, _dps_rthz, _dps2; docs/estimator.md)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--calib", a->calib,
-                  "Calibration file from 'driftless calibrate' (calib.yaml): the matrices M per "
-                  "sensor and end stop (deg/s in, deg/s out) replace the hinge rotations; "
-                  "docs/calibration.md")
+                  "Calibration file (calib.yaml) from 'driftless calibrate' (the matrices M per sensor and "
+                  "end stop replace the hinge rotations; its G, deg/s per g, is subtracted) or from "
+                  "'estimate --selfcal --calib-out' (G, and the temperature states start at its "
+                  "coefficients, deg/s per degC); docs/calibration.md")
       ->check(CLI::ExistingFile);
   auto* calib_out = cmd->add_option(
       "--calib-out", a->calib_out,
@@ -261,7 +262,8 @@ const bool registered = register_command(30, [](CLI::App& app) {
       "coefficients (deg/s per degC), each with its 1-sigma, as calib.yaml for --calib on the next "
       "log of the same sensors (M stays nominal); docs/calibration.md");
   cmd->add_option("--prior-out", a->prior_out,
-                  "With --calib-out: the same as a twin model-config file (simulate --model)")
+                  "With --calib-out: the same as a twin model-config file (a scenario's model: block; "
+                  "compare/diagnose/render --model)")
       ->needs(calib_out);
   cmd->add_flag("--corrected", a->corrected,
                 "Also write corrected.csv: the corrected gyro and fused rates per log row (deg/s), about "

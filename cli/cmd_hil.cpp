@@ -10,9 +10,11 @@
 #include <fmt/core.h>
 
 #include "cli/command.hpp"
+#include "cli/hil_fdi.hpp"
 #include "estimator/filter.hpp"
 #include "estimator/log.hpp"
 #include "estimator/log_metadata.hpp"
+#include "hil_bridge/cpu_latency.hpp"
 #include "hil_bridge/live_loop.hpp"
 #include "hil_bridge/source_rig.hpp"
 
@@ -20,7 +22,7 @@ namespace driftless::cli {
 namespace {
 
 struct HilOptions {
-  std::string source, switch_to, out_dir, estimator_config, scenario, emu_sensor;
+  std::string source, switch_to, out_dir, estimator_config, scenario, emu_sensor, emu_fault;
   std::string twin_flips = "scenario";
   double at_s = kNaN;
   double duration_s = kNaN;
@@ -30,17 +32,31 @@ struct HilOptions {
   int baud = 921600;
   std::uint64_t seed = 1;
   bool realtime = false;
+  bool fdi = false;
+  bool allow_deep_idle = false;
 };
 
 std::string vec3(const Eigen::Vector3d& v) { return fmt::format("{:+.4f} {:+.4f} {:+.4f}", v.x(), v.y(), v.z()); }
 
-int run_hil(const HilOptions& o) {
-  if (!o.switch_to.empty() && std::isnan(o.at_s)) {
-    throw std::invalid_argument("hil: --switch-to needs --at T (session time of the switch, s)");
+// A session paced by the wall clock (hardware, emu-serial, --realtime) polls its source on time;
+// ask Linux to keep the cores out of deep idle states while it runs (docs/hil.md "Speed").
+std::unique_ptr<hil::CpuLatencyRequest> hold_cpus_awake(const HilOptions& o, const hil::SourceRig& first,
+                                                        const hil::SourceRig* second) {
+  auto paced = [](const hil::SourceRig& r) { return dynamic_cast<const hil::SteadyClock*>(r.clock) != nullptr; };
+  if (o.allow_deep_idle || !(paced(first) || (second && paced(*second)))) return nullptr;
+  auto req = std::make_unique<hil::CpuLatencyRequest>(0);
+  if (req->held()) {
+    fmt::print("driftless hil: holding the CPUs out of deep idle states while the session runs (PM QoS 0 us; "
+               "--allow-deep-idle to save power)\n");
+  } else {
+    fmt::print(stderr, "driftless hil: note: could not keep the CPUs out of deep idle states ({}): wake-up "
+               "latency may add tens of microseconds on an idle machine\n", req->why_not());
   }
-  if (o.switch_to.empty() && !std::isnan(o.at_s)) throw std::invalid_argument("hil: --at needs --switch-to SOURCE");
-  std::filesystem::create_directories(o.out_dir);
+  return req;
+}
 
+// what the source rigs need of the options; refuses combinations that cannot work
+hil::RigOptions rig_options(const HilOptions& o) {
   hil::RigOptions ro;
   ro.realtime = o.realtime;
   ro.sample_rate_hz = o.rate_hz;
@@ -57,6 +73,25 @@ int run_hil(const HilOptions& o) {
   if (ro.twin_bridge_flips && o.source != "twin" && o.switch_to != "twin") {
     throw std::invalid_argument("hil: --twin-flips bridge needs the twin source (--source twin or --switch-to twin)");
   }
+  if (!o.emu_fault.empty()) {
+    const auto emulated = [](const std::string& s) { return s == "emu-i2c" || s == "emu-serial"; };
+    if (!emulated(o.source) && !emulated(o.switch_to)) {
+      throw std::invalid_argument("hil: --emu-fault plants a fault into the emulated chips: it needs --source (or "
+                                  "--switch-to) emu-i2c or emu-serial");
+    }
+    ro.emu_fault = hil::parse_planted_fault(o.emu_fault);
+  }
+  return ro;
+}
+
+int run_hil(const HilOptions& o) {
+  if (!o.switch_to.empty() && std::isnan(o.at_s)) {
+    throw std::invalid_argument("hil: --switch-to needs --at T (session time of the switch, s)");
+  }
+  if (o.switch_to.empty() && !std::isnan(o.at_s)) throw std::invalid_argument("hil: --at needs --switch-to SOURCE");
+  std::filesystem::create_directories(o.out_dir);
+
+  const hil::RigOptions ro = rig_options(o);
   auto first = hil::make_source_rig(o.source, ro);
   std::unique_ptr<hil::SourceRig> second;
   if (!o.switch_to.empty()) second = hil::make_source_rig(o.switch_to, ro);
@@ -84,6 +119,7 @@ int run_hil(const HilOptions& o) {
     meta.set("switch_to", second->source->name());
     log::set_number(meta, "switch_at_s", o.at_s);
   }
+  if (ro.emu_fault.planted()) meta.set("emu_fault", ro.emu_fault.describe());
   std::uint32_t fields = first->source->fields() | (second ? second->source->fields() : 0u);
 
   est::EstimatorConfig cfg;
@@ -101,7 +137,15 @@ int run_hil(const HilOptions& o) {
   if (!std::isnan(o.duration_s)) lp.duration_s = o.duration_s;
   lp.switch_at_s = o.at_s;
   hil::SteadyClock wall;
+  const auto latency_request = hold_cpus_awake(o, *first, second.get());
   hil::LiveLoop loop(lp, wall, &writer, &filter);
+  std::unique_ptr<hil::FdiWatch> fdi;
+  if (o.fdi) {
+    est::FdiParams fp;
+    fp.sample_rate_hz = info.sample_rate_hz;
+    fdi = std::make_unique<hil::FdiWatch>(fp);
+    loop.set_fdi(fdi.get());
+  }
   loop.set_motors(first->source, first->motors, first->schedule);
   if (second) loop.set_motors(second->source, second->motors, second->schedule);
   // the terminal view: bias estimates as they converge
@@ -154,7 +198,10 @@ int run_hil(const HilOptions& o) {
   fmt::print("log: {}\n", log_path.string());
   if (!st.complete) throw std::runtime_error("hil: " + st.end_reason + "; the log so far is " + log_path.string() +
                                              " (complete: false)");
-  return 0;
+  if (!fdi) return 0;
+  const std::filesystem::path fdi_json = std::filesystem::path(o.out_dir) / "fdi.json";
+  write_fdi_json(fdi_json, *fdi);
+  return report_fdi(*fdi, fdi_json);
 }
 
 const bool registered = register_command(60, [](CLI::App& app) {
@@ -169,6 +216,9 @@ const bool registered = register_command(60, [](CLI::App& app) {
   cmd->add_flag("--realtime", o->realtime,
                 "Pace the twin, replays and emu-i2c by the wall clock (default: as fast as possible; "
                 "hardware and emu-serial always run in real time)");
+  cmd->add_flag("--allow-deep-idle", o->allow_deep_idle,
+                "Do not ask Linux to keep the CPUs out of deep idle states during a session paced by the wall "
+                "clock (saves power; wake-ups can then be tens of microseconds later)");
   cmd->add_option("--duration", o->duration_s, "Session time to run, s (default: until the source ends)");
   cmd->add_option("--rate", o->rate_hz, "Sample rate of i2c, serial and emulated sources, Hz")->default_val(100.0);
   cmd->add_option("--standstill", o->standstill_s, "Flip schedule hold time at each position, s")->default_val(10.0);
@@ -177,6 +227,12 @@ const bool registered = register_command(60, [](CLI::App& app) {
   cmd->add_option("--emu-sensor", o->emu_sensor,
                   "emu-i2c, emu-serial: drive the emulated chips with the twin's sensor model preset "
                   "(mpu6050, ideal) instead of the built-in biases + white noise");
+  cmd->add_option("--emu-fault", o->emu_fault,
+                  "emu-i2c, emu-serial: plant a sensor fault in the emulated chips: stuck:S:A@T (axis A of sensor S "
+                  "sticks at its value from source time T s) or bias:S:A:DPS@T (adds DPS deg/s); S 1|2, A x|y|z");
+  cmd->add_flag("--fdi", o->fdi,
+                "Run fault detection beside the estimator (docs/fdi.md): 'fdi:' event lines, DIR/fdi.json, and "
+                "exit 1 when a sensor fault is detected or the run was too short to monitor");
   cmd->add_option("--twin-flips", o->twin_flips,
                   "twin: who flips the platforms: scenario (its flip_schedule, inside the simulator) or "
                   "bridge (the bridge's flip schedule commands the twin's servos, --standstill s hold)")

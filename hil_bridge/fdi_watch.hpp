@@ -1,0 +1,53 @@
+// Fault detection on the live stream (docs/fdi.md, docs/hil.md "Fault detection"): the
+// estimator's FaultDetector beside the DriftLess filter of the live loop. Each sample the loop
+// has pushed goes in with the filter's push status; what changed (the residual noise learned,
+// the first alarm, the fault isolated) comes out as one event line for the log and the terminal.
+// Per sample it costs one CUSUM update; never throws.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "estimator/fdi.hpp"
+#include "estimator/filter.hpp"
+#include "estimator/sample.hpp"
+
+namespace driftless::hil {
+
+/// What the watch concluded by the end of a run.
+enum class FdiVerdict {
+  kNotMonitored,  // the detector never finished learning the residual noise (too little rest)
+  kHealthy,       // monitored, no alarm
+  kAlarm,         // an alarm that was not (yet) isolated to a sensor and axis
+  kFault,         // a fault isolated: see detector().fault()
+};
+const char* to_string(FdiVerdict v);
+
+class FdiWatch {
+ public:
+  /// `params.sample_rate_hz` must be the stream's rate (Hz); throws std::invalid_argument naming
+  /// the field on a bad value.
+  explicit FdiWatch(const est::FdiParams& params);
+
+  /// Feeds the sample the filter just took (`status` from its push). Returns an event text when
+  /// the detector's state changed ("fdi: ..."), "" otherwise.
+  std::string push(const Sample& s, est::PushStatus status, const est::DriftlessFilter& filter);
+
+  FdiVerdict verdict() const;
+  const est::FaultDetector& detector() const { return fdi_; }
+  const est::FdiParams& params() const { return params_; }
+  /// Samples in which the residual was tested (both platforms at rest, filter in a standstill).
+  std::uint64_t rest_samples() const { return rest_samples_; }
+  /// Session time at which the detector finished learning and started monitoring, s (NaN before).
+  double t_learned_s() const { return t_learned_s_; }
+
+ private:
+  est::FdiParams params_;
+  est::FaultDetector fdi_;
+  est::FdiStatus last_ = est::FdiStatus::kLearning;
+  bool learned_ = false, alarmed_ = false;
+  std::uint64_t rest_samples_ = 0;
+  double t_learned_s_ = kNaN;
+};
+
+}  // namespace driftless::hil
