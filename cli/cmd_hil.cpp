@@ -143,7 +143,7 @@ int run_hil(const HilOptions& o) {
   if (o.fdi) {
     est::FdiParams fp;
     fp.sample_rate_hz = info.sample_rate_hz;
-    fdi = std::make_unique<hil::FdiWatch>(fp);
+    fdi = std::make_unique<hil::FdiWatch>(fp, cfg.end_margin_s);
     loop.set_fdi(fdi.get());
   }
   loop.set_motors(first->source, first->motors, first->schedule);

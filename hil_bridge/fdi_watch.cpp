@@ -1,6 +1,8 @@
 // The live fault detection (see fdi_watch.hpp).
 #include "hil_bridge/fdi_watch.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 #include "estimator/fdi_input.hpp"
@@ -17,11 +19,33 @@ const char* to_string(FdiVerdict v) {
   return "?";
 }
 
-FdiWatch::FdiWatch(const est::FdiParams& params) : params_(params), fdi_(params) {}
+FdiWatch::FdiWatch(const est::FdiParams& params, double end_margin_s)
+    : params_(params),
+      fdi_(params),
+      margin_samples_(static_cast<std::size_t>(std::lround(std::max(0.0, end_margin_s) * params.sample_rate_hz))) {}
 
 std::string FdiWatch::push(const Sample& s, est::PushStatus status, const est::DriftlessFilter& filter) {
   if (last_ == est::FdiStatus::kIsolated) return {};  // single fault: latched (docs/fdi.md)
-  const est::FdiInput in = est::fdi_input(s, status, filter);
+  est::FdiInput in = est::fdi_input(s, status, filter);
+  // motion: the held rest samples may already carry it (the switch opens late): not at rest
+  if (!in.at_rest) {
+    for (est::FdiInput& h : held_) h.at_rest = false;
+  }
+  held_.push_back(in);
+  std::string text;
+  while (held_.size() > (in.at_rest ? margin_samples_ : 0)) {
+    const std::string e = feed(held_.front());
+    held_.pop_front();
+    if (text.empty()) text = e;
+    if (last_ == est::FdiStatus::kIsolated) {
+      held_.clear();
+      break;
+    }
+  }
+  return text;
+}
+
+std::string FdiWatch::feed(const est::FdiInput& in) {
   if (in.at_rest) ++rest_samples_;
   last_ = fdi_.push(in);
   char text[256];
@@ -36,10 +60,10 @@ std::string FdiWatch::push(const Sample& s, est::PushStatus status, const est::D
   }
   if (!learned_ && last_ != est::FdiStatus::kLearning) {
     learned_ = true;
-    t_learned_s_ = s.t_s;
+    t_learned_s_ = in.t_s;
     const Eigen::Vector3d sig = fdi_.residual_sigma_longrun_dps();
     std::snprintf(text, sizeof text, "fdi: monitoring from t=%.3f s (residual noise learned: long-run sigma %.4f %.4f %.4f deg/s)",
-                  s.t_s, sig.x(), sig.y(), sig.z());
+                  in.t_s, sig.x(), sig.y(), sig.z());
     return text;
   }
   return {};

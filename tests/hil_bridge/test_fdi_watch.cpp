@@ -27,14 +27,15 @@ namespace {
 // the emulated box of docs/hil.md (biases, 0.005 deg/s/sqrt(Hz)), its readings through `fault`
 struct FaultyRig {
   VirtualClock clock;
-  EmulatedMotors motors{clock, {}};
+  EmulatedMotors motors;
   FaultyGenerator gen;
   Mpu6050Emulator chip1{0, gen, clock}, chip2{1, gen, clock};
   EmulatedI2cBus bus{clock, &clock};
   I2cSource src;
   FlipSchedule schedule{{10.0, 10.0}};
-  explicit FaultyRig(const PlantedFault& fault)
-      : gen(std::make_unique<BoxAtRestGenerator>(BoxAtRestGenerator::Params{}, &motors), fault),
+  explicit FaultyRig(const PlantedFault& fault, EmulatedMotors::Params mp = {})
+      : motors(clock, mp),
+        gen(std::make_unique<BoxAtRestGenerator>(BoxAtRestGenerator::Params{}, &motors), fault),
         src(bus, clock, I2cSourceParams{}) {
     bus.attach(0x68, &chip1);
     bus.attach(0x69, &chip2);
@@ -50,16 +51,18 @@ struct LiveRun {
   FdiVerdict verdict = FdiVerdict::kNotMonitored;
   std::optional<est::FaultReport> fault;
   std::optional<double> first_alarm_s;
+  Eigen::Vector3d sigma_longrun_dps = Eigen::Vector3d::Constant(kNaN);  // learned, deg/s
 };
 
-LiveRun run_with_fdi(const PlantedFault& fault, double duration_s) {
-  FaultyRig rig(fault);
+LiveRun run_with_fdi(const PlantedFault& fault, double duration_s, EmulatedMotors::Params mp = {},
+                     double end_margin_s = 0.1) {
+  FaultyRig rig(fault, mp);
   EXPECT_TRUE(rig.src.configure().ok());
   log::Metadata meta;
   meta.set("sample_rate_hz", "100");
   meta.set("latitude_deg", "52.0");
   est::DriftlessFilter filter(est::EstimatorConfig{}, est::box_geometry_from_metadata(meta));
-  FdiWatch watch(est::FdiParams{});
+  FdiWatch watch(est::FdiParams{}, end_margin_s);
   LiveParams lp;
   lp.duration_s = duration_s;
   LiveLoop loop(lp, rig.clock, nullptr, &filter);
@@ -75,6 +78,7 @@ LiveRun run_with_fdi(const PlantedFault& fault, double duration_s) {
   r.verdict = watch.verdict();
   r.fault = watch.detector().fault();
   r.first_alarm_s = watch.detector().first_alarm_s();
+  r.sigma_longrun_dps = watch.detector().residual_sigma_longrun_dps();
   return r;
 }
 
@@ -136,6 +140,22 @@ TEST(LiveFdi, FaultFreeEmulatedRunRaisesNoAlarm) {
   EXPECT_FALSE(r.first_alarm_s.has_value());
   EXPECT_EQ(count_with(r.events, "fdi: monitoring from"), 1);
   EXPECT_EQ(r.events.size(), 1u);
+}
+
+TEST(LiveFdi, SwitchesThatOpenLateDoNotInflateTheLearnedNoise) {
+  // GIVEN end-stop switches that stay closed for the first 3 deg of a flip (the first samples of
+  // a move carry the hinge rate while the angle still reads the stop, as on the serial link)
+  EmulatedMotors::Params late;
+  late.switch_window_deg = 3.0;
+  // WHEN the watch holds rest samples for the filter's end margin (0.1 s)
+  const LiveRun r = run_with_fdi(PlantedFault{}, 90.0, late);
+  // THEN it learns the white-noise level on every axis (0.005 deg/s/sqrt(Hz): ~0.07 deg/s long
+  // run) and raises no alarm
+  EXPECT_EQ(r.verdict, FdiVerdict::kHealthy);
+  EXPECT_LT(r.sigma_longrun_dps.maxCoeff(), 0.1) << r.sigma_longrun_dps.transpose();
+  // AND without the margin the moving samples enter the learning: the scale is inflated
+  const LiveRun raw = run_with_fdi(PlantedFault{}, 90.0, late, 0.0);
+  EXPECT_GT(raw.sigma_longrun_dps.maxCoeff(), 0.5) << raw.sigma_longrun_dps.transpose();
 }
 
 TEST(LiveFdi, StuckAxisIsIsolatedAtOnceAndLogged) {
