@@ -10,6 +10,7 @@
 #include <fmt/core.h>
 
 #include "estimator/allan_stream.hpp"
+#include "estimator/attitude_comparison.hpp"
 #include "estimator/box_geometry.hpp"
 #include "estimator/filter.hpp"
 #include "estimator/log.hpp"
@@ -82,6 +83,19 @@ std::unique_ptr<est::DriftlessFilter> make_filter(const InputArgs& a, const log:
   return std::make_unique<est::DriftlessFilter>(cfg, est::box_geometry_from_metadata(meta));
 }
 
+void add_corrected_notes(const est::DriftlessFilter& filter, double lock_t_s, double lock_sigma_dps,
+                         std::vector<std::string>& notes) {
+  if (filter.counters().updates == 0) {
+    notes.push_back("--corrected: the filter made no update (no standstill found); no corrected channels");
+  } else if (std::isnan(lock_t_s)) {
+    notes.push_back(fmt::format("--corrected: the filter never locked on (a sigma of the correction stayed above "
+                                "{:g} deg/s); no corrected channels", lock_sigma_dps));
+  } else if (lock_sigma_dps > 0.0) {
+    notes.push_back(fmt::format("--corrected: the corrected channels start at lock, t = {:.2f} s (every sigma of "
+                                "the correction below {:g} deg/s)", lock_t_s, lock_sigma_dps));
+  }
+}
+
 Loaded load_log(const InputArgs& a) {
   // the single-sensor form is read too; --corrected runs the filter, which needs both triads
   log::ReaderOptions ro;
@@ -110,8 +124,13 @@ Loaded load_log(const InputArgs& a) {
   std::size_t skipped = 0;
   Sample s;
   bool pending_break = false;
+  // the corrected channels start at lock: before it the correction is the filter's start value
+  double lock_t_s = kNaN;
   while (reader.next(s)) {
-    if (filter) filter->push(s);
+    if (filter) {
+      filter->push(s);
+      if (std::isnan(lock_t_s) && est::filter_locked(*filter, a.corrected_lock_sigma_dps)) lock_t_s = s.t_s;
+    }
     if (first_t.size() < 4096) {
       first_t.push_back(s.t_s);
       if (first_t.size() == 4096) mon.learn(first_t);
@@ -131,7 +150,7 @@ Loaded load_log(const InputArgs& a) {
     }
     for (std::size_t c = 0; c < idx.size(); ++c) out.channels[c].x.push_back(reader.value(idx[c]));
     std::size_t extra = idx.size();
-    for (std::size_t c = 0; c < idx.size(); ++c) {
+    for (std::size_t c = 0; c < idx.size() && !std::isnan(lock_t_s); ++c) {
       if (corr_of[c] < 0) continue;
       const auto& o = filter->output();
       out.channels[extra++].x.push_back(corr_of[c] < 3 ? o.y1c_dps[corr_of[c]] : o.y2c_dps[corr_of[c] - 3]);
@@ -140,9 +159,8 @@ Loaded load_log(const InputArgs& a) {
   if (first_t.size() < 4096) mon.learn(first_t);
   if (!reader.metadata().complete()) out.notes.push_back("the log says 'complete: false'; using the rows present");
   if (skipped > 0) out.notes.push_back(fmt::format("{} rows with a missing value were left out (a segment break each)", skipped));
-  if (filter && filter->counters().updates == 0) {
-    out.notes.push_back("--corrected: the filter made no update (no standstill found); corrected = raw");
-  }
+  if (filter) add_corrected_notes(*filter, lock_t_s, a.corrected_lock_sigma_dps, out.notes);
+  if (filter && std::isnan(lock_t_s)) out.channels.resize(idx.size());  // never locked: raw only
   out.rate_hz = resolve_rate(a.rate_hz, reader.metadata().sample_rate_hz(), mon.report(), out.notes, a.log);
   return out;
 }

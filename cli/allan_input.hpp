@@ -27,6 +27,9 @@ struct InputArgs {
   bool gaps_ignore = false;     // --gaps ignore: samples taken as contiguous across gaps
   bool corrected = false;       // log only: DriftLess-corrected channels too
   std::string config, mode;     // for --corrected
+  // deg/s: the corrected channels start once every sigma of the correction is below this (the
+  // filter has locked on, as in `estimate`'s Fig. 5); 0: from the first sample
+  double corrected_lock_sigma_dps = 0.05;
   /// The importer options with the comma lists split and the format parsed.
   importers::ImportOptions import_options() const;
   const std::string& source() const { return !log.empty() ? log : !in.empty() ? in : csv; }

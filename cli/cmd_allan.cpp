@@ -187,6 +187,11 @@ const bool registered = register_command(40, [](CLI::App& app) {
   cmd->add_flag("--corrected", a->input.corrected, "Log only: also the DriftLess-corrected gyro channels, side by side");
   cmd->add_option("--config", a->input.config, "Estimator configuration for --corrected (docs/estimator.md)")->check(CLI::ExistingFile);
   cmd->add_option("--mode", a->input.mode, "Estimator mode for --corrected: paper or general")->check(CLI::IsMember({"paper", "general"}));
+  cmd->add_option("--corrected-lock-sigma", a->input.corrected_lock_sigma_dps,
+                  "deg/s: the corrected channels start once every sigma of the correction is below this "
+                  "(the filter has locked on); 0 starts them at the first sample")
+      ->capture_default_str()
+      ->check(non_negative_number("deg/s"));
   cmd->add_option("--datasheet", a->datasheet, "Datasheet values to draw: N=<deg/s/rtHz>,B=<deg/s>,K=<deg/s/rts>");
   cmd->add_flag("--kalibr", a->exports.kalibr, "Write Kalibr imu.yaml (aggregated) and imu_<channel>.yaml (per axis), SI units");
   cmd->add_flag("--imu-yaml", a->exports.kalibr, "Same as --kalibr");

@@ -145,8 +145,8 @@ int run_estimate_cmd(const EstimateArgs& a) {
   if (a.plot && !interrupted) {
     double rate = reader.metadata().sample_rate_hz();
     if (!std::isfinite(rate) && summary.rows > 1) rate = double(summary.rows - 1) / (summary.t_last_s - summary.t_first_s);
-    EstimateFigureInputs fig{&files.series(), truth, attitude, rate, summary.attitude_start_s,
-                             a.attitude_start_sigma_dps};
+    EstimateFigureInputs fig{&files.series(), truth, attitude, rate, summary.locked_from_t_s,
+                             a.attitude_start_sigma_dps, summary.attitude_start_s};
     figures = write_estimate_figures(dir, fig);
     for (const auto& f : figures) {
       if (!f.written) warnings.push_back(fmt::format("{} not drawn: {}", f.stem, f.reason));

@@ -201,20 +201,21 @@ FigureOutcome fig5_allan(const fs::path& dir, const EstimateFigureInputs& in) {
 // Fig. 9: attitude error with DriftLess and with the bias fixed at lock, from the comparison's start
 FigureOutcome fig9_attitude(const fs::path& dir, const EstimateFigureInputs& in) {
   if (!in.attitude) return {"fig9_attitude", false, "the log has no reference attitude (ref_q columns)"};
-  if (!std::isfinite(in.lock_s)) {
+  if (!std::isfinite(in.lock_s) || !std::isfinite(in.attitude_start_s)) {
     return {"fig9_attitude", false,
             fmt::format("the filter never locked on (never had every bias sigma below {:g} deg/s), so there is "
                         "no attitude comparison",
                         in.start_sigma_dps)};
   }
+  const double t0 = in.attitude_start_s;
   const double t_end = in.series != nullptr && !in.series->t_s.empty() ? in.series->t_s.back() : kNaN;
   std::string body = fmt::format(
       "  set xlabel 't [s]'; set ylabel 'attitude error [deg]'; set offsets 0, 0, graph 0.05, graph 0.05\n"
       "  set title \"Fig. 9: attitude error, integrated from ref_q at lock (t = {0:.1f} s)\\n"
       "bias fixed at lock (red) against DriftLess (blue)\"\n  set key below maxrows 3 height 1.5\n{1}",
-      in.lock_s, lock_marker(in.lock_s));
-  if (std::isfinite(t_end) && t_end > in.lock_s) {
-    body += fmt::format("  set xrange [{:.3f}:{:.3f}]\n", in.lock_s - 0.02 * (t_end - in.lock_s), t_end);
+      t0, lock_marker(t0));
+  if (std::isfinite(t_end) && t_end > t0) {
+    body += fmt::format("  set xrange [{:.3f}:{:.3f}]\n", t0 - 0.02 * (t_end - t0), t_end);
   }
   static constexpr const char* kAngle[3] = {"roll", "pitch", "heading"};
   body += "  plot ";

@@ -48,8 +48,9 @@ struct EstimateFigureInputs {
   bool truth = false;           // estimate.csv has true_bias columns
   bool attitude = false;        // attitude.csv holds the comparison (the filter locked, ref_q)
   double sample_rate_hz = kNaN;
-  double lock_s = kNaN;         // s, when the filter locked on (NaN: never)
+  double lock_s = kNaN;         // s, the first row whose correction is locked (NaN: never)
   double start_sigma_dps = kNaN;  // deg/s, the lock criterion (every bias sigma below it)
+  double attitude_start_s = kNaN;  // s, the first ref_q at or after lock: where Fig. 9 starts
 };
 
 /// What became of one figure.

@@ -23,6 +23,7 @@ const char* cause_key(est::HealthCause c) {
     case est::HealthCause::kNoiseOverstated: return "noise_overstated";
     case est::HealthCause::kRejectionsAtPosition: return "rejections_at_position";
     case est::HealthCause::kRejections: return "rejections";
+    case est::HealthCause::kLoneRejection: return "lone_rejection";
     case est::HealthCause::kUnobservable: return "unobservable";
     case est::HealthCause::kRelocks: return "relocks";
   }
@@ -66,10 +67,14 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
                                                     "sensors; if the box stands still, add --box-at-rest"
                                                   : "record more flips (both platforms, both directions) or a longer log");
     case est::HealthCause::kNoiseUnderstated:
-      return fmt::format("NIS mean {:.3g} above its 95 % band: the innovations are {:.2g}x larger than the filter "
-                         "expects, its sigma too small (data noisier or bias wandering more than "
+      return fmt::format("NIS mean {:.3g} above its 95 % band{}: the innovations are {:.2g}x larger than the "
+                         "filter expects, its sigma too small (data noisier or bias wandering more than "
                          "noise_density_dps_rthz {:.3g} and the bias instability say); use --tune auto",
-                         f.value, std::sqrt(f.suggested), cfg.noise_density_dps_rthz);
+                         f.value,
+                         f.severity == est::HealthVerdict::kOk
+                             ? " (inside the 99.9 % band: one consistent run in 40 lands here)"
+                             : " and its 99.9 % band",
+                         std::sqrt(f.suggested), cfg.noise_density_dps_rthz);
     case est::HealthCause::kNoiseOverstated:
       return fmt::format("NIS mean {:.3g} below its 95 % band: the innovations are {:.2g}x smaller than the "
                          "filter expects, its sigma too large (data quieter or the bias steadier than configured): "
@@ -86,6 +91,11 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
       return fmt::format("{:.1f} % of the updates were rejected by the NIS gate: noise or bias wander "
                          "larger than configured, or a model that does not fit; use --tune auto",
                          100.0 * f.value);
+    case est::HealthCause::kLoneRejection:
+      return fmt::format("one update rejected by the NIS gate (t = {:.2f} s, NIS {:.3g}): a lone outlier, "
+                         "which the gate is there to remove; the estimate is unaffected. Repeated rejections "
+                         "would mean noise or bias wander larger than configured (--tune auto)",
+                         f.suggested, f.value);
     case est::HealthCause::kUnobservable:
       return fmt::format("{} kept most of the prior sigma (largest sigma {:.3g} deg/s): the flips in this "
                          "log do not observe them; flip both platforms",
@@ -114,10 +124,11 @@ std::string health_json(const est::HealthReport& h, const est::EstimatorConfig& 
   return fmt::format(
       "  \"health\": {{\"verdict\": \"{}\", \"locked\": {}, \"lock_t_s\": {}, \"updates\": {}, \"rejected\": {}, "
       "\"rejected_fraction\": {}, \"nis_updates\": {}, \"nis_dof_mean\": {}, \"nis_mean\": {}, "
-      "\"nis_mean_band_95\": [{}, {}], \"relocks\": {}, \"unobservable\": {},\n  \"findings\": {}}}",
+      "\"nis_mean_band_95\": [{}, {}], \"nis_mean_degraded_above\": {}, \"relocks\": {}, \"unobservable\": {},\n"
+      "  \"findings\": {}}}",
       est::to_string(h.verdict), h.locked ? "true" : "false", json_number(h.lock_t_s), h.updates, h.rejected,
       json_number(h.rejected_fraction), h.nis_updates, json_number(h.nis_dof_mean), json_number(h.nis_mean), json_number(h.nis_mean_band_lo),
-      json_number(h.nis_mean_band_hi), h.relocks, unobs, findings);
+      json_number(h.nis_mean_band_hi), json_number(h.nis_mean_degraded_above), h.relocks, unobs, findings);
 }
 
 std::string tune_json(const est::TuneResult* t) {

@@ -16,7 +16,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr std::string_view kCorrectedHeader = "t,y1c_x,y1c_y,y1c_z,y2c_x,y2c_y,y2c_z,rate_x,rate_y,rate_z,status\n";
+constexpr std::string_view kCorrectedHeader = "t,y1c_x,y1c_y,y1c_z,y2c_x,y2c_y,y2c_z,rate_x,rate_y,rate_z,status,locked\n";
 constexpr std::string_view kAttitudeHeader =
     "t,roll_err_deg,pitch_err_deg,heading_err_deg,angle_err_deg,"
     "raw_roll_err_deg,raw_pitch_err_deg,raw_heading_err_deg,raw_angle_err_deg,"
@@ -65,7 +65,7 @@ void format_corrected(io::OutputFile& f, const std::vector<EstimateFiles::Correc
     }
     out.push_back(',');
     out.append(est::to_string(r.status));
-    out.push_back('\n');
+    out.append(r.locked ? ",1\n" : ",0\n");
     f.maybe_drain();
   }
 }
@@ -101,7 +101,7 @@ EstimateFiles::EstimateFiles(const fs::path& dir, const EstimateFilesOptions& op
   }
   estimate_.write(
       "t,b1_x,b1_y,b1_z,b2_x,b2_y,b2_z,sigma1_x,sigma1_y,sigma1_z,sigma2_x,sigma2_y,sigma2_z,"
-      "nis,nis_gate,dim,samples,plat1_deg,plat2_deg,accepted");
+      "nis,nis_gate,dim,samples,plat1_deg,plat2_deg,accepted,locked");
   estimate_.write(opt_.truth ? ",true_bias1_x,true_bias1_y,true_bias1_z,true_bias2_x,true_bias2_y,true_bias2_z\n"
                              : "\n");
   attitude_.write(kAttitudeHeader);
@@ -110,11 +110,11 @@ EstimateFiles::EstimateFiles(const fs::path& dir, const EstimateFilesOptions& op
 // the writer thread stops before the file it writes is discarded
 EstimateFiles::~EstimateFiles() { corrected_writer_.reset(); }
 
-void EstimateFiles::on_sample(const Sample& s, const est::SampleOutput& o) {
+void EstimateFiles::on_sample(const Sample& s, const est::SampleOutput& o, bool locked) {
   if (corrected_writer_) {
     CorrectedRow r{{s.t_s, o.y1c_dps[0], o.y1c_dps[1], o.y1c_dps[2], o.y2c_dps[0], o.y2c_dps[1], o.y2c_dps[2],
                     o.rate_body_dps[0], o.rate_body_dps[1], o.rate_body_dps[2]},
-                   o.status};
+                   o.status, locked};
     corrected_writer_->push(r);
   }
   if (opt_.keep_series) series_.add(s, o);
@@ -123,7 +123,7 @@ void EstimateFiles::on_sample(const Sample& s, const est::SampleOutput& o) {
   }
 }
 
-void EstimateFiles::on_update(const est::UpdateRecord& r, const est::Matrix6d&, const Sample& s) {
+void EstimateFiles::on_update(const est::UpdateRecord& r, const est::Matrix6d&, const Sample& s, bool locked) {
   Line l;
   l.first(r.t_s, 6);
   for (int i = 0; i < 6; ++i) l.next(r.bias_dps[i], 9);
@@ -135,6 +135,7 @@ void EstimateFiles::on_update(const est::UpdateRecord& r, const est::Matrix6d&, 
   l.next(r.plat1_deg, 3);
   l.next(r.plat2_deg, 3);
   l.next_int(r.accepted ? 1 : 0);
+  l.next_int(locked ? 1 : 0);
   if (opt_.truth) {
     for (int i = 0; i < 3; ++i) l.next(s.true_bias1_dps[i], 9);
     for (int i = 0; i < 3; ++i) l.next(s.true_bias2_dps[i], 9);
@@ -199,6 +200,7 @@ void write_estimate_summary(const fs::path& path, const SummaryContext& ctx, con
       "\"g_sensitivity_dps_per_g\": [{}, {}], \"g_sensitivity_sigma_dps_per_g\": [{}, {}]}},\n",
       s.gsens_states ? "true" : "false", json_vec(s.correction_sigma_dps), mat(s.gsens_dps_per_g[0]),
       mat(s.gsens_dps_per_g[1]), mat(s.gsens_sigma_dps_per_g[0]), mat(s.gsens_sigma_dps_per_g[1]));
+  add("  \"locked_from_t_s\": {}, \"rows_locked\": {},\n", json_number(s.locked_from_t_s), s.samples_locked);
   add("  \"attitude_start_s\": {},\n", json_number(s.attitude_start_s));
   add("  \"attitude_drift_deg_per_h\": {{\"with_driftless\": {}, \"bias_fixed_at_start\": {}, "
       "\"without_driftless\": {}}},\n",
@@ -211,7 +213,8 @@ void write_estimate_summary(const fs::path& path, const SummaryContext& ctx, con
   add("  \"fixed_bias_dps\": {},\n", json_vec(s.fixed_bias_dps));
   o += "  \"relocks\": [";
   for (std::size_t i = 0; i < s.relocks.size(); ++i) {
-    add("{}{{\"t_s\": {}, \"nis\": {}}}", i ? ", " : "", json_number(s.relocks[i].t_s), json_number(s.relocks[i].nis));
+    add("{}{{\"t_s\": {}, \"nis\": {}, \"locked_again_t_s\": {}}}", i ? ", " : "", json_number(s.relocks[i].t_s),
+        json_number(s.relocks[i].nis), json_number(s.relocks[i].locked_again_t_s));
   }
   o += "],\n";
   if (s.truth.available) {

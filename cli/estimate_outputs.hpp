@@ -32,18 +32,20 @@ class EstimateFiles : public est::EstimateSink {
   EstimateFiles(const std::filesystem::path& dir, const EstimateFilesOptions& opt);
   ~EstimateFiles() override;
 
-  void on_sample(const Sample& s, const est::SampleOutput& o) override;
-  void on_update(const est::UpdateRecord& r, const est::Matrix6d& P, const Sample& s) override;
+  void on_sample(const Sample& s, const est::SampleOutput& o, bool locked) override;
+  void on_update(const est::UpdateRecord& r, const est::Matrix6d& P, const Sample& s, bool locked) override;
   void on_attitude(const est::AttitudePoint& p) override;
 
   /// Writes what is left and renames the files into place (throws io::OutputError "<file>: <reason>").
   void commit();
   const FigureSeries& series() const { return series_; }
 
-  /// One corrected.csv row: t, y1c (3), y2c (3), fused rate (3), all deg/s (s for t), and the status.
+  /// One corrected.csv row: t, y1c (3), y2c (3), fused rate (3), all deg/s (s for t), the status
+  /// and whether the correction was locked.
   struct CorrectedRow {
     double v[10];
     est::PushStatus status;
+    bool locked;
   };
 
  private:

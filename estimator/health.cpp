@@ -35,6 +35,8 @@ void HealthMonitor::on_update(const UpdateRecord& rec, const DriftlessFilter& fi
   if (!rec.accepted) {
     ++rejected_;
     ++pc.rejected;
+    last_rejected_t_s_ = rec.t_s;
+    last_rejected_nis_ = rec.nis;
     return;
   }
   // the NIS of accepted updates: under a consistent model each is chi-square with `dim` dof.
@@ -57,6 +59,14 @@ void HealthMonitor::on_update(const UpdateRecord& rec, const DriftlessFilter& fi
 void HealthMonitor::add_gate_findings(HealthReport& h) const {
   if (!(h.rejected_fraction > limits_.max_rejected_fraction) || h.rejected == h.updates) return;
   HealthFinding f;
+  if (h.rejected <= limits_.lone_rejections) {
+    f.cause = HealthCause::kLoneRejection;
+    f.severity = HealthVerdict::kOk;
+    f.value = last_rejected_nis_;
+    f.suggested = last_rejected_t_s_;
+    add(h, f);
+    return;
+  }
   f.cause = HealthCause::kRejections;
   f.value = h.rejected_fraction;
   PositionCount in, out;
@@ -87,7 +97,8 @@ void HealthMonitor::add_nis_findings(HealthReport& h) const {
   HealthFinding f;
   f.cause = high ? HealthCause::kNoiseUnderstated : HealthCause::kNoiseOverstated;
   // sigma too large is safe (the estimate is trusted less than it deserves): a note, not degraded
-  if (low) f.severity = HealthVerdict::kOk;
+  // above the 95 % band but inside the degraded band: a note (1 consistent run in 40 lands there)
+  if (low || !(h.nis_mean > h.nis_mean_degraded_above)) f.severity = HealthVerdict::kOk;
   f.value = h.nis_mean;
   f.suggested = h.nis_mean / h.nis_dof_mean;
   add(h, f);
@@ -140,6 +151,7 @@ HealthReport HealthMonitor::finish(const DriftlessFilter& filter, double duratio
     h.nis_dof_mean = nis.dof / n;
     h.nis_mean_band_lo = chi2_quantile(tail, nis.dof) / n;
     h.nis_mean_band_hi = chi2_quantile(1.0 - tail, nis.dof) / n;
+    h.nis_mean_degraded_above = chi2_quantile(0.5 * (1.0 + limits_.degraded_band_probability), nis.dof) / n;
   }
   add_lock_findings(h, filter, duration_s);
   add_gate_findings(h);

@@ -25,10 +25,12 @@ enum class HealthCause {
   kNoUpdate,             // no standstill became an update
   kAllRejected,          // updates were made but the gate rejected every one
   kNeverLocked,          // updates accepted, yet some bias sigma never fell below the lock level
-  kNoiseUnderstated,     // NIS mean above its band: the data are noisier than R and Q say
+  kNoiseUnderstated,     // NIS mean above its band: the data are noisier than R and Q say (above the
+                         // 95 % band but inside the degraded band: a note)
   kNoiseOverstated,      // NIS mean below its band: sigma too pessimistic (a note: verdict stays ok)
   kRejectionsAtPosition, // the gate rejects at one position pair: a position-dependent error
   kRejections,           // the gate rejects too often, spread over the positions
+  kLoneRejection,        // at most HealthLimits::lone_rejections rejected: outliers the gate is for (a note)
   kUnobservable,         // some bias components kept (most of) their prior sigma
   kRelocks,              // the gate lost lock and re-locked
 };
@@ -37,10 +39,10 @@ enum class HealthCause {
 struct HealthFinding {
   HealthCause cause = HealthCause::kNoUpdate;
   HealthVerdict severity = HealthVerdict::kDegraded;  // kOk = a note that leaves the verdict
-  double value = kNaN;        // the measured quantity (fraction, NIS mean, ...)
+  double value = kNaN;        // the measured quantity (fraction, NIS mean, ...; kLoneRejection: its NIS)
   double suggested = kNaN;    // kNoiseUnder/Overstated: nis_mean / dof, the factor by which the
                               // innovation variance exceeds (or falls short of) what S predicts;
-                              // kNeverLocked: the rejected fraction
+                              // kNeverLocked: the rejected fraction; kLoneRejection: its time, s
   // kRejectionsAtPosition: the (plat1, plat2) angle pairs (deg) where most updates were rejected
   std::vector<std::array<double, 2>> positions_deg;
   std::vector<int> components;  // kUnobservable: 0..5 = b1_x .. b2_z
@@ -49,8 +51,14 @@ struct HealthFinding {
 /// Limits of the verdict (docs/estimator.md section 6.1).
 struct HealthLimits {
   double lock_sigma_dps = 0.05;        // deg/s, locked once every bias sigma is below this
-  double band_probability = 0.95;      // two-sided band of the NIS mean
-  double max_rejected_fraction = 0.02; // above: degraded
+  double band_probability = 0.95;      // two-sided band of the NIS mean (reported; outside: a note)
+  // two-sided band whose upper end makes a NIS mean "degraded": a consistent filter lands above
+  // its 95 % band in 1 run of 40 by construction, above this one in 1 of 2000
+  double degraded_band_probability = 0.999;
+  double max_rejected_fraction = 0.02; // above: degraded (unless the rejections are lone ones)
+  // this many rejections or fewer are a note however short the log: the gate removing a lone
+  // outlier (one 28-update run rejecting 1 is 3.6 %; docs/estimator.md section 6.1)
+  std::uint64_t lone_rejections = 1;
   double position_rejected_fraction = 0.5;  // position pairs rejecting more than this are named
                                             // when the others together reject under a quarter
                                             // as often
@@ -69,6 +77,7 @@ struct HealthReport {
   double nis_dof_mean = kNaN;          // mean residual dimension of those updates
   double nis_mean = kNaN;              // mean NIS of the accepted updates
   double nis_mean_band_lo = kNaN, nis_mean_band_hi = kNaN;  // chi-square band of that mean
+  double nis_mean_degraded_above = kNaN;  // upper end of the degraded_band_probability band
   std::uint64_t relocks = 0;
   std::vector<int> unobservable;       // 0..5 = b1_x .. b2_z
   std::vector<HealthFinding> findings; // worst first
@@ -101,6 +110,7 @@ class HealthMonitor {
   };
   NisSums nis_before_, nis_locked_;  // accepted updates before lock / from the lock on
   std::map<std::pair<long, long>, PositionCount> by_position_;  // key: positions in 0.1 deg
+  double last_rejected_t_s_ = kNaN, last_rejected_nis_ = kNaN;
 };
 
 }  // namespace driftless::est

@@ -134,7 +134,10 @@ void add_filter_warnings(const DriftlessFilter& filter, EstimateSummary& sum) {
     sum.warnings.push_back("the NIS gate rejected " + std::to_string(filter.config().gate_relock_after) +
                            " updates in a row; the filter re-locked at t = " + std::to_string(r.t_s) +
                            " s (NIS " + std::to_string(r.nis) + "): a bias jump, a new sensor, or a model "
-                           "that does not fit these sensors");
+                           "that does not fit these sensors; " +
+                           (std::isfinite(r.locked_again_t_s)
+                                ? "locked again at t = " + std::to_string(r.locked_again_t_s) + " s"
+                                : std::string("not locked again before the end (corrected.csv: locked = 0)")));
   }
 }
 
@@ -180,6 +183,21 @@ void add_attitude_results(const AttitudeComparison& att, const DriftlessFilter& 
   }
 }
 
+// after an update: is the correction locked (filter_locked at the lock level)? Records the first
+// lock, each gate re-lock and when the lock came back after it.
+// `t_s` is the time of the sample whose push made the update: the first row it corrects.
+bool lock_step(const DriftlessFilter& filter, double lock_sigma_dps, const UpdateRecord& u, double t_s,
+               EstimateSummary& sum) {
+  if (u.relocked) sum.relocks.push_back({u.t_s, u.nis, kNaN});
+  const bool locked = filter_locked(filter, lock_sigma_dps);
+  if (!locked) return false;
+  if (!std::isfinite(sum.locked_from_t_s)) sum.locked_from_t_s = t_s;
+  if (!sum.relocks.empty() && !std::isfinite(sum.relocks.back().locked_again_t_s)) {
+    sum.relocks.back().locked_again_t_s = t_s;
+  }
+  return true;
+}
+
 // the pass itself; `reader` (optional) adds the log reader's findings to the warnings
 EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const SampleSource& next,
                          const log::LogReader* reader, const EstimatorConfig& cfg, EstimateSink* sink,
@@ -196,13 +214,14 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
   const bool use_window = have_truth && std::isfinite(opt.eval_start_s);
   HealthMonitor health(opt.health);
 
-  // an update (accepted or rejected) reaches the sink, the truth scores and the re-lock list
+  // the lock state changes only at updates (P shrinks there; a gate re-lock widens it)
+  bool locked = false;
   auto on_update = [&](PushStatus st, const Sample& s) {
     if (st != PushStatus::kUpdated && st != PushStatus::kRejected) return;
     const UpdateRecord& u = filter.last_update();
-    if (sink != nullptr) sink->on_update(u, filter.covariance_dps2(), s);
+    locked = lock_step(filter, opt.attitude_start_sigma_dps, u, s.t_s, sum);
+    if (sink != nullptr) sink->on_update(u, filter.covariance_dps2(), s, locked);
     health.on_update(u, filter);
-    if (u.relocked) sum.relocks.push_back({u.t_s, u.nis});
     if (have_truth && st == PushStatus::kUpdated) score.add(filter, s);
     if (use_window) window.on_update(u);
   };
@@ -217,8 +236,9 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
     if (!std::isfinite(sum.t_first_s)) sum.t_first_s = s.t_s;
     sum.t_last_s = s.t_s;
     const PushStatus st = filter.push(s);
-    if (sink != nullptr) sink->on_sample(s, filter.output());
-    on_update(st, s);
+    on_update(st, s);  // first: the row that made an update carries the state after it
+    sum.samples_locked += locked ? 1 : 0;
+    if (sink != nullptr) sink->on_sample(s, filter.output(), locked);
     if (use_window) window.add(filter, s);
 
     // attitude: the comparison starts at the first finite ref_q once the filter has locked on

@@ -22,10 +22,15 @@ namespace driftless::est {
 class EstimateSink {
  public:
   virtual ~EstimateSink() = default;
-  /// Every sample, after the filter saw it (out: corrected outputs and fused rate).
-  virtual void on_sample(const Sample& /*s*/, const SampleOutput& /*out*/) {}
-  /// Every update; `s` is the sample whose push produced it (its true_ columns for evaluation).
-  virtual void on_update(const UpdateRecord& /*rec*/, const Matrix6d& /*P*/, const Sample& /*s*/) {}
+  /// Every sample, after the filter saw it (out: corrected outputs and fused rate). `locked`: the
+  /// correction applied to it is an estimate, i.e. every sigma of the correction is below the
+  /// lock level (EstimateRunOptions::attitude_start_sigma_dps) after the latest update; false
+  /// before the first lock and again after a gate re-lock widened P, until it shrinks again.
+  virtual void on_sample(const Sample& /*s*/, const SampleOutput& /*out*/, bool /*locked*/) {}
+  /// Every update; `s` is the sample whose push produced it (its true_ columns for evaluation);
+  /// `locked` as in on_sample, after this update.
+  virtual void on_update(const UpdateRecord& /*rec*/, const Matrix6d& /*P*/, const Sample& /*s*/,
+                         bool /*locked*/) {}
   /// Attitude errors every `attitude_interval_s`.
   virtual void on_attitude(const AttitudePoint& /*p*/) {}
 };
@@ -88,6 +93,8 @@ struct WindowStats {
 struct RelockEvent {
   double t_s = kNaN;  // s, time of the update taken by the re-lock
   double nis = kNaN;  // its NIS before P was widened
+  // s, the first row after it whose correction is locked again (NaN: not before the end)
+  double locked_again_t_s = kNaN;
 };
 
 /// What a pass produced.
@@ -127,6 +134,10 @@ struct EstimateSummary {
   WindowStats window;  // with EstimateRunOptions::eval_start_s
   bool log_complete = true;
   std::vector<RelockEvent> relocks;
+  // s, the first row whose correction was locked (the lock level of on_sample: the row that made
+  // the locking update); NaN: never
+  double locked_from_t_s = kNaN;
+  std::uint64_t samples_locked = 0;  // rows whose correction was locked (corrected.csv locked = 1)
   HealthReport health;  // the verdict: lock, gate rejections, NIS against its band, observability
   std::vector<std::string> warnings;
 };

@@ -7,6 +7,7 @@
 
 #include "estimator/health.hpp"
 #include "estimator/pipeline.hpp"
+#include "estimator/stats.hpp"
 #include "tests/estimator/synth.hpp"
 #include "tests/temp_path.hpp"
 
@@ -175,6 +176,106 @@ TEST(HealthTest, NisBandIsTheChiSquareClosedForm) {
   EXPECT_NEAR(cdf12(4.0 * h.nis_mean_band_hi), 0.975, 1e-9);
   // and the never-updated filter is not locked: the verdict says so
   EXPECT_EQ(h.verdict, HealthVerdict::kFailed);
+}
+
+// a healthy log (noise as configured, biases still, Q ~ 0) with a 0.5 deg/s offset planted on
+// gyro 1's x axis in the middle of the standstills that start at each time in `at_s`
+HealthReport with_outliers(const std::vector<double>& at_s, const std::string& name) {
+  auto p = mpu_like(18);
+  p.gm_sigma_dps = 0.0;
+  p.before_quantise = [at_s](Sample& s) {
+    for (double t0 : at_s) {
+      if (s.t_s > t0 + 2.0 && s.t_s < t0 + 8.0) s.gyro1_dps.x() += 0.5;
+    }
+  };
+  EstimatorConfig cfg;
+  cfg.q_override_dps2_per_s = 1e-14;
+  return run_synth(p, name, cfg).health;
+}
+
+TEST(HealthTest, ALoneRejectionIsANoteAndTwoAreDegraded) {
+  // GIVEN a healthy 900 s log (81 updates) with one planted outlier standstill (11 s cycle: the
+  // 31st rest starts at 330 s)
+  const HealthReport one = with_outliers({330.0}, "lone_outlier.csv");
+  // THEN the gate rejects that one update (1.2 % of the updates, 3.6 % had the log been 28
+  // updates long); the verdict stays ok with a note naming its time
+  EXPECT_EQ(one.rejected, 1u);
+  EXPECT_EQ(one.verdict, HealthVerdict::kOk) << causes(one);
+  // GIVEN two outliers at different positions (2.5 % of 81 updates, above the 2 % limit)
+  const HealthReport two = with_outliers({330.0, 550.0}, "two_outliers.csv");
+  // THEN degraded, the cause is the rejections, not a lone one
+  EXPECT_EQ(two.rejected, 2u);
+  EXPECT_EQ(two.verdict, HealthVerdict::kDegraded) << causes(two);
+  EXPECT_TRUE(has(two, HealthCause::kRejections)) << causes(two);
+  EXPECT_FALSE(has(two, HealthCause::kLoneRejection));
+}
+
+TEST(HealthTest, ALoneRejectionAboveTheFractionLimitIsANoteWithItsTime) {
+  // GIVEN the lone outlier on a log of 28 updates (308 s: one rejection is 3.6 %, above 2 %)
+  auto p = mpu_like(19);
+  p.duration_s = 308.0;
+  p.gm_sigma_dps = 0.0;
+  p.before_quantise = [](Sample& s) {
+    if (s.t_s > 222.0 && s.t_s < 228.0) s.gyro1_dps.x() += 0.5;
+  };
+  EstimatorConfig cfg;
+  cfg.q_override_dps2_per_s = 1e-14;
+  const HealthReport h = run_synth(p, "lone_outlier_short.csv", cfg).health;
+  // THEN rejected 1 of 28, verdict ok, and the note carries the update's time and its NIS
+  EXPECT_EQ(h.rejected, 1u);
+  EXPECT_GT(h.rejected_fraction, HealthLimits{}.max_rejected_fraction);
+  EXPECT_EQ(h.verdict, HealthVerdict::kOk) << causes(h);
+  ASSERT_TRUE(has(h, HealthCause::kLoneRejection)) << causes(h);
+  const auto f = *std::find_if(h.findings.begin(), h.findings.end(),
+                               [](const HealthFinding& x) { return x.cause == HealthCause::kLoneRejection; });
+  EXPECT_EQ(f.severity, HealthVerdict::kOk);
+  EXPECT_GT(f.suggested, 225.0);  // the standstill 220..230 s ends its update near 230 s
+  EXPECT_LT(f.suggested, 231.0);
+  EXPECT_GT(f.value, chi2_quantile(EstimatorConfig{}.nis_gate_probability, 3.0));
+}
+
+// the monitor fed `n` accepted 3-dim updates of NIS `nis` after a lock
+HealthReport nis_only(int n, double nis) {
+  test::SynthParams p;
+  DriftlessFilter filter(EstimatorConfig{}, test::synth_geometry(p));
+  HealthMonitor mon;
+  for (int k = 0; k < n; ++k) {
+    UpdateRecord r;
+    r.accepted = true;
+    r.dim = 3;
+    r.nis = nis;
+    mon.on_update(r, filter);
+  }
+  return mon.finish(filter, 0.0);
+}
+
+TEST(HealthTest, ANisMeanAboveThe95BandIsANoteUntilThe999Band) {
+  // GIVEN 25 updates (75 dof): the 95 % band's top and the 99.9 % band's top, closed form by the
+  // Wilson-Hilferty cube to 1 % (chi2_p(k) = k (1 - 2/(9k) + z sqrt(2/(9k)))^3)
+  const HealthReport ref = nis_only(25, 3.0);
+  auto wh = [](double z, double k) {
+    const double a = 2.0 / (9.0 * k);
+    return k * std::pow(1.0 - a + z * std::sqrt(a), 3) / 25.0;
+  };
+  EXPECT_NEAR(ref.nis_mean_band_hi, wh(1.959964, 75.0), 0.01 * ref.nis_mean_band_hi);
+  EXPECT_NEAR(ref.nis_mean_degraded_above, wh(3.290527, 75.0), 0.01 * ref.nis_mean_degraded_above);
+  // WHEN the mean lies between the two THEN the NIS finding is a note
+  const double mid = 0.5 * (ref.nis_mean_band_hi + ref.nis_mean_degraded_above);
+  const HealthReport note = nis_only(25, mid);
+  ASSERT_TRUE(has(note, HealthCause::kNoiseUnderstated));
+  for (const auto& f : note.findings) {
+    if (f.cause == HealthCause::kNoiseUnderstated) {
+      EXPECT_EQ(f.severity, HealthVerdict::kOk);
+    }
+  }
+  // WHEN it lies above the 99.9 % band THEN degraded
+  const HealthReport bad = nis_only(25, ref.nis_mean_degraded_above * 1.01);
+  for (const auto& f : bad.findings) {
+    if (f.cause == HealthCause::kNoiseUnderstated) {
+      EXPECT_EQ(f.severity, HealthVerdict::kDegraded);
+    }
+  }
+  EXPECT_TRUE(has(bad, HealthCause::kNoiseUnderstated));
 }
 
 }  // namespace

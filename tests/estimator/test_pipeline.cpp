@@ -205,5 +205,84 @@ TEST(PipelineTest, AnEvaluationWindowScoresEverySampleInItAndReAlignsTheAttitude
   EXPECT_TRUE(std::isnan(late.attitude_realign_s));
 }
 
+// the lock flag of every row and of every update
+struct LockSink : EstimateSink {
+  struct Row {
+    double t_s;
+    PushStatus status;
+    bool locked;
+  };
+  std::vector<Row> rows;
+  std::vector<std::pair<double, bool>> updates;  // (update time, locked after it)
+  void on_sample(const Sample& s, const SampleOutput& o, bool locked) override { rows.push_back({s.t_s, o.status, locked}); }
+  void on_update(const UpdateRecord& r, const Matrix6d&, const Sample&, bool locked) override {
+    updates.emplace_back(r.t_s, locked);
+  }
+};
+
+TEST(PipelineTest, TheLockFlagStartsAtTheLockingUpdateAndDropsAtAReLock) {
+  // GIVEN a noisy flip log with a 1 deg/s step on gyro 1 x at t = 250 s and a filter that expects
+  // a steady bias (so the gate rejects the step, then re-locks with a widened P)
+  test::SynthParams p;
+  p.duration_s = 400.0;
+  p.noise_sigma_dps = 0.05;
+  p.before_quantise = [](Sample& s) {
+    if (s.t_s > 250.0) s.gyro1_dps.x() += 1.0;
+  };
+  const auto path = temp_path("lock_flag.csv");
+  test::synth_log(p, path);
+  EstimatorConfig cfg;
+  cfg.q_override_dps2_per_s = 1e-14;
+  LockSink sink;
+  log::LogReader reader(path);
+  const auto s = run_estimate(reader, cfg, &sink);
+  // THEN no row is locked before the row that made the locking update; from there on every row is
+  // until the re-lock, which unlocks until the filter locks again; the counts agree
+  ASSERT_TRUE(std::isfinite(s.locked_from_t_s));
+  ASSERT_EQ(s.relocks.size(), 1u);
+  const RelockEvent& rl = s.relocks[0];
+  ASSERT_TRUE(std::isfinite(rl.locked_again_t_s));
+  EXPECT_GT(rl.locked_again_t_s, rl.t_s + 5.0);  // at least one more standstill is needed
+  // the unlocked rows after the first lock: one run, from the row that made the re-lock update
+  // (just after its last standstill sample rl.t_s) to the row before locked_again_t_s
+  std::uint64_t locked_rows = 0;
+  double first_locked = kNaN, gap_start = kNaN, gap_end = kNaN;
+  int gaps = 0;
+  bool prev = false;
+  for (const auto& r : sink.rows) {
+    locked_rows += r.locked ? 1 : 0;
+    if (r.locked && std::isnan(first_locked)) {
+      first_locked = r.t_s;
+      EXPECT_EQ(r.status, PushStatus::kUpdated);  // the row whose push made the update
+    }
+    if (!std::isnan(first_locked) && prev != r.locked) {
+      if (!r.locked) {
+        ++gaps;
+        gap_start = r.t_s;
+        EXPECT_EQ(r.status, PushStatus::kUpdated);  // the re-lock update is taken
+      } else if (gaps > 0) {
+        gap_end = r.t_s;
+        EXPECT_EQ(r.status, PushStatus::kUpdated);
+      }
+    }
+    prev = r.locked;
+  }
+  EXPECT_DOUBLE_EQ(first_locked, s.locked_from_t_s);
+  EXPECT_EQ(gaps, 1);
+  EXPECT_GT(gap_start, rl.t_s);
+  EXPECT_LT(gap_start, rl.t_s + 0.5);  // the end margin and the first moving sample
+  EXPECT_DOUBLE_EQ(gap_end, rl.locked_again_t_s);
+  EXPECT_EQ(locked_rows, s.samples_locked);
+  EXPECT_LT(s.locked_from_t_s, 60.0);
+  // and the updates carry the same flag: the one before the lock is not locked, the last one is
+  ASSERT_GE(sink.updates.size(), 3u);
+  EXPECT_FALSE(sink.updates.front().second);
+  EXPECT_TRUE(sink.updates.back().second);
+  // the warning says when it locked again
+  bool warned = false;
+  for (const auto& w : s.warnings) warned = warned || w.find("locked again at t =") != std::string::npos;
+  EXPECT_TRUE(warned);
+}
+
 }  // namespace
 }  // namespace driftless::est
