@@ -8,6 +8,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "calibration/yaml_io.hpp"
+#include "estimator/geometry.hpp"
 #include "estimator/output_file.hpp"
 
 namespace driftless::calib {
@@ -137,6 +138,67 @@ void save_calib(const std::filesystem::path& path, const est::CalibFit& fit,
   io::write_file(path, std::string(out.c_str()) + "\n");
 }
 
+void save_selfcal_calib(const std::filesystem::path& path, const SelfCalibration& sc) {
+  using yio::num;
+  YAML::Emitter out;
+  out << YAML::Comment(
+      "driftless estimate --selfcal output (docs/calibration.md). Convention as driftless calibrate's:\n"
+      "y_i = M^-1 w_box + b_i + G_i f_i + k_i (T_i - T_ref); M here are the nominal rotations (not\n"
+      "calibrated). Units: deg/s, deg, deg/s per g, deg/s per degC, degC.");
+  out << YAML::BeginMap;
+  out << YAML::Key << "format" << YAML::Value << kCalibFormat;
+  out << YAML::Key << "method" << YAML::Value << "selfcal";
+  out << YAML::Key << "matrices" << YAML::Value << "nominal";
+  out << YAML::Key << "hinge1_axis" << YAML::Value;
+  yio::emit_vec3(out, sc.hinge1_axis);
+  out << YAML::Key << "hinge2_axis" << YAML::Value;
+  yio::emit_vec3(out, sc.hinge2_axis);
+  out << YAML::Key << "rig" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "source" << YAML::Value << sc.source;
+  out << YAML::Key << "latitude_deg" << YAML::Value;
+  emit_num_or_null(out, sc.latitude_deg);
+  out << YAML::Key << "sample_rate_hz" << YAML::Value;
+  emit_num_or_null(out, sc.sample_rate_hz);
+  out << YAML::EndMap;
+  for (int i = 0; i < 2; ++i) {
+    const auto iu = static_cast<std::size_t>(i);
+    const Eigen::Vector3d axis = (i == 0 ? sc.hinge1_axis : sc.hinge2_axis).normalized();
+    out << YAML::Key << kSensorKey[i] << YAML::Value << YAML::BeginMap;
+    for (int p = 0; p < 2; ++p) {
+      out << YAML::Key << kPosKey[p] << YAML::Value << YAML::BeginMap << YAML::Key << "M" << YAML::Value;
+      yio::emit_mat3(out, geo::rot_about_axis_deg(axis, p == 0 ? -90.0 : 90.0));
+      out << YAML::EndMap;
+    }
+    out << YAML::Key << "g_sensitivity" << YAML::Value << YAML::BeginMap << YAML::Key << "G_dps_per_g" << YAML::Value;
+    yio::emit_mat3(out, sc.G_dps_per_g[iu]);
+    out << YAML::Key << "G_sigma" << YAML::Value;
+    yio::emit_mat3(out, sc.G_sigma[iu]);
+    out << YAML::EndMap;
+    if (sc.temp_states) {
+      out << YAML::Key << "temperature" << YAML::Value << YAML::BeginMap << YAML::Key << "bias_tc_dps_per_degc"
+          << YAML::Value;
+      yio::emit_vec3(out, sc.temp_coef_dps_per_degc[iu]);
+      out << YAML::Key << "bias_tc_sigma_dps_per_degc" << YAML::Value;
+      yio::emit_vec3(out, sc.temp_coef_sigma_dps_per_degc[iu]);
+      out << YAML::Key << "final_temp_degc" << YAML::Value;
+      emit_num_or_null(out, sc.temp_ref_c[iu]);
+      out << YAML::EndMap;
+    }
+    out << YAML::EndMap;
+  }
+  out << YAML::EndMap;
+  io::write_file(path, std::string(out.c_str()) + "\n");
+}
+
+est::Calibration CalibFile::to_filter_calibration() const {
+  est::Calibration cal = matrices_nominal ? est::Calibration{} : est::to_filter_calibration(M);
+  if (has_g_sensitivity) cal.G_dps_per_g = G_dps_per_g;
+  cal.has_temp_coef = has_temp_coef;
+  cal.temp_coef_dps_per_degc = temp_coef_dps_per_degc;
+  cal.temp_coef_sigma_dps_per_degc = temp_coef_sigma_dps_per_degc;
+  return cal;
+}
+
 CalibFile load_calib(const std::filesystem::path& path) {
   using namespace yio;
   const std::string file = path.string();
@@ -153,6 +215,11 @@ CalibFile load_calib(const std::filesystem::path& path) {
     fail(file, root["format"], "format", std::string("expected '") + kCalibFormat + "', got '" + fmt_id + "'");
   CalibFile c;
   c.method = root["method"] ? as_string(root["method"], file, "method") : "unknown";
+  if (root["matrices"]) {
+    const std::string m = as_string(root["matrices"], file, "matrices");
+    if (m != "nominal" && m != "calibrated") fail(file, root["matrices"], "matrices", "expected nominal or calibrated, got '" + m + "'");
+    c.matrices_nominal = m == "nominal";
+  }
   if (root["hinge1_axis"]) c.hinge1_axis = as_vec3(root["hinge1_axis"], file, "hinge1_axis");
   if (root["hinge2_axis"]) c.hinge2_axis = as_vec3(root["hinge2_axis"], file, "hinge2_axis");
   if (const YAML::Node rig = root["rig"]) {
@@ -179,6 +246,16 @@ CalibFile load_calib(const std::filesystem::path& path) {
       const std::string key = std::string(kSensorKey[i]) + ".g_sensitivity.G_dps_per_g";
       c.G_dps_per_g[static_cast<std::size_t>(i)] = as_mat3(gs["G_dps_per_g"], file, key);
       c.has_g_sensitivity = true;
+    }
+    if (const YAML::Node tn = s["temperature"]) {
+      const std::string key = std::string(kSensorKey[i]) + ".temperature.";
+      const auto iu = static_cast<std::size_t>(i);
+      c.temp_coef_dps_per_degc[iu] = as_vec3(tn["bias_tc_dps_per_degc"], file, key + "bias_tc_dps_per_degc");
+      c.temp_coef_sigma_dps_per_degc[iu] =
+          as_vec3(tn["bias_tc_sigma_dps_per_degc"], file, key + "bias_tc_sigma_dps_per_degc");
+      if ((c.temp_coef_sigma_dps_per_degc[iu].array() < 0.0).any())
+        fail(file, tn["bias_tc_sigma_dps_per_degc"], key + "bias_tc_sigma_dps_per_degc", "a sigma must be >= 0 deg/s per degC");
+      c.has_temp_coef = true;
     }
   }
   with_location(file, 0, "", [&] { c.M.validate(); });

@@ -44,7 +44,35 @@ struct CalibFile {
   /// g-sensitivity per sensor (sensorN.g_sensitivity.G_dps_per_g, deg/s per g), when fitted
   bool has_g_sensitivity = false;
   std::array<Eigen::Matrix3d, 2> G_dps_per_g{Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero()};
+  /// `matrices: nominal`: M are the nominal rotations Rot(hinge, +-90), not calibrated (a
+  /// self-calibration's file); the twin prior then leaves scale, misalignment and mounting alone
+  bool matrices_nominal = false;
+  /// bias temperature coefficients (sensorN.temperature, deg/s per degC) with their 1-sigma
+  bool has_temp_coef = false;
+  std::array<Eigen::Vector3d, 2> temp_coef_dps_per_degc{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  std::array<Eigen::Vector3d, 2> temp_coef_sigma_dps_per_degc{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  /// what the estimator uses: M, G and the temperature coefficients
+  est::Calibration to_filter_calibration() const;
 };
+
+/// What `driftless estimate --selfcal --calib-out` writes: the g-sensitivity and temperature
+/// coefficients the filter estimated, each with its 1-sigma; M stays nominal.
+struct SelfCalibration {
+  std::string source;  // "estimate --selfcal on FILE"
+  double latitude_deg = driftless::kNaN;
+  double sample_rate_hz = driftless::kNaN;
+  Eigen::Vector3d hinge1_axis = Eigen::Vector3d::UnitZ();
+  Eigen::Vector3d hinge2_axis = Eigen::Vector3d::UnitX();
+  std::array<Eigen::Matrix3d, 2> G_dps_per_g{Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero()};
+  std::array<Eigen::Matrix3d, 2> G_sigma{Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero()};
+  bool temp_states = false;  // the temperature coefficients below were states
+  std::array<Eigen::Vector3d, 2> temp_coef_dps_per_degc{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  std::array<Eigen::Vector3d, 2> temp_coef_sigma_dps_per_degc{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  std::array<double, 2> temp_ref_c{driftless::kNaN, driftless::kNaN};  // degC, of the final bias
+};
+
+/// Writes a self-calibration as calib.yaml (same format; method selfcal, matrices nominal).
+void save_selfcal_calib(const std::filesystem::path& path, const SelfCalibration& sc);
 
 /// Writes calib.yaml (throws std::runtime_error naming the path when it cannot be written).
 /// With a valid `g`, each sensor block also holds its g_sensitivity.

@@ -30,11 +30,32 @@ SensorPrior sensor_prior(const est::CalibMatrices& m, int sensor, const Eigen::V
   return p;
 }
 
+namespace {
+
+// the effects M determines: scale factor, misalignment and mounting (see sensor_prior)
+void emit_matrix_effects(YAML::Emitter& out, const SensorPrior& s) {
+  using yio::num;
+  out << YAML::Key << "scale_factor" << YAML::Value << YAML::BeginMap << YAML::Key << "enabled" << YAML::Value << true
+      << YAML::Key << "value_pct" << YAML::Value;
+  yio::emit_vec3(out, s.scale_pct);
+  out << YAML::Key << "sigma_pct" << YAML::Value << 0 << YAML::EndMap;
+  out << YAML::Key << "misalignment" << YAML::Value << YAML::BeginMap << YAML::Key << "enabled" << YAML::Value << true
+      << YAML::Key << "matrix_pct" << YAML::Value;
+  yio::emit_mat3(out, s.misalignment_pct);
+  out << YAML::Key << "sigma_pct" << YAML::Value << 0 << YAML::EndMap;
+  out << YAML::Key << "mounting_misalignment" << YAML::Value << YAML::BeginMap << YAML::Key << "enabled" << YAML::Value
+      << true << YAML::Key << "angles_deg" << YAML::Value;
+  yio::emit_vec3(out, s.mounting_deg);
+  out << YAML::Key << "sigma_deg" << YAML::Value << 0 << YAML::EndMap;
+}
+
+}  // namespace
+
 std::string model_prior_yaml(const CalibFile& c) {
   using yio::num;
   YAML::Emitter out;
   out << YAML::Comment("model prior from a calibration (" + c.source +
-                       "), written by driftless calibrate --prior-out; docs/calibration.md");
+                       "), written by --prior-out; docs/calibration.md");
   out << YAML::BeginMap << YAML::Key << "model" << YAML::Value << YAML::BeginMap;
   const SensorPrior s[2] = {sensor_prior(c.M, 0, c.hinge1_axis), sensor_prior(c.M, 1, c.hinge2_axis)};
   out << YAML::Key << "box" << YAML::Value << YAML::BeginMap;
@@ -42,31 +63,30 @@ std::string model_prior_yaml(const CalibFile& c) {
   yio::emit_vec3(out, c.hinge1_axis);
   out << YAML::Key << "hinge2_axis" << YAML::Value;
   yio::emit_vec3(out, c.hinge2_axis);
-  for (int i = 0; i < 2; ++i) {
+  // nominal matrices (a self-calibration) say nothing about the stops: the scenario's stay
+  for (int i = 0; i < 2 && !c.matrices_nominal; ++i) {
     out << YAML::Key << (i == 0 ? "stop1_error_deg" : "stop2_error_deg") << YAML::Value << YAML::Flow
         << YAML::BeginSeq << num(s[i].stop_error_deg[0]) << num(s[i].stop_error_deg[1]) << YAML::EndSeq;
   }
   out << YAML::EndMap;
   for (int i = 0; i < 2; ++i) {
+    const auto iu = static_cast<std::size_t>(i);
     out << YAML::Key << (i == 0 ? "sensor1" : "sensor2") << YAML::Value << YAML::BeginMap;
     out << YAML::Key << "effects" << YAML::Value << YAML::BeginMap;
-    out << YAML::Key << "scale_factor" << YAML::Value << YAML::BeginMap << YAML::Key << "enabled"
-        << YAML::Value << true << YAML::Key << "value_pct" << YAML::Value;
-    yio::emit_vec3(out, s[i].scale_pct);
-    out << YAML::Key << "sigma_pct" << YAML::Value << 0 << YAML::EndMap;
-    out << YAML::Key << "misalignment" << YAML::Value << YAML::BeginMap << YAML::Key << "enabled"
-        << YAML::Value << true << YAML::Key << "matrix_pct" << YAML::Value;
-    yio::emit_mat3(out, s[i].misalignment_pct);
-    out << YAML::Key << "sigma_pct" << YAML::Value << 0 << YAML::EndMap;
-    out << YAML::Key << "mounting_misalignment" << YAML::Value << YAML::BeginMap << YAML::Key
-        << "enabled" << YAML::Value << true << YAML::Key << "angles_deg" << YAML::Value;
-    yio::emit_vec3(out, s[i].mounting_deg);
-    out << YAML::Key << "sigma_deg" << YAML::Value << 0 << YAML::EndMap;
+    if (!c.matrices_nominal) emit_matrix_effects(out, s[i]);
     if (c.has_g_sensitivity) {
       out << YAML::Key << "g_sensitivity" << YAML::Value << YAML::BeginMap << YAML::Key << "enabled"
           << YAML::Value << true << YAML::Key << "matrix_dps_per_g" << YAML::Value;
-      yio::emit_mat3(out, c.G_dps_per_g[static_cast<std::size_t>(i)]);
+      yio::emit_mat3(out, c.G_dps_per_g[iu]);
       out << YAML::Key << "sigma_dps_per_g" << YAML::Value << 0 << YAML::EndMap;
+    }
+    if (c.has_temp_coef) {
+      out << YAML::Key << "temperature" << YAML::Value << YAML::BeginMap << YAML::Key << "bias_tc_dps_per_degc"
+          << YAML::Value;
+      yio::emit_vec3(out, c.temp_coef_dps_per_degc[iu]);
+      out << YAML::Key << "bias_tc_sigma_dps_per_degc" << YAML::Value;
+      yio::emit_vec3(out, Eigen::Vector3d::Zero());
+      out << YAML::EndMap;
     }
     out << YAML::EndMap << YAML::EndMap;
   }

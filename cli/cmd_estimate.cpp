@@ -19,6 +19,8 @@
 #include "estimator/pipeline.hpp"
 #include "estimator/tune.hpp"
 #include "calibration/calib_file.hpp"
+#include "calibration/prior.hpp"
+#include "estimator/output_file.hpp"
 
 namespace driftless::cli {
 namespace {
@@ -31,6 +33,8 @@ struct EstimateArgs {
   std::string mode;  // empty = config / general
   std::string config;
   std::string calib;  // calib.yaml from driftless calibrate (docs/calibration.md)
+  std::string calib_out;  // --selfcal: write the estimated G and temperature coefficients as calib.yaml
+  std::string prior_out;  // with --calib-out: the same as a twin model prior
   bool plot = false;
   bool corrected = false;  // write corrected.csv (--corrected)
   bool selfcal = false;   // self-calibrating mode: g-sensitivity states (docs/estimator.md section 1b)
@@ -41,6 +45,33 @@ struct EstimateArgs {
 };
 
 bool stop_polled() { return stop_requested().load(); }
+
+// --calib-out / --prior-out: what the self-calibrating pass estimated, as calib.yaml and as a twin
+// model prior (docs/calibration.md "calib.yaml from a self-calibration")
+void write_selfcal_files(const EstimateArgs& a, const log::Metadata& meta, const est::EstimateSummary& s) {
+  if (a.calib_out.empty()) return;
+  calib::SelfCalibration sc;
+  sc.source = "driftless estimate --selfcal on " + a.log;
+  sc.latitude_deg = meta.latitude_deg();
+  sc.sample_rate_hz = meta.sample_rate_hz();
+  sc.hinge1_axis = meta.hinge1_axis();
+  sc.hinge2_axis = meta.hinge2_axis();
+  sc.G_dps_per_g = s.gsens_dps_per_g;
+  sc.G_sigma = s.gsens_sigma_dps_per_g;
+  sc.temp_states = s.temp_states;
+  for (int i = 0; i < 2; ++i) {
+    const auto iu = static_cast<std::size_t>(i);
+    sc.temp_coef_dps_per_degc[iu] = s.temp_coef_dps_per_degc.segment<3>(3 * i);
+    sc.temp_coef_sigma_dps_per_degc[iu] = s.temp_coef_sigma_dps_per_degc.segment<3>(3 * i);
+  }
+  sc.temp_ref_c = s.temp_ref_c;
+  calib::save_selfcal_calib(a.calib_out, sc);
+  fmt::print("  wrote {} (g-sensitivity{} with 1-sigma; M nominal)\n", a.calib_out,
+             sc.temp_states ? " and bias temperature coefficients" : "");
+  if (a.prior_out.empty()) return;
+  io::write_file(a.prior_out, calib::model_prior_yaml(calib::load_calib(a.calib_out)));
+  fmt::print("  wrote {} (model prior for the twin)\n", a.prior_out);
+}
 
 // --tune auto: a first pass over the log measures N and K (docs/estimator.md section 6.2)
 est::TuneResult tune_config(const EstimateArgs& a, est::EstimatorConfig& cfg) {
@@ -85,6 +116,10 @@ int run_estimate_cmd(const EstimateArgs& a) {
   if (!a.mode.empty()) est::set_config_value(cfg, "mode", a.mode);
   if (a.selfcal) cfg.self_calibration = true;
   if (a.box_at_rest) cfg.box_at_rest = true;
+  if (!a.calib_out.empty() && !cfg.self_calibration) {
+    throw std::invalid_argument("--calib-out needs --selfcal (or self_calibration: true in --config): without it "
+                                "the g-sensitivity is not estimated");
+  }
   // parse the column groups the pass uses (the accelerometers only for a g-sensitivity calibration;
   // the temperatures drive the bias temperature states)
   log::ReaderOptions read_opt;
@@ -104,9 +139,9 @@ int run_estimate_cmd(const EstimateArgs& a) {
           meta.hinge1_axis().y(), meta.hinge1_axis().z(), meta.hinge2_axis().x(), meta.hinge2_axis().y(),
           meta.hinge2_axis().z()));
     }
-    cfg.calibration = est::to_filter_calibration(c.M);
-    // y <- y - G f / g with the log's accelerometer columns (samples without them stay as they are)
-    if (c.has_g_sensitivity) cfg.calibration.G_dps_per_g = c.G_dps_per_g;
+    // M (unless nominal); y <- y - G f / g with the log's accelerometer columns (samples without
+    // them stay as they are); the temperature states start at the calibrated coefficients
+    cfg.calibration = c.to_filter_calibration();
   }
   cfg.validate();
   est::TuneResult tune;
@@ -192,6 +227,7 @@ int run_estimate_cmd(const EstimateArgs& a) {
                                        summary.t_last_s)
                          : "");
   if (interrupted) return interrupted_exit_code();
+  write_selfcal_files(a, reader.metadata(), summary);
   std::fflush(stdout);
   return report_health(a, cfg, summary.health);
 }
@@ -215,10 +251,20 @@ const bool registered = register_command(30, [](CLI::App& app) {
                   "_dps, _dps_rthz, _dps2; docs/estimator.md)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--calib", a->calib,
-                  "Calibration file from 'driftless calibrate' (calib.yaml): the matrices M per "
-                  "sensor and end stop (deg/s in, deg/s out) replace the hinge rotations; "
-                  "docs/calibration.md")
+                  "Calibration file (calib.yaml) from 'driftless calibrate' (the matrices M per sensor and "
+                  "end stop replace the hinge rotations; its G, deg/s per g, is subtracted) or from "
+                  "'estimate --selfcal --calib-out' (G, and the temperature states start at its "
+                  "coefficients, deg/s per degC); docs/calibration.md")
       ->check(CLI::ExistingFile);
+  auto* calib_out = cmd->add_option(
+      "--calib-out", a->calib_out,
+      "With --selfcal: write the estimated g-sensitivity (deg/s per g) and bias temperature "
+      "coefficients (deg/s per degC), each with its 1-sigma, as calib.yaml for --calib on the next "
+      "log of the same sensors (M stays nominal); docs/calibration.md");
+  cmd->add_option("--prior-out", a->prior_out,
+                  "With --calib-out: the same as a twin model-config file (a scenario's model: block; "
+                  "compare/diagnose/render --model)")
+      ->needs(calib_out);
   cmd->add_flag("--corrected", a->corrected,
                 "Also write corrected.csv: the corrected gyro and fused rates per log row (deg/s), about "
                 "110 bytes a row (0.6 GB for a 14 h log at 100 Hz); the bias estimates are in estimate.csv "

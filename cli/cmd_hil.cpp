@@ -13,6 +13,7 @@
 #include "estimator/filter.hpp"
 #include "estimator/log.hpp"
 #include "estimator/log_metadata.hpp"
+#include "hil_bridge/cpu_latency.hpp"
 #include "hil_bridge/live_loop.hpp"
 #include "hil_bridge/source_rig.hpp"
 
@@ -30,9 +31,27 @@ struct HilOptions {
   int baud = 921600;
   std::uint64_t seed = 1;
   bool realtime = false;
+  bool allow_deep_idle = false;
 };
 
 std::string vec3(const Eigen::Vector3d& v) { return fmt::format("{:+.4f} {:+.4f} {:+.4f}", v.x(), v.y(), v.z()); }
+
+// A session paced by the wall clock (hardware, emu-serial, --realtime) polls its source on time;
+// ask Linux to keep the cores out of deep idle states while it runs (docs/hil.md "Speed").
+std::unique_ptr<hil::CpuLatencyRequest> hold_cpus_awake(const HilOptions& o, const hil::SourceRig& first,
+                                                        const hil::SourceRig* second) {
+  auto paced = [](const hil::SourceRig& r) { return dynamic_cast<const hil::SteadyClock*>(r.clock) != nullptr; };
+  if (o.allow_deep_idle || !(paced(first) || (second && paced(*second)))) return nullptr;
+  auto req = std::make_unique<hil::CpuLatencyRequest>(0);
+  if (req->held()) {
+    fmt::print("driftless hil: holding the CPUs out of deep idle states while the session runs (PM QoS 0 us; "
+               "--allow-deep-idle to save power)\n");
+  } else {
+    fmt::print(stderr, "driftless hil: note: could not keep the CPUs out of deep idle states ({}): wake-up "
+               "latency may add tens of microseconds on an idle machine\n", req->why_not());
+  }
+  return req;
+}
 
 int run_hil(const HilOptions& o) {
   if (!o.switch_to.empty() && std::isnan(o.at_s)) {
@@ -101,6 +120,7 @@ int run_hil(const HilOptions& o) {
   if (!std::isnan(o.duration_s)) lp.duration_s = o.duration_s;
   lp.switch_at_s = o.at_s;
   hil::SteadyClock wall;
+  const auto latency_request = hold_cpus_awake(o, *first, second.get());
   hil::LiveLoop loop(lp, wall, &writer, &filter);
   loop.set_motors(first->source, first->motors, first->schedule);
   if (second) loop.set_motors(second->source, second->motors, second->schedule);
@@ -169,6 +189,9 @@ const bool registered = register_command(60, [](CLI::App& app) {
   cmd->add_flag("--realtime", o->realtime,
                 "Pace the twin, replays and emu-i2c by the wall clock (default: as fast as possible; "
                 "hardware and emu-serial always run in real time)");
+  cmd->add_flag("--allow-deep-idle", o->allow_deep_idle,
+                "Do not ask Linux to keep the CPUs out of deep idle states during a session paced by the wall "
+                "clock (saves power; wake-ups can then be tens of microseconds later)");
   cmd->add_option("--duration", o->duration_s, "Session time to run, s (default: until the source ends)");
   cmd->add_option("--rate", o->rate_hz, "Sample rate of i2c, serial and emulated sources, Hz")->default_val(100.0);
   cmd->add_option("--standstill", o->standstill_s, "Flip schedule hold time at each position, s")->default_val(10.0);

@@ -43,6 +43,12 @@ struct Calibration {
   /// g-sensitivity per sensor, deg/s per g of specific force (sensor axes): push() subtracts
   /// G f / g from the gyros of samples whose accel columns are finite. Zero = none.
   std::array<Eigen::Matrix3d, 2> G_dps_per_g{Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero()};
+  /// bias temperature coefficients per sensor (deg/s per degC, sensor axes) and their 1-sigma,
+  /// e.g. from a self-calibration's calib.yaml: the temperature states (when on) start here
+  /// instead of at 0 with the data-sheet prior temp_coef_sigma_dps_per_degc
+  bool has_temp_coef = false;
+  std::array<Eigen::Vector3d, 2> temp_coef_dps_per_degc{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  std::array<Eigen::Vector3d, 2> temp_coef_sigma_dps_per_degc{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
   bool empty() const { return sensor1.empty() && sensor2.empty(); }
   bool has_g_sensitivity() const { return !G_dps_per_g[0].isZero(0.0) || !G_dps_per_g[1].isZero(0.0); }
   /// Throws std::invalid_argument when a matrix is singular or not finite.

@@ -28,6 +28,11 @@ void Calibration::validate() const {
   for (int i = 0; i < 2; ++i) {
     if (!G_dps_per_g[static_cast<std::size_t>(i)].allFinite())
       throw std::invalid_argument("calibration: sensor " + std::to_string(i + 1) + " has a non-finite g-sensitivity entry");
+    const auto& k = temp_coef_dps_per_degc[static_cast<std::size_t>(i)];
+    const auto& ks = temp_coef_sigma_dps_per_degc[static_cast<std::size_t>(i)];
+    if (has_temp_coef && (!k.allFinite() || !ks.allFinite() || (ks.array() < 0.0).any()))
+      throw std::invalid_argument("calibration: sensor " + std::to_string(i + 1) +
+                                  " has a non-finite temperature coefficient or a negative sigma (deg/s per degC)");
   }
   auto check = [&](const std::vector<CalibratedPosition>& list, int sensor) {
     for (const auto& p : list) {
@@ -148,6 +153,15 @@ DriftlessFilter::DriftlessFilter(const EstimatorConfig& cfg, const BoxGeometry& 
   // the temperature coefficients start at 0 with the spec's sigma; off, they stay exactly 0
   P_.diagonal().segment<6>(kTempCoef1.start).setConstant(cfg_.temp_coef_sigma_dps_per_degc *
                                                           cfg_.temp_coef_sigma_dps_per_degc);
+  // a calibrated start (calib.yaml from a self-calibration): its values and sigma (floored)
+  if (has_temp_states() && cfg_.calibration.has_temp_coef) {
+    for (int i = 0; i < 2; ++i) {
+      const auto iu = static_cast<std::size_t>(i);
+      x_.segment<3>(kTempCoef1.start + 3 * i) = cfg_.calibration.temp_coef_dps_per_degc[iu];
+      P_.diagonal().segment<3>(kTempCoef1.start + 3 * i) =
+          cfg_.calibration.temp_coef_sigma_dps_per_degc[iu].cwiseAbs2().cwiseMax(cfg_.variance_floor_dps2);
+    }
+  }
   // the g-sensitivities start at 0 with the spec's sigma in self-calibrating mode, else stay 0
   if (has_gsens_states()) {
     P_.diagonal().segment<18>(kGSens1.start).setConstant(cfg_.gsens_sigma_dps_per_g * cfg_.gsens_sigma_dps_per_g);

@@ -13,17 +13,29 @@ CC=clang CXX=clang++ cmake -S "$root/tests/fuzz" -B "$build" -DCMAKE_BUILD_TYPE=
 cmake --build "$build" -j "$(nproc 2>/dev/null || echo 2)"
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
-status=0
-for corpus in "$root"/tests/fuzz/corpus/*/; do
-  name=$(basename "$corpus")
-  work="$build/work/$name"; mkdir -p "$work"
-  log="$build/$name.log"
+# one harness per core at a time: each runs single-threaded for its bounded time, so the stage takes
+# about ceil(harnesses / cores) x SECONDS instead of harnesses x SECONDS
+fuzz_one() {
+  local name=$1 corpus=$2
+  local work="$build/work/$name" log="$build/$name.log"
+  mkdir -p "$work"
   # new inputs go to the work folder; the committed corpus is read, never written
   if "$build/fuzz_$name" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
        -artifact_prefix="$build/$name-" "$work" "$corpus" > "$log" 2>&1; then
     echo "fuzz $name: $(grep -m1 'stat::number_of_executed_units' "$log" | awk '{print $2}') runs, no finding"
   else
-    echo "fuzz $name: FINDING (full log: $log)"; tail -40 "$log"; status=1
+    echo "fuzz $name: FINDING (full log: $log)"; tail -40 "$log"; return 1
   fi
+}
+cores=$(nproc 2>/dev/null || echo 2)
+status=0
+pids=()
+for corpus in "$root"/tests/fuzz/corpus/*/; do
+  while (( $(jobs -rp | wc -l) >= cores )); do wait -n || status=1; done
+  fuzz_one "$(basename "$corpus")" "$corpus" &
+  pids+=($!)
 done
+# wait for each remaining harness by pid: 'wait -n' above already reaped some, and waiting on a
+# reaped pid returns its saved status in bash
+for pid in "${pids[@]}"; do wait "$pid" || status=1; done
 exit $status

@@ -1,0 +1,96 @@
+#!/usr/bin/env bash
+# calib.yaml from the self-calibrating mode (docs/calibration.md "calib.yaml from a
+# self-calibration"): --selfcal --box-at-rest on one static log of a pair of MPU6050s writes their
+# g-sensitivity and temperature coefficients with sigma; `estimate --calib` on a second log of the
+# same sensors (other seed: other turn-on bias and noise) then locks without --selfcal, where the
+# plain estimate fails; the twin accepts the same file as a model prior.
+# usage: estimate_selfcal_calib.sh <path-to-driftless> <source-dir>
+set -uo pipefail
+bin=$1
+t=$(mktemp -d); trap 'rm -rf "$t"' EXIT
+fail() { echo "FAIL: $*"; exit 1; }
+verdict() { jq -r .health.verdict "$1/summary.json"; }
+
+# GIVEN the static scenario with one pair of sensors: G (deg/s per g) and the bias temperature
+# coefficients (deg/s per degC) planted with no run-to-run draw, so two seeds are two logs of the
+# same sensors
+cat > "$t/pair.yaml" <<'EOF'
+name: static_pair
+description: static box, the same two MPU6050s in every run (planted g-sensitivity and tempco)
+duration_s: 600
+seed: 4
+latitude_deg: 52.0
+sample_rate_hz: 100
+platform_readback: end_stops
+model:
+  box:
+    stop1_error_deg: [0.12, -0.08]
+    stop2_error_deg: [-0.05, 0.15]
+  sensor1:
+    preset: mpu6050
+    effects:
+      g_sensitivity: {matrix_dps_per_g: [[0.03, -0.02, 0.05], [0.04, 0.02, -0.03], [-0.05, 0.06, 0.02]], sigma_dps_per_g: 0}
+      temperature: {bias_tc_dps_per_degc: [0.03, -0.05, 0.04], bias_tc_sigma_dps_per_degc: [0, 0, 0]}
+  sensor2:
+    preset: mpu6050
+    effects:
+      g_sensitivity: {matrix_dps_per_g: [[-0.04, 0.03, 0.02], [0.05, -0.03, 0.04], [0.02, -0.06, 0.03]], sigma_dps_per_g: 0}
+      temperature: {bias_tc_dps_per_degc: [-0.02, 0.06, -0.04], bias_tc_sigma_dps_per_degc: [0, 0, 0]}
+motion:
+  type: static
+  attitude_ypr_deg: [30, 0, 0]
+flip_schedule:
+  standstill_s: 30
+  flip_angle_deg: 90
+EOF
+"$bin" simulate --scenario "$t/pair.yaml" --seed 4 --out "$t/a" > /dev/null 2>&1 || fail "simulate seed 4"
+"$bin" simulate --scenario "$t/pair.yaml" --seed 5 --out "$t/b" > /dev/null 2>&1 || fail "simulate seed 5"
+
+# WHEN the first log is self-calibrated with --calib-out
+"$bin" estimate --log "$t/a/log.csv" --out "$t/sc" --selfcal --box-at-rest --calib-out "$t/calib.yaml" \
+  --prior-out "$t/prior.yaml" > "$t/sc.out" 2> "$t/sc.err" || fail "selfcal: exit $?: $(cat "$t/sc.out" "$t/sc.err")"
+# THEN calib.yaml holds G with its sigma, the temperature coefficients, nominal matrices
+for key in "format: driftless-calib 1" "method: selfcal" "matrices: nominal" G_dps_per_g G_sigma \
+           bias_tc_dps_per_degc bias_tc_sigma_dps_per_degc; do
+  grep -q "$key" "$t/calib.yaml" || fail "calib.yaml lacks '$key'"
+done
+# AND the G it holds is the planted one where the flips observe it: sensor 2's y column (platform 2
+# turns about box x, so gravity lies along sensor 2's +-y) within 4 sigma of the planted
+# (0.03, -0.03, -0.06) deg/s per g, sigma well below the prior 0.0577; the other columns keep it
+python3 - "$t/calib.yaml" <<'EOF' || fail "calib.yaml G against the planted G"
+import sys, re
+text = open(sys.argv[1]).read()
+s2 = text[text.index("sensor2:"):]
+def mat(key):
+    m = re.search(key + r":\s*\n((?:\s*- \[.*\]\n){3})", s2)
+    return [[float(v) for v in row.strip()[3:-1].split(",")] for row in m.group(1).strip().splitlines()]
+G, S = mat("G_dps_per_g"), mat("G_sigma")
+ok = True
+for r, want in enumerate([0.03, -0.03, -0.06]):
+    print(f"sensor 2 G[{r}][y] {G[r][1]:.4f} sigma {S[r][1]:.4f} (planted {want})")
+    ok = ok and 0 < S[r][1] < 0.01 and abs(G[r][1] - want) < 4 * S[r][1]
+    ok = ok and abs(S[r][0] - 0.0577) < 0.001  # the x column: gravity never along sensor x
+sys.exit(0 if ok else 1)
+EOF
+
+# WHEN the second log is estimated without self-calibration
+"$bin" estimate --log "$t/b/log.csv" --out "$t/plain" > /dev/null 2>&1
+[[ $(verdict "$t/plain") == failed ]] || fail "second log without --calib: verdict $(verdict "$t/plain"), expected failed"
+# AND with --calib calib.yaml (no --selfcal)
+"$bin" estimate --log "$t/b/log.csv" --out "$t/cal" --calib "$t/calib.yaml" > "$t/cal.out" 2> "$t/cal.err"
+rc=$?
+# THEN it locks, with few rejections, and exits 0
+[[ $rc -eq 0 ]] || fail "second log with --calib: exit $rc: $(cat "$t/cal.out" "$t/cal.err")"
+jq -e '.health.locked and .health.rejected_fraction < 0.05 and .self_calibration.enabled == false' \
+  "$t/cal/summary.json" > /dev/null || fail "second log with --calib: $(jq -c .health "$t/cal/summary.json")"
+
+# AND the twin accepts the model prior (a scenario whose model: block is the prior): the run plants
+# the self-calibrated G of sensor 2
+{ printf 'name: from_prior\nduration_s: 5\nseed: 5\n'; grep -v '^#' "$t/prior.yaml"; printf 'motion: {type: static}\n'; } > "$t/twin.yaml"
+"$bin" simulate --scenario "$t/twin.yaml" --out "$t/twin" > /dev/null 2> "$t/twin.err" || fail "simulate with the prior: $(cat "$t/twin.err")"
+g=$(grep -o 'matrix_dps_per_g: \[\[[^]]*\], \[[^]]*\]' "$t/twin/scenario.resolved.yaml" | sed -n 2p)
+[[ $g == *"0.0304"* ]] || fail "the prior's sensor 2 G is not in the resolved scenario: $g"
+# --calib-out without --selfcal is refused
+"$bin" estimate --log "$t/b/log.csv" --out "$t/x" --calib-out "$t/x.yaml" > /dev/null 2> "$t/x.err"
+[[ $? -ne 0 ]] && grep -q -- "--calib-out needs --selfcal" "$t/x.err" || fail "--calib-out without --selfcal accepted"
+echo "ok"
