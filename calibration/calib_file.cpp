@@ -59,11 +59,7 @@ void save_calib(const std::filesystem::path& path, const est::CalibFit& fit,
     out << YAML::Key << "name" << YAML::Value << s.name;
     out << YAML::Key << "axis_box" << YAML::Value;
     yio::emit_vec3(out, s.axis_box);
-    out << YAML::Key << "plat1_deg" << YAML::Value << num(s.plat1_deg);
-    out << YAML::Key << "plat2_deg" << YAML::Value << num(s.plat2_deg);
-    out << YAML::Key << "t_start_s" << YAML::Value << num(s.t_start_s);
-    out << YAML::Key << "t_end_s" << YAML::Value << num(s.t_end_s);
-    out << YAML::Key << "rate_dps" << YAML::Value << num(s.rate_dps);
+    emit_segment_span(out, s);
     if (k < rig.samples_used.size())
       out << YAML::Key << "samples_used" << YAML::Value << rig.samples_used[k];
     out << YAML::EndMap;

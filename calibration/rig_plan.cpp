@@ -195,6 +195,15 @@ RigPlan load_rig_plan(const std::filesystem::path& path) {
   return parse_rig_plan(node, path.string());
 }
 
+void emit_segment_span(YAML::Emitter& out, const PlanSegment& s) {
+  using yio::num;
+  out << YAML::Key << "plat1_deg" << YAML::Value << num(s.plat1_deg);
+  out << YAML::Key << "plat2_deg" << YAML::Value << num(s.plat2_deg);
+  out << YAML::Key << "t_start_s" << YAML::Value << num(s.t_start_s);
+  out << YAML::Key << "t_end_s" << YAML::Value << num(s.t_end_s);
+  out << YAML::Key << "rate_dps" << YAML::Value << num(s.rate_dps);
+}
+
 void save_rig_plan(const std::filesystem::path& path, const RigPlan& plan) {
   using yio::num;
   YAML::Emitter out;
@@ -214,11 +223,7 @@ void save_rig_plan(const std::filesystem::path& path, const RigPlan& plan) {
       out << YAML::Key << "axis_box" << YAML::Value;
       yio::emit_vec3(out, s.axis_box);
     }
-    out << YAML::Key << "plat1_deg" << YAML::Value << num(s.plat1_deg);
-    out << YAML::Key << "plat2_deg" << YAML::Value << num(s.plat2_deg);
-    out << YAML::Key << "t_start_s" << YAML::Value << num(s.t_start_s);
-    out << YAML::Key << "t_end_s" << YAML::Value << num(s.t_end_s);
-    out << YAML::Key << "rate_dps" << YAML::Value << num(s.rate_dps);
+    emit_segment_span(out, s);
     out << YAML::Key << "half_period_s" << YAML::Value << num(s.half_period_s);
     out << YAML::Key << "first_sign" << YAML::Value << num(s.first_sign);
     out << YAML::Key << "settle_s" << YAML::Value << num(s.settle_s);

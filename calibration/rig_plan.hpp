@@ -15,6 +15,7 @@
 
 namespace YAML {
 class Node;
+class Emitter;
 }
 
 namespace driftless::calib {
@@ -81,6 +82,9 @@ RigPlan parse_rig_plan(const YAML::Node& node, const std::string& file);
 RigPlan load_rig_plan(const std::filesystem::path& path);
 /// Writes a plan as YAML (load_rig_plan reads it back).
 void save_rig_plan(const std::filesystem::path& path, const RigPlan& plan);
+/// Emits a segment's positions and span into an open YAML map (plat1_deg, plat2_deg in deg,
+/// t_start_s, t_end_s in s, rate_dps in deg/s): the keys the plan and the calibration file share.
+void emit_segment_span(YAML::Emitter& out, const PlanSegment& s);
 
 /// What extract_segments found.
 struct ExtractReport {

@@ -39,12 +39,7 @@ int run_compare(const Args& a) {
     print_result(r);
   }
   progress.done();
-  fmt::print("wrote {}/report.html and {}/diagnosis.json\n", a.common.out, a.common.out);
-  if (const std::string why = doubt(r); !why.empty()) {
-    fmt::print(stderr, "driftless compare: {}; see {}/report.html\n", why, a.common.out);
-    return 1;
-  }
-  return 0;
+  return finish_report("compare", a.common, r, 0);
 }
 
 const bool registered = register_command(50, [](CLI::App& app) {
@@ -52,19 +47,9 @@ const bool registered = register_command(50, [](CLI::App& app) {
                                             "window, whiteness and Allan deviation against the model's noise, and the "
                                             "missing effects by forward selection (docs/compare.md)");
   auto a = std::make_shared<Args>();
-  cmd->add_option("--log", a->common.log, "Measurement log (CSV, driftless-log 1; gyro in deg/s)")->required()->check(CLI::ExistingFile);
-  cmd->add_option("--model", a->common.model, "Model or scenario YAML (its 'model:' block); default: embedded nominal MPU6050 "
-                  "(datasheet noise, bias instability, turn-on bias, DLPF_CFG 3; scale, cross-axis, g-sensitivity, "
-                  "temperature coefficients at zero; docs/compare.md). The model runs at the log's rate")
-      ->check(CLI::ExistingFile);
+  add_compare_options(*cmd, a->common);
   cmd->add_option("--before", a->before, "An earlier model YAML: report the residual before (this) and after (--model)")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--out", a->common.out, "Output directory (report.html, diagnosis.json, plots/)")->required();
-  cmd->add_flag("--resample", a->common.resample, "Resample the log to the sample_rate_hz the model file states (default: "
-                "the model runs at the log's rate)");
-  cmd->add_option("--block", a->common.block_s, "Block length of the residual fits, s (default 0.1)")->check(positive_number("s"));
-  cmd->add_option("--threshold", a->common.threshold, "Evidence (2 ln L gain - ln(m) per parameter) above which an effect "
-                  "is selected (default 10)")->check(CLI::NonNegativeNumber);
   return [a] { return run_compare(*a); };
 });
 

@@ -63,12 +63,7 @@ int run_diagnose(const Args& a) {
     diagnose::write_report(r, a.common.out, x);
   }
   progress.done();
-  fmt::print("wrote {}/report.html and {}/diagnosis.json\n", a.common.out, a.common.out);
-  if (const std::string why = doubt(r); !why.empty()) {
-    fmt::print(stderr, "driftless diagnose: {}; see {}/report.html\n", why, a.common.out);
-    return 1;
-  }
-  return code;
+  return finish_report("diagnose", a.common, r, code);
 }
 
 const bool registered = register_command(51, [](CLI::App& app) {
@@ -76,18 +71,9 @@ const bool registered = register_command(51, [](CLI::App& app) {
                                              "effects first, then the noise model) and, with --apply, write the model with "
                                              "all of them and compare again (docs/compare.md)");
   auto a = std::make_shared<Args>();
-  cmd->add_option("--log", a->common.log, "Measurement log (CSV, driftless-log 1; gyro in deg/s)")->required()->check(CLI::ExistingFile);
-  cmd->add_option("--model", a->common.model, "Model or scenario YAML; default: embedded nominal MPU6050 (datasheet noise, "
-                  "bias instability, turn-on bias, DLPF_CFG 3; scale, cross-axis, g-sensitivity, temperature coefficients "
-                  "at zero; docs/compare.md). The model runs at the log's rate")->check(CLI::ExistingFile);
-  cmd->add_option("--out", a->common.out, "Output directory (report.html, diagnosis.json, plots/)")->required();
+  add_compare_options(*cmd, a->common);
   cmd->add_option("--apply", a->apply, "Write the model with every selected effect and noise-model change to this YAML "
                   "file, then compare again; exit 1 unless the new model is consistent with the log");
-  cmd->add_flag("--resample", a->common.resample, "Resample the log to the sample_rate_hz the model file states (default: "
-                "the model runs at the log's rate)");
-  cmd->add_option("--block", a->common.block_s, "Block length of the residual fits, s (default 0.1)")->check(positive_number("s"));
-  cmd->add_option("--threshold", a->common.threshold, "Evidence above which an effect is selected (default 10)")
-      ->check(CLI::NonNegativeNumber);
   return [a] { return run_diagnose(*a); };
 });
 

@@ -10,6 +10,7 @@
 #include <fmt/core.h>
 
 #include "cli/command.hpp"
+#include "cli/hil_fdi.hpp"
 #include "estimator/filter.hpp"
 #include "estimator/log.hpp"
 #include "estimator/log_metadata.hpp"
@@ -21,7 +22,7 @@ namespace driftless::cli {
 namespace {
 
 struct HilOptions {
-  std::string source, switch_to, out_dir, estimator_config, scenario, emu_sensor;
+  std::string source, switch_to, out_dir, estimator_config, scenario, emu_sensor, emu_fault;
   std::string twin_flips = "scenario";
   double at_s = kNaN;
   double duration_s = kNaN;
@@ -31,6 +32,7 @@ struct HilOptions {
   int baud = 921600;
   std::uint64_t seed = 1;
   bool realtime = false;
+  bool fdi = false;
   bool allow_deep_idle = false;
 };
 
@@ -53,13 +55,8 @@ std::unique_ptr<hil::CpuLatencyRequest> hold_cpus_awake(const HilOptions& o, con
   return req;
 }
 
-int run_hil(const HilOptions& o) {
-  if (!o.switch_to.empty() && std::isnan(o.at_s)) {
-    throw std::invalid_argument("hil: --switch-to needs --at T (session time of the switch, s)");
-  }
-  if (o.switch_to.empty() && !std::isnan(o.at_s)) throw std::invalid_argument("hil: --at needs --switch-to SOURCE");
-  std::filesystem::create_directories(o.out_dir);
-
+// what the source rigs need of the options; refuses combinations that cannot work
+hil::RigOptions rig_options(const HilOptions& o) {
   hil::RigOptions ro;
   ro.realtime = o.realtime;
   ro.sample_rate_hz = o.rate_hz;
@@ -76,6 +73,25 @@ int run_hil(const HilOptions& o) {
   if (ro.twin_bridge_flips && o.source != "twin" && o.switch_to != "twin") {
     throw std::invalid_argument("hil: --twin-flips bridge needs the twin source (--source twin or --switch-to twin)");
   }
+  if (!o.emu_fault.empty()) {
+    const auto emulated = [](const std::string& s) { return s == "emu-i2c" || s == "emu-serial"; };
+    if (!emulated(o.source) && !emulated(o.switch_to)) {
+      throw std::invalid_argument("hil: --emu-fault plants a fault into the emulated chips: it needs --source (or "
+                                  "--switch-to) emu-i2c or emu-serial");
+    }
+    ro.emu_fault = hil::parse_planted_fault(o.emu_fault);
+  }
+  return ro;
+}
+
+int run_hil(const HilOptions& o) {
+  if (!o.switch_to.empty() && std::isnan(o.at_s)) {
+    throw std::invalid_argument("hil: --switch-to needs --at T (session time of the switch, s)");
+  }
+  if (o.switch_to.empty() && !std::isnan(o.at_s)) throw std::invalid_argument("hil: --at needs --switch-to SOURCE");
+  std::filesystem::create_directories(o.out_dir);
+
+  const hil::RigOptions ro = rig_options(o);
   auto first = hil::make_source_rig(o.source, ro);
   std::unique_ptr<hil::SourceRig> second;
   if (!o.switch_to.empty()) second = hil::make_source_rig(o.switch_to, ro);
@@ -103,6 +119,7 @@ int run_hil(const HilOptions& o) {
     meta.set("switch_to", second->source->name());
     log::set_number(meta, "switch_at_s", o.at_s);
   }
+  if (ro.emu_fault.planted()) meta.set("emu_fault", ro.emu_fault.describe());
   std::uint32_t fields = first->source->fields() | (second ? second->source->fields() : 0u);
 
   est::EstimatorConfig cfg;
@@ -122,6 +139,13 @@ int run_hil(const HilOptions& o) {
   hil::SteadyClock wall;
   const auto latency_request = hold_cpus_awake(o, *first, second.get());
   hil::LiveLoop loop(lp, wall, &writer, &filter);
+  std::unique_ptr<hil::FdiWatch> fdi;
+  if (o.fdi) {
+    est::FdiParams fp;
+    fp.sample_rate_hz = info.sample_rate_hz;
+    fdi = std::make_unique<hil::FdiWatch>(fp, cfg.end_margin_s);
+    loop.set_fdi(fdi.get());
+  }
   loop.set_motors(first->source, first->motors, first->schedule);
   if (second) loop.set_motors(second->source, second->motors, second->schedule);
   // the terminal view: bias estimates as they converge
@@ -174,7 +198,10 @@ int run_hil(const HilOptions& o) {
   fmt::print("log: {}\n", log_path.string());
   if (!st.complete) throw std::runtime_error("hil: " + st.end_reason + "; the log so far is " + log_path.string() +
                                              " (complete: false)");
-  return 0;
+  if (!fdi) return 0;
+  const std::filesystem::path fdi_json = std::filesystem::path(o.out_dir) / "fdi.json";
+  write_fdi_json(fdi_json, *fdi);
+  return report_fdi(*fdi, fdi_json);
 }
 
 const bool registered = register_command(60, [](CLI::App& app) {
@@ -200,6 +227,12 @@ const bool registered = register_command(60, [](CLI::App& app) {
   cmd->add_option("--emu-sensor", o->emu_sensor,
                   "emu-i2c, emu-serial: drive the emulated chips with the twin's sensor model preset "
                   "(mpu6050, ideal) instead of the built-in biases + white noise");
+  cmd->add_option("--emu-fault", o->emu_fault,
+                  "emu-i2c, emu-serial: plant a sensor fault in the emulated chips: stuck:S:A@T (axis A of sensor S "
+                  "sticks at its value from source time T s) or bias:S:A:DPS@T (adds DPS deg/s); S 1|2, A x|y|z");
+  cmd->add_flag("--fdi", o->fdi,
+                "Run fault detection beside the estimator (docs/fdi.md): 'fdi:' event lines, DIR/fdi.json, and "
+                "exit 1 when a sensor fault is detected or the run was too short to monitor");
   cmd->add_option("--twin-flips", o->twin_flips,
                   "twin: who flips the platforms: scenario (its flip_schedule, inside the simulator) or "
                   "bridge (the bridge's flip schedule commands the twin's servos, --standstill s hold)")

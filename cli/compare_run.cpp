@@ -55,4 +55,27 @@ std::string doubt(const diagnose::CompareResult& r) {
   return {};
 }
 
+void add_compare_options(CLI::App& cmd, CompareArgs& a) {
+  cmd.add_option("--log", a.log, "Measurement log (CSV, driftless-log 1; gyro in deg/s)")->required()->check(CLI::ExistingFile);
+  cmd.add_option("--model", a.model, "Model or scenario YAML (its 'model:' block); default: embedded nominal MPU6050 "
+                 "(datasheet noise, bias instability, turn-on bias, DLPF_CFG 3; scale, cross-axis, g-sensitivity, "
+                 "temperature coefficients at zero; docs/compare.md). The model runs at the log's rate")
+      ->check(CLI::ExistingFile);
+  cmd.add_option("--out", a.out, "Output directory (report.html, diagnosis.json, plots/)")->required();
+  cmd.add_flag("--resample", a.resample, "Resample the log to the sample_rate_hz the model file states (default: "
+               "the model runs at the log's rate)");
+  cmd.add_option("--block", a.block_s, "Block length of the residual fits, s (default 0.1)")->check(positive_number("s"));
+  cmd.add_option("--threshold", a.threshold, "Evidence (2 ln L gain - ln(m) per parameter) above which an effect "
+                 "is selected (default 10)")->check(CLI::NonNegativeNumber);
+}
+
+int finish_report(const char* command, const CompareArgs& a, const diagnose::CompareResult& r, int code) {
+  fmt::print("wrote {}/report.html and {}/diagnosis.json\n", a.out, a.out);
+  if (const std::string why = doubt(r); !why.empty()) {
+    fmt::print(stderr, "driftless {}: {}; see {}/report.html\n", command, why, a.out);
+    return 1;
+  }
+  return code;
+}
+
 }  // namespace driftless::cli

@@ -6,6 +6,10 @@
 
 #include "diagnose/compare.hpp"
 
+namespace CLI {
+class App;
+}
+
 namespace driftless::cli {
 
 /// The options both commands take.
@@ -15,6 +19,10 @@ struct CompareArgs {
   double block_s = 0.1;
   double threshold = 10.0;
 };
+
+/// Declares the options of CompareArgs on `cmd` (--log, --model, --out, --resample, --block,
+/// --threshold), once for both commands; `a` must outlive the parse.
+void add_compare_options(CLI::App& cmd, CompareArgs& a);
 
 /// The model, options and replayed log of a comparison.
 struct CompareSetup {
@@ -34,5 +42,9 @@ void print_result(const diagnose::CompareResult& r);
 /// Why a result cannot be stood behind ("" when it can): the residual has structure no effect
 /// explains, or a selected fit is implausible.
 std::string doubt(const diagnose::CompareResult& r);
+
+/// The end both commands share: says where the report went; when doubt(r) has a reason, prints
+/// it as "driftless COMMAND: why; see OUT/report.html" and returns 1, else `code`.
+int finish_report(const char* command, const CompareArgs& a, const diagnose::CompareResult& r, int code);
 
 }  // namespace driftless::cli

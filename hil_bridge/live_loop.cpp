@@ -175,8 +175,11 @@ LiveStats LiveLoop::run(SampleSource& first, SampleSource* second, const std::at
       }
     }
     if (log_) log_->write(s);
-    if (filter_) filter_->push(s);
+    const est::PushStatus pushed = filter_ ? filter_->push(s) : est::PushStatus::kInvalid;
     t_last_ = s.t_s;
+    if (fdi_ && filter_) {
+      if (const std::string e = fdi_->push(s, pushed, *filter_); !e.empty()) event(e);
+    }
     if (std::isnan(stats_.t_first_s)) stats_.t_first_s = s.t_s;
     stats_.t_last_s = s.t_s;
     ++stats_.samples;

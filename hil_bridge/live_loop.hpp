@@ -15,6 +15,7 @@
 #include "estimator/filter.hpp"
 #include "estimator/log.hpp"
 #include "hil_bridge/clock.hpp"
+#include "hil_bridge/fdi_watch.hpp"
 #include "hil_bridge/motors.hpp"
 #include "hil_bridge/source.hpp"
 
@@ -56,6 +57,9 @@ class LiveLoop {
   void set_motors(const SampleSource* source, Motors* motors, FlipSchedule* schedule) {
     rigs_.push_back({source, motors, schedule});
   }
+  /// Runs fault detection beside the filter (needs a filter; `fdi` may be null and must outlive
+  /// the loop): its state changes become event lines ("fdi: ...").
+  void set_fdi(FdiWatch* fdi) { fdi_ = fdi; }
   /// Called after each sample is written and pushed (terminal display, benchmarks).
   void on_sample(std::function<void(const Sample&, SampleSource&)> f) { on_sample_ = std::move(f); }
   /// Called for every event line written.
@@ -73,6 +77,7 @@ class LiveLoop {
   Clock& clock_;
   log::LogWriter* log_;
   est::DriftlessFilter* filter_;
+  FdiWatch* fdi_ = nullptr;
   struct MotorRig {
     const SampleSource* source;
     Motors* motors;

@@ -99,12 +99,18 @@ struct SerialRig final : SourceRig {
 };
 
 // what the emulated chips measure: the built-in box at rest, or the twin's sensor model preset
-// named by --emu-sensor (the same box, latitude and motors)
+// named by --emu-sensor (the same box, latitude and motors); with --emu-fault, a planted fault
 std::unique_ptr<ImuGenerator> make_generator(const RigOptions& opt, const BoxAtRestGenerator::Params& gp,
                                              const EmulatedMotors* motors) {
-  if (opt.emu_sensor.empty()) return std::make_unique<BoxAtRestGenerator>(gp, motors);
-  const twin::SensorParams sp = twin::sensor_preset(opt.emu_sensor);
-  return std::make_unique<SensorModelGenerator>(sp, sp, opt.sample_rate_hz, opt.seed, gp, motors);
+  std::unique_ptr<ImuGenerator> gen;
+  if (opt.emu_sensor.empty()) {
+    gen = std::make_unique<BoxAtRestGenerator>(gp, motors);
+  } else {
+    const twin::SensorParams sp = twin::sensor_preset(opt.emu_sensor);
+    gen = std::make_unique<SensorModelGenerator>(sp, sp, opt.sample_rate_hz, opt.seed, gp, motors);
+  }
+  if (!opt.emu_fault.planted()) return gen;
+  return std::make_unique<FaultyGenerator>(std::move(gen), opt.emu_fault);
 }
 
 }  // namespace
@@ -177,7 +183,7 @@ std::unique_ptr<SourceRig> make_source_rig(const std::string& spec, const RigOpt
       fp.rate_hz = opt.sample_rate_hz;
       fp.generator = opt.emulated_box;
       fp.generator.seed = opt.seed;
-      if (!opt.emu_sensor.empty()) {
+      if (!opt.emu_sensor.empty() || opt.emu_fault.planted()) {
         make_generator(opt, fp.generator, nullptr);  // an unknown preset fails here, before the run
         fp.make_generator = [opt, gp = fp.generator](const EmulatedMotors* motors, double rate_hz) {
           BoxAtRestGenerator::Params g = gp;

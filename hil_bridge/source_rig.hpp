@@ -12,6 +12,7 @@
 #include "estimator/log.hpp"
 #include "hil_bridge/clock.hpp"
 #include "hil_bridge/imu_generator.hpp"
+#include "hil_bridge/planted_fault.hpp"
 #include "hil_bridge/motors.hpp"
 #include "hil_bridge/source.hpp"
 
@@ -30,6 +31,7 @@ struct RigOptions {
   BoxAtRestGenerator::Params emulated_box;  // what emu-i2c / emu-serial measure
   std::string emu_sensor;        // emu-i2c, emu-serial: a twin sensor-model preset ("mpu6050", "ideal")
                                  // instead of the built-in bias + white-noise generator
+  PlantedFault emu_fault;        // emu-i2c, emu-serial: a sensor fault planted into the chips' readings
 };
 
 /// A ready-to-configure source and its helpers. Owns everything it points to.

@@ -12,6 +12,7 @@
 #include "estimator/numbers.hpp"
 #include "estimator/output_file.hpp"
 #include "estimator/pipeline.hpp"
+#include "estimator/fdi_input.hpp"
 #include "estimator/geometry.hpp"
 #include "estimator/random.hpp"
 #include "twin/simulator.hpp"
@@ -228,20 +229,7 @@ Metrics evaluate_fdi(const RunSetup& setup, const log::Metadata& meta, const Sam
       }
     }
     const est::PushStatus st = filter.push(s);
-    est::FdiInput in;
-    in.t_s = s.t_s;
-    in.gyro1_dps = s.gyro1_dps;
-    in.gyro2_dps = s.gyro2_dps;
-    in.at_rest = (st == est::PushStatus::kAccumulating || st == est::PushStatus::kUpdated ||
-                  st == est::PushStatus::kRejected) &&
-                 std::isfinite(s.plat1_deg) && std::isfinite(s.plat2_deg);
-    if (in.at_rest) {
-      in.R_body_from_sensor1 = filter.body_from_sensor(1, s.plat1_deg);
-      in.R_body_from_sensor2 = filter.body_from_sensor(2, s.plat2_deg);
-    }
-    in.bias_dps = filter.bias_dps();
-    in.bias_cov_dps2 = filter.covariance_dps2();
-    if (fdi.push(in) == est::FdiStatus::kIsolated) break;
+    if (fdi.push(est::fdi_input(s, st, filter)) == est::FdiStatus::kIsolated) break;
   }
   const auto& f = fdi.fault();
   const auto alarm = fdi.first_alarm_s();

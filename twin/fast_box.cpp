@@ -12,10 +12,6 @@
 #include "twin/simulator.hpp"
 
 namespace driftless::twin {
-namespace {
-
-}  // namespace
-
 FastBox::FastBox(const Scenario& scenario)
     : sc_((scenario.validate(), scenario)),
       motion_(make_motion(sc_.motion, sc_.duration_s, sc_.seed, sc_.base_dir)),
@@ -24,6 +20,7 @@ FastBox::FastBox(const Scenario& scenario)
                rnd::stream_seed(sc_.seed, rnd::Stream::kSensor1)),
       sensor2_(sc_.model.sensor2, sc_.sample_rate_hz,
                rnd::stream_seed(sc_.seed, rnd::Stream::kSensor2)),
+      delay_(sc_.model.time_offset_s, sc_.sample_rate_hz),
       earth_enu_radps_(geo::earth_rate_enu_radps(sc_.latitude_deg)),
       a1_(sc_.model.box.hinge_axis(1)),
       a2_(sc_.model.box.hinge_axis(2)),
@@ -68,8 +65,11 @@ bool FastBox::next(Sample& out) {
   const Eigen::Matrix3d R1 = geo::rot_about_axis_rad(a1_, angle_rad_[0]);
   const Eigen::Matrix3d R2 = geo::rot_about_axis_rad(a2_, angle_rad_[1]);
   // eq. (1) truth: R_i^T x + thetadot_i a_i (the hinge axis is the same in sensor axes)
-  SensorTruth t1{t, R1.transpose() * w_body + rate_radps_[0] * a1_, R1.transpose() * f_body};
-  SensorTruth t2{t, R2.transpose() * w_body + rate_radps_[1] * a2_, R2.transpose() * f_body};
+  Eigen::Vector3d w[2] = {R1.transpose() * w_body + rate_radps_[0] * a1_, R2.transpose() * w_body + rate_radps_[1] * a2_};
+  Eigen::Vector3d f[2] = {R1.transpose() * f_body, R2.transpose() * f_body};
+  delay_.apply(w, f);  // model.time_offset_s: the truth the sensors sampled
+  const SensorTruth t1{t, w[0], f[0]};
+  const SensorTruth t2{t, w[1], f[1]};
   const SensorReading r1 = sensor1_.step(t1);
   const SensorReading r2 = sensor2_.step(t2);
 

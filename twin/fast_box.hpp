@@ -1,7 +1,8 @@
 // The fast closed-form kinematic path for sweeps: the same Scenario, Motion, flip schedule and
 // sensor model as the Simulator, without MuJoCo. The platforms follow their motor reference
 // exactly (clipped at the true end stops, stop-angle errors included), so there is no servo lag,
-// end-stop ringing or motor overshoot: studies of those use the full twin (runner: twin).
+// end-stop ringing or motor overshoot: studies of those use the full twin (runner: twin). The
+// sensors' sampling offset (model.time_offset_s) is applied as in the Simulator.
 // Sensor i's frame is Rot(hinge_i, platform angle) in box axes, eq. (1):
 //   y_i = R_i^T x + thetadot_i a_i + b_i + n_i (plus every effect of the sensor model).
 #pragma once
@@ -17,6 +18,7 @@
 #include "twin/motion.hpp"
 #include "twin/scenario.hpp"
 #include "twin/sensor/sensor_model.hpp"
+#include "twin/truth_delay.hpp"
 
 namespace driftless::twin {
 
@@ -38,6 +40,7 @@ class FastBox {
   std::unique_ptr<Motion> motion_;
   FlipController flips_;
   SensorModel sensor1_, sensor2_;
+  TruthDelay delay_;  // model.time_offset_s
   Eigen::Vector3d earth_enu_radps_;
   Eigen::Vector3d a1_, a2_;
   std::uint64_t total_ = 0, k_ = 0;

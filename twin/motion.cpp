@@ -12,6 +12,7 @@
 #include "estimator/input_error.hpp"
 #include "estimator/random.hpp"
 #include "estimator/sample.hpp"
+#include "importers/ground_truth.hpp"
 
 namespace driftless::twin {
 namespace {
@@ -552,14 +553,47 @@ void MotionConfig::validate() const {
   }
 }
 
+namespace {
+
+// EuRoC / Vicon ground truth: the importers' reader (stamps as whole ns), times from the first
+// stamp formed in integers, so a 1.4e18 ns stamp keeps its last digit
+std::vector<TrajectoryPoint> read_euroc_trajectory(const std::filesystem::path& path) {
+  const importers::GroundTruth gt = importers::read_ground_truth(path);
+  const std::int64_t t0_ns = gt.poses.front().t_ns;
+  std::vector<TrajectoryPoint> pts;
+  pts.reserve(gt.poses.size());
+  for (const importers::PoseStamp& p : gt.poses) {
+    TrajectoryPoint pt;
+    pt.t_s = static_cast<double>(p.t_ns - t0_ns) * 1e-9;
+    pt.p_enu_m = p.p_ref_m;
+    pt.q_enu_from_body = p.q_ref_from_body;
+    pts.push_back(pt);
+  }
+  return pts;
+}
+
+// true when the first line that is not blank starts with EuRoC's "#timestamp" header
+bool is_euroc_layout(std::istream& in) {
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    return line.rfind("#timestamp", 0) == 0;
+  }
+  return false;
+}
+
+}  // namespace
+
 std::vector<TrajectoryPoint> read_trajectory_csv(const std::filesystem::path& path) {
   std::ifstream in(path);
   if (!in) throw InputError(path.string(), 0, "", "cannot open trajectory file");
+  if (is_euroc_layout(in)) return read_euroc_trajectory(path);
+  in.clear();
+  in.seekg(0);
   std::string line;
   std::size_t line_no = 0;
   int idx[8] = {-1, -1, -1, -1, -1, -1, -1, -1};  // t, px, py, pz, qw, qx, qy, qz
-  bool euroc = false, have_header = false;
-  double t_first_ns = kNaN;
+  bool have_header = false;
   std::vector<TrajectoryPoint> pts;
   const char* names[8] = {"t", "px", "py", "pz", "qw", "qx", "qy", "qz"};
   const auto fail = [&](const std::string& what) { throw InputError(path.string(), line_no, "", what); };
@@ -568,13 +602,6 @@ std::vector<TrajectoryPoint> read_trajectory_csv(const std::filesystem::path& pa
     if (!line.empty() && line.back() == '\r') line.pop_back();
     if (line.empty()) continue;
     if (!have_header) {
-      if (line.rfind("#timestamp", 0) == 0) {
-        // EuRoC MAV ground truth: #timestamp [ns], p_RS_R_x [m], ..., q_RS_w [], q_RS_x [], ...
-        euroc = true;
-        for (int k = 0; k < 8; ++k) idx[k] = k;
-        have_header = true;
-        continue;
-      }
       if (line[0] == '#') continue;
       const auto cols = split_csv(line);
       for (std::size_t c = 0; c < cols.size(); ++c) {
@@ -610,12 +637,7 @@ std::vector<TrajectoryPoint> read_trajectory_csv(const std::filesystem::path& pa
       }
     }
     TrajectoryPoint pt;
-    if (euroc) {
-      if (std::isnan(t_first_ns)) t_first_ns = v[0];
-      pt.t_s = (v[0] - t_first_ns) * 1e-9;
-    } else {
-      pt.t_s = v[0];
-    }
+    pt.t_s = v[0];
     pt.p_enu_m = Eigen::Vector3d(v[1], v[2], v[3]);
     pt.q_enu_from_body = Eigen::Quaterniond(v[4], v[5], v[6], v[7]);
     const double n = pt.q_enu_from_body.norm();

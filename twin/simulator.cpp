@@ -40,14 +40,9 @@ Simulator::Simulator(const Scenario& scenario, std::unique_ptr<Motion> motion, s
       flips_(scenario.flip_schedule, scenario.model.box, options.initial_sign),
       gate_(scenario.model.box, motion_->is_static(), scenario.sample_rate_hz),
       earth_enu_radps_(geo::earth_rate_enu_radps(scenario.latitude_deg)),
+      delay_(scenario.model.time_offset_s, scenario.sample_rate_hz),
       steps_per_sample_(scenario.steps_per_sample()),
       total_(scenario.total_samples()) {
-  if (scenario.model.time_offset_s < 0) {
-    throw std::invalid_argument(fmt::format(
-        "model.time_offset_s = {} s: simulate models sensors sampling before the log's time stamp "
-        "(offset >= 0) only; compare and diagnose honour negative offsets",
-        scenario.model.time_offset_s));
-  }
   if (options.initial_sign != std::array<int, 2>{1, 1} && !options.external_flips) {
     throw std::invalid_argument("simulator: platforms starting anywhere but (+,+) need external flip control "
                                 "(the flip schedule's eq. (5) sequence starts at (+,+))");
@@ -315,25 +310,10 @@ void Simulator::fill_sample(Sample& out) {
   out = Sample{};
   out.t_s = truth_.t_s;
   // the sensor-effect catalogue turns the truth into readings (docs/effects.md)
-  // model.time_offset_s: the sensors sampled the truth of `offset` earlier (linear
-  // interpolation between the output samples kept in a short history)
-  const double shift = scenario_.model.time_offset_s * scenario_.sample_rate_hz;
+  // model.time_offset_s: the sensors sampled the truth of `offset` earlier
   Eigen::Vector3d w_in[2] = {truth_.w_sensor_radps[0], truth_.w_sensor_radps[1]};
   Eigen::Vector3d f_in[2] = {truth_.f_sensor_mps2[0], truth_.f_sensor_mps2[1]};
-  if (shift > 0) {
-    history_.push_back(truth_);
-    const auto keep = static_cast<std::size_t>(std::ceil(shift)) + 2;
-    while (history_.size() > keep) history_.pop_front();
-    const auto whole = static_cast<std::size_t>(std::floor(shift));
-    const double u = shift - static_cast<double>(whole);
-    const std::size_t last = history_.size() - 1;
-    const SampleTruth& a = history_[last >= whole ? last - whole : 0];
-    const SampleTruth& b = history_[last >= whole + 1 ? last - whole - 1 : 0];
-    for (int i = 0; i < 2; ++i) {
-      w_in[i] = (1.0 - u) * a.w_sensor_radps[i] + u * b.w_sensor_radps[i];
-      f_in[i] = (1.0 - u) * a.f_sensor_mps2[i] + u * b.f_sensor_mps2[i];
-    }
-  }
+  delay_.apply(w_in, f_in);
   SensorReading r[2];
   for (int i = 0; i < 2; ++i) {
     SensorTruth st;

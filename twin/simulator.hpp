@@ -23,6 +23,7 @@
 #include "twin/rest_path.hpp"
 #include "twin/scenario.hpp"
 #include "twin/sensor/sensor_model.hpp"
+#include "twin/truth_delay.hpp"
 #include "twin/world.hpp"
 
 namespace driftless::twin {
@@ -125,6 +126,7 @@ class Simulator {
   FlipReplay replays_;
   std::vector<SensorModel> sensors_;  // sensor 1, sensor 2
   Eigen::Vector3d earth_enu_radps_;
+  TruthDelay delay_;             // model.time_offset_s
   long steps_per_sample_;
   std::uint64_t total_;
   std::uint64_t samples_ = 0;
@@ -139,7 +141,6 @@ class Simulator {
   MotionState base_;             // motion state at the last output sample
   MotionState next_base_;        // look-ahead: motion state at an output sample
   std::uint64_t next_base_sample_ = ~std::uint64_t{0};
-  std::deque<SampleTruth> history_;  // recent output truths (model.time_offset_s > 0)
 };
 
 /// Result of simulate_to_log().

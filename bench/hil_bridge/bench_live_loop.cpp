@@ -5,6 +5,8 @@
 //    up (no FIFO overflow, no sample lost); the second argument 1 holds the CPUs out of deep idle
 //    states as `driftless hil` does (hil_bridge/cpu_latency.hpp), 0 does not;
 //  - LiveLoopEmulatedI2cAfap: the same loop on a virtual clock: samples per second of CPU.
+// The argument fdi = 1 (LiveLoop1kHzRealtime's third, LiveLoopEmulatedI2cAfap's only) runs the
+// fault detection beside the filter (driftless hil --fdi).
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -22,6 +24,7 @@
 #include "hil_bridge/cpu_latency.hpp"
 #include "hil_bridge/i2c/emulated_bus.hpp"
 #include "hil_bridge/i2c/i2c_source.hpp"
+#include "hil_bridge/fdi_watch.hpp"
 #include "hil_bridge/live_loop.hpp"
 
 namespace driftless::hil {
@@ -32,6 +35,12 @@ log::Metadata meta_1khz() {
   m.set("sample_rate_hz", "1000");
   m.set("latitude_deg", "52.0");
   return m;
+}
+
+est::FdiParams fdi_1khz() {
+  est::FdiParams p;
+  p.sample_rate_hz = 1000.0;
+  return p;
 }
 
 std::filesystem::path temp_log() {
@@ -84,6 +93,8 @@ void LiveLoop1kHzRealtime(benchmark::State& state) {
     lp.duration_s = duration_s;
     LiveLoop loop(lp, rig.clock, &writer, &filter);
     loop.set_motors(&rig.src, &rig.motors, &rig.schedule);
+    FdiWatch fdi(fdi_1khz());
+    if (state.range(2) != 0) loop.set_fdi(&fdi);
     latency_us.clear();
     latency_us.reserve(static_cast<std::size_t>(duration_s * 1000.0) + 10);
     // session time = source time here (the first sample is t = 0 on both)
@@ -112,7 +123,14 @@ void LiveLoop1kHzRealtime(benchmark::State& state) {
   state.counters["p99_us"] = pct(0.99);
   state.counters["max_us"] = latency_us.empty() ? NAN : latency_us.back();
 }
-BENCHMARK(LiveLoop1kHzRealtime)->Args({5, 1})->Args({5, 0})->Iterations(1)->Unit(benchmark::kSecond);
+BENCHMARK(LiveLoop1kHzRealtime)
+    ->ArgNames({"s", "awake", "fdi"})
+    ->Args({5, 1, 0})
+    ->Args({5, 1, 1})
+    ->Args({5, 0, 0})
+    ->Args({5, 0, 1})
+    ->Iterations(1)
+    ->Unit(benchmark::kSecond);
 
 void LiveLoopEmulatedI2cAfap(benchmark::State& state) {
   const double duration_s = 20.0;
@@ -126,6 +144,8 @@ void LiveLoopEmulatedI2cAfap(benchmark::State& state) {
     lp.duration_s = duration_s;
     LiveLoop loop(lp, rig.clock, &writer, &filter);
     loop.set_motors(&rig.src, &rig.motors, &rig.schedule);
+    FdiWatch fdi(fdi_1khz());
+    if (state.range(0) != 0) loop.set_fdi(&fdi);
     std::atomic<bool> stop{false};
     const LiveStats st = loop.run(rig.src, nullptr, stop);
     writer.finish(st.complete);
@@ -136,7 +156,7 @@ void LiveLoopEmulatedI2cAfap(benchmark::State& state) {
   state.counters["us_per_sample"] =
       benchmark::Counter(static_cast<double>(samples), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
-BENCHMARK(LiveLoopEmulatedI2cAfap)->Unit(benchmark::kMillisecond);
+BENCHMARK(LiveLoopEmulatedI2cAfap)->ArgName("fdi")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace driftless::hil

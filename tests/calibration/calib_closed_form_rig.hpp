@@ -123,8 +123,12 @@ inline std::vector<Sample> dynamic_log(const est::CalibMatrices& M, const Eigen:
   for (long k = 0; k * dt < duration_s; ++k) {
     const double t = k * dt;
     const double kPiX2 = 2.0 * kPi;
-    const Eigen::Vector3d w_rel(10.0 + 20.0 * std::sin(kPiX2 * t / 37.0), -8.0 + 15.0 * std::sin(kPiX2 * t / 23.0),
-                                12.0 * std::cos(kPiX2 * t / 53.0));
+    // the box rate relative to ENU, deg/s: a smooth function of time
+    const auto rate_rel_dps = [kPiX2](double u) {
+      return Eigen::Vector3d(10.0 + 20.0 * std::sin(kPiX2 * u / 37.0), -8.0 + 15.0 * std::sin(kPiX2 * u / 23.0),
+                             12.0 * std::cos(kPiX2 * u / 53.0));
+    };
+    const Eigen::Vector3d w_rel = rate_rel_dps(t);
     const Eigen::Vector3d w_box = w_rel + q.conjugate() * w_earth_enu;
     const long phase = static_cast<long>(t / (standstill_s + 1.0));
     const bool flipping = t - static_cast<double>(phase) * (standstill_s + 1.0) >= standstill_s;
@@ -148,8 +152,14 @@ inline std::vector<Sample> dynamic_log(const est::CalibMatrices& M, const Eigen:
     s.true_bias2_dps = bias_dps[1];
     s.true_rate_body_dps = w_box;
     out.push_back(s);
-    // attitude in the Earth-fixed ENU frame
-    q = (q * Eigen::Quaterniond(Eigen::AngleAxisd(w_rel.norm() * kRadPerDeg * dt, w_rel.normalized()))).normalized();
+    // attitude in the Earth-fixed ENU frame: the continuous motion to the next sample (midpoint
+    // substeps, so ref_q is the true attitude at each sample time, not a rectangle-rule lag)
+    constexpr int kSub = 20;
+    for (int j = 0; j < kSub; ++j) {
+      const Eigen::Vector3d w = rate_rel_dps(t + (j + 0.5) * dt / kSub);
+      q = q * Eigen::Quaterniond(Eigen::AngleAxisd(w.norm() * kRadPerDeg * dt / kSub, w.normalized()));
+    }
+    q.normalize();
   }
   if (meta) {
     meta->set("sample_rate_hz", "100");

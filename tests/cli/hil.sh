@@ -92,4 +92,23 @@ if "$bin" hil --source emu-i2c --twin-flips bridge --out "$out/g" --duration 1 2
 grep -q "needs the twin source" "$out/g.err" || fail "--twin-flips without twin: $(cat "$out/g.err")"
 # a bad switch request is refused before anything runs
 if "$bin" hil --source emu-i2c --switch-to emu-serial --out "$out/e" --duration 1 2> "$out/e.err"; then fail "--switch-to without --at accepted"; fi
+# --fdi: a stuck axis planted into the emulated chips is isolated, logged, in fdi.json, and exit 1
+rc=0
+"$bin" hil --source emu-i2c --fdi --emu-fault stuck:2:y@45 --out "$out/f" --duration 60 > "$out/f.txt" 2> "$out/f.err" || rc=$?
+[[ $rc -eq 1 ]] || { cat "$out/f.err"; fail "--fdi with a stuck axis: exit $rc, expected 1"; }
+grep -q "sensor 2 is faulty" "$out/f.err" || fail "--fdi: no verdict line: $(cat "$out/f.err")"
+grep -q "^# event: t=45\.[0-9]* fdi: fault isolated: stuck on sensor 2 axis y" "$out/f/log.csv" || fail "--fdi: no event line in the log"
+grep -q '"verdict": "fault"' "$out/f/fdi.json" || fail "--fdi: fdi.json verdict: $(cat "$out/f/fdi.json")"
+grep -q '"axis": "y"' "$out/f/fdi.json" || fail "--fdi: fdi.json axis"
+grep -q "^# emu_fault: stuck on sensor 2 axis y from t=45 s" "$out/f/log.csv" || fail "--fdi: the log's metadata does not say the planted fault"
+# fault-free: healthy, exit 0; too short to learn the residual noise: not monitored, exit 1
+"$bin" hil --source emu-i2c --fdi --out "$out/h" --duration 60 > "$out/h.txt" || fail "--fdi fault-free: exit $?"
+grep -q '"verdict": "healthy"' "$out/h/fdi.json" || fail "--fdi fault-free: $(cat "$out/h/fdi.json")"
+if "$bin" hil --source emu-i2c --fdi --out "$out/s" --duration 5 > /dev/null 2> "$out/s.err"; then fail "--fdi on 5 s: exit 0"; fi
+grep -q "fdi: not monitored" "$out/s.err" || fail "--fdi on 5 s: $(cat "$out/s.err")"
+# a planted fault needs an emulated source, and a readable spelling
+if "$bin" hil --source twin --emu-fault stuck:1:x@1 --out "$out/t" --duration 1 2> "$out/t.err"; then fail "--emu-fault on the twin accepted"; fi
+grep -q "needs --source (or --switch-to) emu-i2c" "$out/t.err" || fail "--emu-fault on the twin: $(cat "$out/t.err")"
+if "$bin" hil --source emu-i2c --emu-fault stuck:3:x@1 --out "$out/u" --duration 1 2> "$out/u.err"; then fail "--emu-fault sensor 3 accepted"; fi
+grep -q "sensor '3' is not 1 or 2" "$out/u.err" || fail "--emu-fault sensor 3: $(cat "$out/u.err")"
 echo "hil: ok"

@@ -5,7 +5,8 @@
 #  2. no function in the product is over 150 lines;
 #  3. each piece of shared physics is defined once: the old copies do not come back; every file
 #     the program writes goes through the one output helper (estimator/output_file.hpp);
-#  4. the estimator tests have one closed-form generator.
+#  4. the estimator tests have one closed-form generator; the twin-side test logs (tests/diagnose
+#     headers) come from the twin's own sources (FastBox, Simulator), not from a copy of them.
 # Usage: check.sh SOURCE_DIR. Prints every violation with file:line and exits 1 if there is one.
 set -uo pipefail
 src=${1:?usage: check.sh SOURCE_DIR}
@@ -25,7 +26,7 @@ check_includes() {
     < <(grep -rnE "$pattern" "$folder" --include='*.cpp' --include='*.hpp')
 }
 check_includes estimator twin diagnose calibration studies hil_bridge renders cli report importers mujoco yaml-cpp fmt GL
-check_includes twin diagnose calibration studies hil_bridge renders cli report importers
+check_includes twin diagnose calibration studies hil_bridge renders cli report
 check_includes diagnose calibration studies hil_bridge renders cli
 check_includes calibration diagnose studies hil_bridge renders cli
 check_includes studies diagnose hil_bridge renders cli
@@ -81,10 +82,19 @@ estimator/random.hpp estimator/random.cpp|the random generators|std::(normal|uni
 estimator/attitude.hpp estimator/attitude.cpp estimator/attitude_comparison.hpp estimator/attitude_comparison.cpp|strapdown attitude integration (compare through est::run_estimate / AttitudeComparison)|AttitudeIntegrator
 twin/world.cpp twin/world.hpp twin/simulator.cpp diagnose/compare_model.cpp|stepping the MuJoCo world (run the twin's Simulator with a Motion and, for outside flips, command_platform)|step_driven\(|mj_step[12]?\(
 estimator/pipeline.cpp|NEES against the truth (score through est::run_estimate)|\.(llt|ldlt)\(\)\.solve\(e\)
+estimator/fdi_input.cpp|the fault detector's input built from the filter (use est::fdi_input)|\.R_body_from_sensor[12] = 
+twin/truth_delay.cpp twin/truth_delay.hpp|the sensors' sampling offset (model.time_offset_s: use twin::TruthDelay)|time_offset_s \* 
+cli/compare_run.cpp|the options compare and diagnose share (use cli::add_compare_options)|"--(block|threshold|resample)"
+importers/ground_truth.cpp|parsing EuRoC ground-truth stamps (use importers::read_ground_truth: whole ns)|_ns *= *v\[0\]|t_first_ns
 RULES
 
 # 4. one closed-form generator for the estimator tests (tests/estimator/synth.hpp, Eigen only):
 #    no other header there draws its own samples
 while IFS= read -r f; do say "a second closed-form generator: $f (extend tests/estimator/synth.hpp)"; done \
   < <(grep -lE "std::mt19937|normal_distribution" tests/estimator/*.hpp 2>/dev/null | grep -vx 'tests/estimator/synth.hpp')
+
+# 5. the diagnose tests' logs come from the twin (FastBox or Simulator) or the independent Python
+#    generator: no test header there runs the sensor model or integrates an attitude of its own
+while IFS= read -r f; do say "a copy of the twin's generator: $f (build the log with twin::FastBox or the Simulator)"; done \
+  < <(grep -lE "SensorModel [a-z_0-9]+[({]|\.step\([a-z_]+\)|AngleAxisd\([^)]*normalized" tests/diagnose/*.hpp 2>/dev/null)
 exit $bad
