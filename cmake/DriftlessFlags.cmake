@@ -49,10 +49,12 @@ function(driftless_add_test name)
     WORKING_DIRECTORY ${PROJECT_BINARY_DIR})
 endfunction()
 
-# driftless_add_tests_in_folder(LIBS ...): every test_*.cpp / slow_test_*.cpp here is one binary.
+# driftless_add_tests_in_folder(LIBS ...): every test_*.cpp / slow_test_*.cpp here or in a subfolder is one binary.
 function(driftless_add_tests_in_folder)
   cmake_parse_arguments(ARG "" "" "LIBS" ${ARGN})
-  file(GLOB files CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/test_*.cpp
+  # subfolders mirror the source's (tests/twin/sensor/ for twin/sensor/); the label and the
+  # target prefix stay the top folder's
+  file(GLOB_RECURSE files CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/test_*.cpp
        ${CMAKE_CURRENT_SOURCE_DIR}/slow_test_*.cpp)
   get_filename_component(folder ${CMAKE_CURRENT_SOURCE_DIR} NAME)
   foreach(f ${files})
