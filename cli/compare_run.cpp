@@ -51,6 +51,10 @@ std::string doubt(const diagnose::CompareResult& r) {
     return "a selected effect has an implausible value (check the log's units, axes and frame convention, "
            "docs/log-format.md)";
   }
+  if (!r.offset_beyond_zro.empty()) {
+    return "the gyro differs from the reference by a constant rate beyond the sensor's zero-rate tolerance (the "
+           "reference turns where the gyro does not: check ref_q's frame and time base, the latitude, the gyro's units)";
+  }
   if (r.verdict == diagnose::Verdict::kUnexplained) return "the residual has structure no candidate effect explains";
   return {};
 }

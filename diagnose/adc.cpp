@@ -101,7 +101,7 @@ double finite_median(const std::vector<double>& x) {
 // residual's median; a bias of 20 deg/s is normal), predicts beyond them
 double saturation_evidence(const Replay& r, const Residual& res, int c, double ymax, double tol, double floor_dps) {
   const int s = c / 3, j = c % 3;
-  const double bias_dps = finite_median(res.e_dps[c]);
+  const double bias_dps = finite_median(res.e_series(c));
   double dj = 0.0;
   std::size_t plateau = 0;
   for (std::size_t k = 0; k < res.n; ++k) {

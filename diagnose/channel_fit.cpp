@@ -266,7 +266,7 @@ Channels build_channels(const ColumnInputs& in, const Residual& res) {
       C.gram = Eigen::MatrixXd::Zero(1, 1);
       return;
     }
-    C.z = block_series_of(res, res.e_dps[c]);
+    C.z = block_series_of(res, res.e_series(c));
     fill_columns(in, res, C);
     // noise model: the model's bias processes; the white density is a nuisance, fitted
     C.noise.white_dps_rthz = p.white_noise.enabled ? std::max(1e-6, p.white_noise.density_dps_rthz[C.j]) : 1e-6;

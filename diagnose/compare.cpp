@@ -16,6 +16,7 @@
 #include "diagnose/selection.hpp"
 #include "diagnose/signal_chain.hpp"
 #include "diagnose/summary.hpp"
+#include "estimator/mpu6050.hpp"
 
 namespace driftless::diagnose {
 namespace {
@@ -69,6 +70,19 @@ bool adopt_drift(const NoiseModelFindings& nm, const Residual& res, Channels& ch
   for (ChannelData& C : ch)
     if (C.present) rebuild_gram(C, res.block_series);
   return true;
+}
+
+// a constant offset between gyro and reference larger than the sensor's zero-rate tolerance
+// (and 3 sigma of the model's turn-on spread: the MPU6050 default's 20/3 deg/s gives the
+// datasheet's +-20 deg/s) is no turn-on bias: the reference shows a rotation the gyro
+// does not (a drifting or mis-framed ref_q, a wrong Earth rate) or the gyro is in other units
+void flag_offsets_beyond_zro(const CompareModel& model, int channels, CompareResult& out) {
+  for (int c = 0; c < channels; ++c) {
+    const twin::ConstantBiasParams& cb = model.sensor[c / 3].constant_bias;
+    const double spread_dps = cb.enabled ? cb.sigma_dps[c % 3] : 0.0;
+    const double limit_dps = std::max(mpu6050::kGyroZroToleranceDps, 3.0 * spread_dps);
+    if (std::abs(out.channels[static_cast<std::size_t>(c)].turn_on_bias_dps) > limit_dps) out.offset_beyond_zro.push_back(c);
+  }
 }
 
 std::vector<int> axes_of(const Candidate& c, int s) {
@@ -175,8 +189,9 @@ CompareResult compare(const Replay& r, const CompareModel& model, const CompareO
   NoiseModelFindings nm;
   AfterFit after;
   for (int pass = 0; pass < 3; ++pass) {
+    after = AfterFit{};  // the last pass's per-sample series go before the selection runs again
     sel = select_effects(si);
-    after = residual_after(ch, in, res, sel.spec, sel.fit, true);
+    after = residual_after(ch, in, res, sel.spec, sel.fit, AfterDetail::kSamples);
     nm = noise_model_candidates(r, res, ch, model, after, opt.evidence_threshold);
     if (pass == 2 || !adopt_drift(nm, res, ch)) break;
     out.notes.push_back("the bias drifts otherwise than the model's noise processes say: the effects were selected "
@@ -185,7 +200,7 @@ CompareResult compare(const Replay& r, const CompareModel& model, const CompareO
   out.selected = std::move(sel.selected);
   out.not_supported = std::move(sel.not_supported);
   out.notes.insert(out.notes.end(), sel.notes.begin(), sel.notes.end());
-  const AfterFit before = residual_after(ch, in, res, FitSpec{}, FitResult{}, true);
+  const AfterFit before = residual_after(ch, in, res, FitSpec{}, FitResult{}, AfterDetail::kStats);
   out.noise_model = std::move(nm.supported);
   out.not_supported.insert(out.not_supported.end(), nm.not_supported.begin(), nm.not_supported.end());
   // 5: where it fails, and the verdict
@@ -193,6 +208,7 @@ CompareResult compare(const Replay& r, const CompareModel& model, const CompareO
   for (const auto& c : out.selected) apply_candidate(selected_model, c);
   summarise_channels(ch, res, model, selected_model, before, after, opt, out);
   summarise_regimes(r, res, ch, after, opt, out);
+  flag_offsets_beyond_zro(model, res.channels(), out);
   plot_series(res, after, out);
   decide_verdict(out);
   return out;

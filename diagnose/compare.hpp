@@ -136,6 +136,10 @@ struct CompareResult {
   std::vector<RegimeSummary> regimes;
   std::vector<WindowSummary> windows, worst_windows;
   std::vector<Correlation> correlations;  // significant ones, strongest first
+  // channels whose constant offset from the reference (turn_on_bias_dps) no sensor of the model's
+  // kind can have: beyond the MPU6050's zero-rate tolerance and 3 sigma of the model's turn-on
+  // spread (the reference turns at a rate the gyro does not see, or another frame or unit)
+  std::vector<int> offset_beyond_zro;
   std::vector<std::string> notes;         // assumptions (replay, resampling, model)
   std::string model_source, log_path;
   double duration_s = 0.0, sample_rate_hz = 0.0, block_s = 0.0;

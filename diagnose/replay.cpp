@@ -16,72 +16,75 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-// the columns a replay needs, kept compact (a 1 h log at 100 Hz is 360k rows)
+// the columns a replay needs, one vector per column (a 1 h log at 100 Hz is 360k rows): the
+// measured ones (t, gyro, platform angles, temperature, accel) are moved into the Replay when it
+// is built, and ref_p / accel are kept only when the log has them
 struct Raw {
-  double t = kNaN;
-  Eigen::Vector3d g[2];
-  double plat[2] = {kNaN, kNaN};
-  Eigen::Vector4d q = Eigen::Vector4d::Constant(kNaN);
-  Eigen::Vector3d p = Eigen::Vector3d::Constant(kNaN);
-  Eigen::Vector3d a[2];
-  double temp[2] = {kNaN, kNaN};
+  explicit Raw(std::uint32_t fields) : with_p((fields & kFieldRefP) != 0), with_a((fields & kFieldAccel) != 0) {}
+  std::size_t size() const { return n; }
+  void push(const Sample& s) {
+    t.push_back(s.t_s);
+    g[0].push_back(s.gyro1_dps), g[1].push_back(s.gyro2_dps);
+    plat[0].push_back(s.plat1_deg), plat[1].push_back(s.plat2_deg);
+    temp[0].push_back(s.temp1_c), temp[1].push_back(s.temp2_c);
+    q.push_back(s.ref_q_wxyz);
+    if (with_p) p.push_back(s.ref_p_enu_m);
+    if (with_a) a[0].push_back(s.accel1_mps2), a[1].push_back(s.accel2_mps2);
+    ++n;
+  }
+  // gives back what the vectors' growth reserved, one column at a time
+  void shrink() {
+    for (auto* v : {&t, &plat[0], &plat[1], &temp[0], &temp[1]}) v->shrink_to_fit();
+    for (auto* v : {&g[0], &g[1], &a[0], &a[1], &p}) v->shrink_to_fit();
+    q.shrink_to_fit();
+  }
+  std::size_t n = 0;
+  bool with_p = false, with_a = false;
+  std::vector<double> t;
+  std::array<std::vector<Eigen::Vector3d>, 2> g, a;
+  std::array<std::vector<double>, 2> plat, temp;
+  std::vector<Eigen::Vector4d> q;
+  std::vector<Eigen::Vector3d> p;
 };
-
-Raw to_raw(const Sample& s) {
-  Raw r;
-  r.t = s.t_s;
-  r.g[0] = s.gyro1_dps;
-  r.g[1] = s.gyro2_dps;
-  r.plat[0] = s.plat1_deg;
-  r.plat[1] = s.plat2_deg;
-  r.q = s.ref_q_wxyz;
-  r.p = s.ref_p_enu_m;
-  r.a[0] = s.accel1_mps2;
-  r.a[1] = s.accel2_mps2;
-  r.temp[0] = s.temp1_c;
-  r.temp[1] = s.temp2_c;
-  return r;
-}
 
 double lerp(double a, double b, double u) { return a + (b - a) * u; }
 
 // linear interpolation of every column onto a uniform grid at rate_hz (quaternions: nlerp)
-std::vector<Raw> resample(const std::vector<Raw>& in, double rate_hz) {
-  std::vector<Raw> out;
-  if (in.size() < 2) return in;
-  const double t0 = in.front().t, t1 = in.back().t;
+Raw resample(Raw&& in, double rate_hz) {
+  if (in.size() < 2) return std::move(in);
+  Raw out(0);
+  out.with_p = in.with_p, out.with_a = in.with_a;
+  const double t0 = in.t.front(), t1 = in.t.back();
   const auto n = static_cast<std::size_t>(std::floor((t1 - t0) * rate_hz + 1e-9)) + 1;
-  out.reserve(n);
   std::size_t j = 0;
   for (std::size_t k = 0; k < n; ++k) {
     const double t = t0 + static_cast<double>(k) / rate_hz;
-    while (j + 2 < in.size() && in[j + 1].t <= t) ++j;
-    const Raw& a = in[j];
-    const Raw& b = in[j + 1];
-    const double u = std::clamp((t - a.t) / (b.t - a.t), 0.0, 1.0);
-    Raw r;
-    r.t = t;
+    while (j + 2 < in.size() && in.t[j + 1] <= t) ++j;
+    const std::size_t a = j, b = j + 1;
+    const double u = std::clamp((t - in.t[a]) / (in.t[b] - in.t[a]), 0.0, 1.0);
+    out.t.push_back(t);
     for (int s = 0; s < 2; ++s) {
-      r.g[s] = a.g[s] + (b.g[s] - a.g[s]) * u;
-      r.a[s] = a.a[s] + (b.a[s] - a.a[s]) * u;
-      r.plat[s] = lerp(a.plat[s], b.plat[s], u);
-      r.temp[s] = lerp(a.temp[s], b.temp[s], u);
+      out.g[s].push_back(in.g[s][a] + (in.g[s][b] - in.g[s][a]) * u);
+      if (in.with_a) out.a[s].push_back(in.a[s][a] + (in.a[s][b] - in.a[s][a]) * u);
+      out.plat[s].push_back(lerp(in.plat[s][a], in.plat[s][b], u));
+      out.temp[s].push_back(lerp(in.temp[s][a], in.temp[s][b], u));
     }
-    Eigen::Vector4d qb = b.q;
-    if (a.q.dot(qb) < 0) qb = -qb;
-    r.q = (a.q + (qb - a.q) * u);
-    if (r.q.allFinite()) r.q.normalize();
-    r.p = a.p + (b.p - a.p) * u;
-    out.push_back(r);
+    Eigen::Vector4d qb = in.q[b];
+    if (in.q[a].dot(qb) < 0) qb = -qb;
+    Eigen::Vector4d q = (in.q[a] + (qb - in.q[a]) * u);
+    if (q.allFinite()) q.normalize();
+    out.q.push_back(q);
+    if (in.with_p) out.p.push_back(in.p[a] + (in.p[b] - in.p[a]) * u);
+    ++out.n;
   }
   return out;
 }
 
 // median sample interval, s
-double median_dt(const std::vector<Raw>& raw) {
+double median_dt(const Raw& raw) {
   std::vector<double> dt;
   dt.reserve(raw.size());
-  for (std::size_t k = 1; k < raw.size(); ++k) dt.push_back(raw[k].t - raw[k - 1].t);
+  for (std::size_t k = 1; k < raw.size(); ++k) dt.push_back(raw.t[k] - raw.t[k - 1]);
   if (dt.empty()) return kNaN;
   auto mid = dt.begin() + static_cast<std::ptrdiff_t>(dt.size() / 2);
   std::nth_element(dt.begin(), mid, dt.end());
@@ -89,7 +92,7 @@ double median_dt(const std::vector<Raw>& raw) {
 }
 
 // largest swing of a sensor's output inside rest intervals of both platforms, deg/s
-double largest_rest_swing_dps(const std::vector<Raw>& raw, double fs) {
+double largest_rest_swing_dps(const Raw& raw, double fs) {
   // a running median over 1 s suppresses noise; the swing is the spread of that median
   // between consecutive platform flips (a static box only sees bias + Earth rate there)
   const auto w = static_cast<std::size_t>(std::max(1.0, std::round(fs)));
@@ -97,8 +100,8 @@ double largest_rest_swing_dps(const std::vector<Raw>& raw, double fs) {
   std::size_t seg_start = 0;
   auto same_rest = [&](std::size_t a, std::size_t b) {
     for (int s = 0; s < 2; ++s) {
-      if (!std::isfinite(raw[a].plat[s]) || !std::isfinite(raw[b].plat[s])) return false;
-      if (std::abs(raw[a].plat[s] - raw[b].plat[s]) > 0.5) return false;
+      if (!std::isfinite(raw.plat[s][a]) || !std::isfinite(raw.plat[s][b])) return false;
+      if (std::abs(raw.plat[s][a] - raw.plat[s][b]) > 0.5) return false;
     }
     return true;
   };
@@ -112,7 +115,7 @@ double largest_rest_swing_dps(const std::vector<Raw>& raw, double fs) {
         for (std::size_t b = seg_start; b + w <= k; b += w) {
           buf.clear();
           for (std::size_t i = b; i < b + w; ++i) {
-            if (std::isfinite(raw[i].g[s][ax])) buf.push_back(raw[i].g[s][ax]);
+            if (std::isfinite(raw.g[s][i][ax])) buf.push_back(raw.g[s][i][ax]);
           }
           if (buf.empty()) continue;
           auto mid = buf.begin() + static_cast<std::ptrdiff_t>(buf.size() / 2);
@@ -157,7 +160,7 @@ void read_header(const log::Metadata& meta, std::uint32_t fields, Replay& out) {
 // Without ref_q there is nothing to compare it with (a static body's Earth rate alone cannot
 // tell a scale or cross-axis error from the turn-on bias). There is no second platform: it is
 // held at 0 deg (no flips) so that only sensor 1's samples decide what is usable
-void single_sensor(std::vector<Raw>& raw, Replay& out) {
+void single_sensor(Raw& raw, Replay& out) {
   if (out.sensors != 1) return;
   if (!out.has_ref_q) {
     throw std::runtime_error(fmt::format(
@@ -165,13 +168,13 @@ void single_sensor(std::vector<Raw>& raw, Replay& out) {
         "need the body's reference attitude to predict one IMU (join motion capture or a trajectory with "
         "'driftless convert --ref'; docs/log-format.md)", out.log_path));
   }
-  for (Raw& r : raw) r.plat[1] = 0.0;
+  std::fill(raw.plat[1].begin(), raw.plat[1].end(), 0.0);
   out.notes.push_back("a single-sensor log: one IMU against the reference attitude (ref_q); the sensor-2 channels, "
                       "platform flips and end stops take no part");
 }
 
 // the sample rate: metadata, else the median interval; resampled when asked
-void set_rate(std::vector<Raw>& raw, const ReplayOptions& opt, Replay& out) {
+void set_rate(Raw& raw, const ReplayOptions& opt, Replay& out) {
   const double dt_med = median_dt(raw);
   double fs = out.meta.sample_rate_hz();
   if (!std::isfinite(fs) || fs <= 0) {
@@ -184,7 +187,7 @@ void set_rate(std::vector<Raw>& raw, const ReplayOptions& opt, Replay& out) {
   }
   out.log_rate_hz = fs;
   if (std::isfinite(opt.resample_hz) && std::abs(fs - opt.resample_hz) > 0.01 * opt.resample_hz) {
-    raw = resample(raw, opt.resample_hz);
+    raw = resample(std::move(raw), opt.resample_hz);
     out.resampled = true;
     out.notes.push_back(fmt::format("the log ({:.3f} Hz) was resampled to {:.3f} Hz by linear interpolation", fs, opt.resample_hz));
     fs = opt.resample_hz;
@@ -193,7 +196,7 @@ void set_rate(std::vector<Raw>& raw, const ReplayOptions& opt, Replay& out) {
 }
 
 // attitude: ref_q, or (static logs only) identity with the Earth rate as the only rate
-void check_attitude(std::vector<Raw>& raw, const ReplayOptions& opt, Replay& out) {
+void check_attitude(Raw& raw, const ReplayOptions& opt, Replay& out) {
   if (!out.has_ref_q) {
     const double swing = largest_rest_swing_dps(raw, out.sample_rate_hz);
     if (swing > opt.static_rate_limit_dps) {
@@ -202,19 +205,20 @@ void check_attitude(std::vector<Raw>& raw, const ReplayOptions& opt, Replay& out
           "by {:.2f} deg/s while both platforms rest); compare needs ref_q (and ref_p for accelerations) to replay a "
           "moving box (docs/log-format.md)", out.log_path, swing));
     }
-    for (auto& r : raw) r.q = Eigen::Vector4d(1, 0, 0, 0);
+    std::fill(raw.q.begin(), raw.q.end(), Eigen::Vector4d(1, 0, 0, 0));
     out.notes.push_back("the log has no ref_q: the box is assumed static and level with body axes = ENU (identity "
                         "attitude), so the body rate is the Earth rate only");
   }
-  for (auto& r : raw) {
-    if (!r.q.allFinite() || r.q.norm() < 0.5) {
-      throw std::runtime_error(fmt::format("{}: ref_q at t = {:.6f} s is empty or not a unit quaternion", out.log_path, r.t));
+  for (std::size_t k = 0; k < raw.size(); ++k) {
+    Eigen::Vector4d& q = raw.q[k];
+    if (!q.allFinite() || q.norm() < 0.5) {
+      throw std::runtime_error(fmt::format("{}: ref_q at t = {:.6f} s is empty or not a unit quaternion", out.log_path, raw.t[k]));
     }
-    r.q.normalize();
+    q.normalize();
   }
 }
 
-Eigen::Quaterniond quat(const Raw& r) { return Eigen::Quaterniond(r.q[0], r.q[1], r.q[2], r.q[3]); }
+Eigen::Quaterniond quat(const Eigen::Vector4d& q) { return Eigen::Quaterniond(q[0], q[1], q[2], q[3]); }
 
 // a kink of the rate (a motion profile starting or ending an acceleration) is not band limited:
 // no stencil rebuilds the rate near it. It shows as an isolated spike of the second difference
@@ -253,13 +257,12 @@ void mark_kinks(const std::vector<Eigen::Vector3d>& mean_rate, std::size_t fir_h
 // included (rotation vectors of interval increments lose the coning term: a false 0.02 % scale
 // on a 1.5 Hz two-axis wobble at 100 Hz). Near the ends, central differences. The Earth rate is
 // added in body axes; the transport rate (v/R) is neglected.
-void body_rate(const std::vector<Raw>& raw, const Eigen::Vector3d& earth_enu, const ReplayOptions& opt, Replay& out) {
+void body_rate(Raw& raw, const Eigen::Vector3d& earth_enu, const ReplayOptions& opt, Replay& out) {
   const std::size_t n = raw.size();
-  out.t_s.resize(n);
+  out.t_s = std::move(raw.t);
   std::vector<Eigen::Vector4d> q(n);
   for (std::size_t k = 0; k < n; ++k) {
-    out.t_s[k] = raw[k].t;
-    q[k] = raw[k].q;
+    q[k] = raw.q[k];
     if (k > 0 && q[k].dot(q[k - 1]) < 0) q[k] = -q[k];  // one hemisphere: q and -q are one rotation
   }
   const std::vector<double> d = central_differentiator();
@@ -282,7 +285,7 @@ void body_rate(const std::vector<Raw>& raw, const Eigen::Vector3d& earth_enu, co
   // kinks from the interval mean rates (their second differences)
   std::vector<Eigen::Vector3d> mean_rate(n - 1);
   for (std::size_t k = 0; k + 1 < n; ++k) {
-    mean_rate[k] = geo::rotvec_rad(quat(raw[k]).conjugate() * quat(raw[k + 1])) / (out.t_s[k + 1] - out.t_s[k]);
+    mean_rate[k] = geo::rotvec_rad(quat(raw.q[k]).conjugate() * quat(raw.q[k + 1])) / (out.t_s[k + 1] - out.t_s[k]);
   }
   mark_kinks(mean_rate, M, opt, out);
   // the first and last M samples have no full differentiator stencil: left out like a kink
@@ -290,11 +293,11 @@ void body_rate(const std::vector<Raw>& raw, const Eigen::Vector3d& earth_enu, co
 }
 
 // specific force in body axes: second differences of ref_p, else gravity only
-void specific_force(const std::vector<Raw>& raw, Replay& out) {
+void specific_force(Raw& raw, Replay& out) {
   const std::size_t n = raw.size();
   bool p_ok = out.has_ref_p;
   if (p_ok) {
-    for (const auto& r : raw) p_ok = p_ok && r.p.allFinite();
+    for (const auto& p : raw.p) p_ok = p_ok && p.allFinite();
     if (!p_ok) out.notes.push_back("ref_p has empty values; accelerations set to zero");
   }
   const Eigen::Vector3d g_enu(0, 0, kStandardGravityMps2);  // f = a - g, g = (0,0,-9.81)
@@ -303,10 +306,11 @@ void specific_force(const std::vector<Raw>& raw, Replay& out) {
     Eigen::Vector3d a_enu = Eigen::Vector3d::Zero();
     if (p_ok && k > 0 && k + 1 < n) {
       const double h1 = out.t_s[k] - out.t_s[k - 1], h2 = out.t_s[k + 1] - out.t_s[k];
-      a_enu = 2.0 * ((raw[k + 1].p - raw[k].p) / h2 - (raw[k].p - raw[k - 1].p) / h1) / (h1 + h2);
+      a_enu = 2.0 * ((raw.p[k + 1] - raw.p[k]) / h2 - (raw.p[k] - raw.p[k - 1]) / h1) / (h1 + h2);
     }
-    out.f_body_mps2[k] = quat(raw[k]).conjugate() * (a_enu + g_enu);
+    out.f_body_mps2[k] = quat(raw.q[k]).conjugate() * (a_enu + g_enu);
   }
+  raw.p = {};  // ref_p is used up
   if (!out.has_accel && !p_ok) {
     out.notes.push_back("no ref_p and no accel columns: the specific force is gravity alone (vehicle accelerations unknown)");
   }
@@ -314,19 +318,21 @@ void specific_force(const std::vector<Raw>& raw, Replay& out) {
 }
 
 // platforms: angle as logged, rate by central differences; unknown angle = moving
-std::array<std::vector<std::uint8_t>, 2> platform_motion(const std::vector<Raw>& raw, const ReplayOptions& opt, Replay& out) {
+std::array<std::vector<std::uint8_t>, 2> platform_motion(Raw& raw, const ReplayOptions& opt, Replay& out) {
   const std::size_t n = raw.size();
   std::array<std::vector<std::uint8_t>, 2> moving;
   for (int s = 0; s < 2; ++s) {
-    out.plat_deg[s].resize(n);
+    const std::vector<double>& plat = raw.plat[s];
     out.plat_rate_dps[s].resize(n);
-    out.temp_c[s].resize(n);
+    if (out.has_temp) {
+      out.temp_c[s] = std::move(raw.temp[s]);
+    } else {
+      out.temp_c[s].assign(n, kNaN), raw.temp[s] = {};
+    }
     moving[s].assign(n, 0);
     for (std::size_t k = 0; k < n; ++k) {
-      out.plat_deg[s][k] = raw[k].plat[s];
-      out.temp_c[s][k] = out.has_temp ? raw[k].temp[s] : kNaN;
       const std::size_t a = k == 0 ? 0 : k - 1, b = k + 1 < n ? k + 1 : n - 1;
-      out.plat_rate_dps[s][k] = std::isfinite(raw[k].plat[s]) ? (raw[b].plat[s] - raw[a].plat[s]) / (out.t_s[b] - out.t_s[a]) : kNaN;
+      out.plat_rate_dps[s][k] = std::isfinite(plat[k]) ? (plat[b] - plat[a]) / (out.t_s[b] - out.t_s[a]) : kNaN;
       const double r = out.plat_rate_dps[s][k];
       moving[s][k] = !std::isfinite(r) || std::abs(r) > opt.flip_rate_threshold_dps;
     }
@@ -343,7 +349,7 @@ std::array<std::vector<std::uint8_t>, 2> platform_motion(const std::vector<Raw>&
 }
 
 // per platform: time since it last stopped, the direction it went, the side it rests on
-void flip_history(const std::vector<Raw>& raw, const std::array<std::vector<std::uint8_t>, 2>& moving, Replay& out) {
+void flip_history(const Raw& raw, const std::array<std::vector<std::uint8_t>, 2>& moving, Replay& out) {
   const std::size_t n = raw.size();
   for (int s = 0; s < 2; ++s) {
     out.since_flip_s[s].assign(n, std::numeric_limits<float>::infinity());
@@ -354,13 +360,13 @@ void flip_history(const std::vector<Raw>& raw, const std::array<std::vector<std:
     bool was_moving = false;
     for (std::size_t k = 0; k < n; ++k) {
       if (moving[s][k]) {
-        if (!was_moving) start_angle = k > 0 ? raw[k - 1].plat[s] : kNaN;  // the last known angle before the move
+        if (!was_moving) start_angle = k > 0 ? raw.plat[s][k - 1] : kNaN;  // the last known angle before the move
         was_moving = true;
         continue;
       }
       if (was_moving) {
         stop_t = out.t_s[k];
-        const double end_angle = raw[k].plat[s];
+        const double end_angle = raw.plat[s][k];
         dir = (std::isfinite(start_angle) && std::isfinite(end_angle)) ? (end_angle > start_angle ? 1 : -1) : 0;
         was_moving = false;
       }
@@ -368,28 +374,27 @@ void flip_history(const std::vector<Raw>& raw, const std::array<std::vector<std:
         out.since_flip_s[s][k] = static_cast<float>(out.t_s[k] - stop_t);
         out.last_flip_dir[s][k] = static_cast<std::int8_t>(dir);
       }
-      const double ang = raw[k].plat[s];
+      const double ang = raw.plat[s][k];
       if (std::isfinite(ang) && std::abs(ang) > 1.0) out.rest_side[s][k] = ang > 0 ? 1 : -1;
     }
   }
 }
 
 // each sensor's ideal output (docs/log-format.md): y_i = R_i^T w_body + thetadot_i a_i
-void sensor_truth(const std::vector<Raw>& raw, const Eigen::Vector3d& dearth_dlat_enu, Replay& out) {
+void sensor_truth(Raw& raw, const Eigen::Vector3d& dearth_dlat_enu, Replay& out) {
   const std::size_t n = raw.size();
   out.usable.assign(n, 1);
   for (int s = 0; s < 2; ++s) {
-    out.gyro_dps[s].resize(n);
     out.w_radps[s].resize(n);
-    out.f_mps2[s].resize(n);
     out.dw_dlat_radps[s].resize(n);
+    // the log's accel columns are the specific force where they are finite (used in place)
+    std::vector<Eigen::Vector3d> f = out.has_accel ? std::move(raw.a[s]) : std::vector<Eigen::Vector3d>(n);
     const Eigen::Vector3d& axis = out.hinge_axis[s];
     for (std::size_t k = 0; k < n; ++k) {
-      out.gyro_dps[s][k] = raw[k].g[s];
-      const double ang = raw[k].plat[s];
+      const double ang = raw.plat[s][k];
       if (!std::isfinite(ang)) {
         out.w_radps[s][k].setConstant(kNaN);
-        out.f_mps2[s][k].setConstant(kNaN);
+        f[k].setConstant(kNaN);
         out.dw_dlat_radps[s][k].setConstant(kNaN);
         out.usable[k] = 0;
         continue;
@@ -397,15 +402,18 @@ void sensor_truth(const std::vector<Raw>& raw, const Eigen::Vector3d& dearth_dla
       const Eigen::Matrix3d Rt = geo::rot_about_axis_deg(axis, ang).transpose();
       const double rate = out.plat_rate_dps[s][k];
       out.w_radps[s][k] = Rt * out.w_body_radps[k] + (std::isfinite(rate) ? rate : 0.0) * kRadPerDeg * axis;
-      out.f_mps2[s][k] = out.has_accel && raw[k].a[s].allFinite() ? raw[k].a[s] : Eigen::Vector3d(Rt * out.f_body_mps2[k]);
-      out.dw_dlat_radps[s][k] = Rt * (quat(raw[k]).conjugate() * dearth_dlat_enu);
-      if (s < out.sensors && !raw[k].g[s].allFinite()) out.usable[k] = 0;
+      if (!(out.has_accel && f[k].allFinite())) f[k] = Rt * out.f_body_mps2[k];
+      out.dw_dlat_radps[s][k] = Rt * (quat(raw.q[k]).conjugate() * dearth_dlat_enu);
+      if (s < out.sensors && !raw.g[s][k].allFinite()) out.usable[k] = 0;
     }
+    out.f_mps2[s] = std::move(f);
+    out.gyro_dps[s] = std::move(raw.g[s]);
+    out.plat_deg[s] = std::move(raw.plat[s]);
   }
   out.rows_missing_gyro = static_cast<std::size_t>(std::count(out.usable.begin(), out.usable.end(), 0));
 }
 
-Replay build(std::vector<Raw> raw, const log::Metadata& meta, std::uint32_t fields, const ReplayOptions& opt,
+Replay build(Raw raw, const log::Metadata& meta, std::uint32_t fields, const ReplayOptions& opt,
              const std::string& where) {
   opt.validate();
   Replay out;
@@ -462,9 +470,8 @@ void ReplayOptions::validate() const {
 
 Replay replay_samples(const std::vector<Sample>& samples, const log::Metadata& meta,
                       std::uint32_t fields, const ReplayOptions& opt, const std::string& where) {
-  std::vector<Raw> raw;
-  raw.reserve(samples.size());
-  for (const auto& s : samples) raw.push_back(to_raw(s));
+  Raw raw(fields);
+  for (const auto& s : samples) raw.push(s);
   return build(std::move(raw), meta, fields, opt, where);
 }
 
@@ -473,9 +480,10 @@ Replay replay_log(const std::filesystem::path& path, const ReplayOptions& opt) {
   ro.accept_single_sensor = true;
   ro.fields = kFieldAccel | kFieldTemp | kFieldRefQ | kFieldRefP;  // the truth columns are never read here
   log::LogReader reader(path, ro);
-  std::vector<Raw> raw;
+  Raw raw(reader.fields());
   Sample s;
-  while (reader.next(s)) raw.push_back(to_raw(s));
+  while (reader.next(s)) raw.push(s);
+  raw.shrink();
   Replay r = build(std::move(raw), reader.metadata(), reader.fields(), opt, path.string());
   if (!reader.metadata().complete()) {
     r.notes.push_back("the log says 'complete: false' (the recording did not finish)");

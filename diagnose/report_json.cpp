@@ -132,7 +132,9 @@ std::string diagnosis_json(const CompareResult& r, const ReportExtras& x) {
   o << "  \"verdict\": " << q(verdict_id(r.verdict)) << ",\n  \"statement\": " << q(r.statement) << ",\n";
   o << "  \"evidence_threshold\": " << n(r.threshold) << ", \"samples\": " << r.samples << ", \"samples_used\": " << r.samples_used
     << ", \"duration_s\": " << n(r.duration_s) << ", \"sample_rate_hz\": " << n(r.sample_rate_hz) << ", \"sensors\": " << r.sensors << ", \"block_s\": " << n(r.block_s)
-    << ", \"resampled\": " << (r.resampled ? "true" : "false") << ",\n  \"notes\": ";
+    << ", \"resampled\": " << (r.resampled ? "true" : "false") << ",\n  \"offset_beyond_zro\": [";
+  for (std::size_t i = 0; i < r.offset_beyond_zro.size(); ++i) o << (i ? ", " : "") << q(channel_name(r.offset_beyond_zro[i]));
+  o << "],\n  \"notes\": ";
   strings_json(o, r.notes);
   o << ",\n";
   candidates_json(o, "selected", r.selected);

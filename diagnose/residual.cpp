@@ -30,7 +30,7 @@ std::size_t mask_hinge_bursts(const Replay& r, int s, Residual& res) {
   for (std::size_t k = 1; k < n; ++k) {
     if (!res.mask[k] || !res.mask[k - 1]) continue;
     Eigen::Vector3d d;
-    for (int j = 0; j < 3; ++j) d[j] = res.e_dps[s * 3 + j][k] - res.e_dps[s * 3 + j][k - 1];
+    for (int j = 0; j < 3; ++j) d[j] = res.e_dps(s * 3 + j, k) - res.e_dps(s * 3 + j, k - 1);
     dh[k] = std::abs(a.dot(d));
     doff[k] = (d - a * a.dot(d)).norm();
     if (k % 3 == 0) sample.push_back(dh[k]);
@@ -93,13 +93,7 @@ Residual make_residual(const Replay& r, const CompareModel& model, double block_
   if (!r.has_temp) res.notes.push_back("the log has no temperature columns: the model's temperature curve is used");
   res.mask.resize(res.n);
   for (std::size_t k = 0; k < res.n; ++k) res.mask[k] = r.usable[k] && !r.flipping[k] && !r.rough[k];
-  for (int c = 0; c < 6; ++c) {
-    const int s = c / 3, j = c % 3;
-    res.e_dps[c].resize(res.n);
-    for (std::size_t k = 0; k < res.n; ++k) {
-      res.e_dps[c][k] = r.usable[k] ? r.gyro_dps[s][k][j] - res.pred[s].gyro_dps[k][j] : kNaN;
-    }
-  }
+  res.replay = &r;
   for (int s = 0; s < res.sensors; ++s) {
     const std::size_t cnt = mask_hinge_bursts(r, s, res);
     if (cnt == 0) continue;
@@ -123,6 +117,12 @@ Residual make_residual(const Replay& r, const CompareModel& model, double block_
   }
   res.temp_span_c = hi - lo;
   return res;
+}
+
+std::vector<double> Residual::e_series(int c) const {
+  std::vector<double> e(n);
+  for (std::size_t k = 0; k < n; ++k) e[k] = e_dps(c, k);
+  return e;
 }
 
 std::vector<double> block_series_of(const Residual& res, const std::vector<double>& x) {

@@ -62,12 +62,12 @@ std::vector<double> without_delay_signature(const Replay& r, const Residual& res
     if (!res.mask[k]) continue;
     const Eigen::Vector3d x(1.0, d1[k], d2[k]);
     A += x * x.transpose();
-    b += x * res.e_dps[c][k];
+    b += x * res.e_dps(c, k);
   }
   const Eigen::Vector3d beta = A.ldlt().solve(b);
   std::vector<double> out(n, kNaN);
   for (std::size_t k = 1; k + 1 < n; ++k) {
-    if (res.mask[k]) out[k] = res.e_dps[c][k] - beta.dot(Eigen::Vector3d(1.0, d1[k], d2[k]));
+    if (res.mask[k]) out[k] = res.e_dps(c, k) - beta.dot(Eigen::Vector3d(1.0, d1[k], d2[k]));
   }
   return out;
 }

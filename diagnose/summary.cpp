@@ -47,17 +47,18 @@ double gm_avar(double sigma, double T, double tau) {
   return sigma * sigma * 2.0 / (x * x) * (x - 1.5 + 2.0 * std::exp(-x) - 0.5 * std::exp(-2.0 * x));
 }
 
-// mean and rms of a per-sample series over the fit samples
-std::pair<double, double> mean_rms(const Residual& res, const std::vector<float>& e) {
+// mean and rms of a per-sample float series over the fit samples (NaN left out)
+struct RunningMeanRms {
   double s1 = 0, s2 = 0;
   std::size_t n = 0;
-  for (std::size_t k = 0; k < res.n; ++k) {
-    if (!res.mask[k] || !std::isfinite(e[k])) continue;
-    s1 += e[k], s2 += static_cast<double>(e[k]) * e[k], ++n;
+  void add(float e) {
+    if (std::isfinite(e)) s1 += e, s2 += static_cast<double>(e) * e, ++n;
   }
-  const double d = std::max<double>(1.0, static_cast<double>(n));
-  return {s1 / d, std::sqrt(s2 / d)};
-}
+  std::pair<double, double> mean_rms() const {
+    const double d = std::max<double>(1.0, static_cast<double>(n));
+    return {s1 / d, std::sqrt(s2 / d)};
+  }
+};
 
 // the residual's Allan deviation (bias drift kept) against the model's N^2/tau + K^2 tau/3 + GM,
 // with the model's band at the data's confidence. Samples left out (flips, kinks) are filled
@@ -117,15 +118,16 @@ void whiteness(const ChannelData& c, const Residual& res, const std::vector<doub
 }  // namespace
 
 AfterFit residual_after(const Channels& ch, const ColumnInputs& in, const Residual& res, const FitSpec& spec,
-                        const FitResult& fit, bool per_sample) {
+                        const FitResult& fit, AfterDetail detail) {
   AfterFit a;
   const std::size_t L = res.block_len;
+  const bool keep = detail == AfterDetail::kSamples;
   for (int c = 0; c < 6; ++c) {
     const ChannelData& C = ch[c];
     if (!C.present) {  // sensor 2 of a single-sensor log: NaN throughout
       a.z[c].assign(res.blocks, kNaN);
       a.bias[c].assign(res.blocks, kNaN);
-      if (per_sample) a.e_drift[c].assign(res.n, std::numeric_limits<float>::quiet_NaN()), a.e[c] = a.e_drift[c];
+      if (keep) a.e_drift[c].assign(res.n, std::numeric_limits<float>::quiet_NaN()), a.e[c] = a.e_drift[c];
       continue;
     }
     const Eigen::VectorXd coef = channel_coefficients(C, c, spec, fit);
@@ -133,25 +135,27 @@ AfterFit residual_after(const Channels& ch, const ColumnInputs& in, const Residu
     a.bias[c] = BiasWhitener(res.block_series, C.noise).smooth(a.z[c]);
     for (std::size_t b = 0; b < res.blocks; ++b)
       if (!res.block_series.count[b]) a.z[c][b] = kNaN;
-    if (!per_sample) continue;
-    a.e_drift[c].resize(res.n);
-    a.e[c].resize(res.n);
+    if (detail == AfterDetail::kBlocks) continue;
+    if (keep) a.e_drift[c].resize(res.n), a.e[c].resize(res.n);
     const auto& bias = a.bias[c];
+    RunningMeanRms stats;
     for (std::size_t k = 0; k < res.n; ++k) {
-      double v = res.e_dps[c][k];
+      double v = res.e_dps(c, k);
       if (std::isfinite(v)) {
         for (int i = 0; i < static_cast<int>(C.cols.size()); ++i)
           if (coef[i] != 0.0) v -= column_value(in, C.s, C.j, C.cols[i], k) * coef[i];
       }
-      a.e_drift[c][k] = static_cast<float>(v);
       // bias per sample: linear interpolation between block centres
       const double u = (static_cast<double>(k % L) + 0.5) / static_cast<double>(L) - 0.5;
       const std::size_t b = k / L;
       double bv = bias[b];
       if (u > 0 && b + 1 < res.blocks) bv += (bias[b + 1] - bias[b]) * u;
       if (u < 0 && b > 0) bv += (bias[b] - bias[b - 1]) * u;
-      a.e[c][k] = static_cast<float>(v - bv);
+      const auto e = static_cast<float>(v - bv);
+      if (res.mask[k]) stats.add(e);
+      if (keep) a.e_drift[c][k] = static_cast<float>(v), a.e[c][k] = e;
     }
+    std::tie(a.mean_dps[c], a.rms_dps[c]) = stats.mean_rms();
   }
   return a;
 }
@@ -164,10 +168,12 @@ void summarise_channels(const Channels& ch, const Residual& res, const CompareMo
     ChannelSummary& cs = out.channels[c];
     const twin::SensorParams& p = model.sensor[C.s];
     const twin::SensorParams& p_sel = selected_model.sensor[C.s];
-    std::vector<float> raw(res.e_dps[c].begin(), res.e_dps[c].end());
-    std::tie(cs.raw_mean_dps, cs.raw_rms_dps) = mean_rms(res, raw);
-    std::tie(cs.mean_dps, cs.rms_dps) = mean_rms(res, before.e[c]);
-    cs.rms_after_dps = mean_rms(res, after.e[c]).second;
+    RunningMeanRms raw;
+    for (std::size_t k = 0; k < res.n; ++k)
+      if (res.mask[k]) raw.add(static_cast<float>(res.e_dps(c, k)));
+    std::tie(cs.raw_mean_dps, cs.raw_rms_dps) = raw.mean_rms();
+    cs.mean_dps = before.mean_dps[c], cs.rms_dps = before.rms_dps[c];
+    cs.rms_after_dps = after.rms_dps[c];
     cs.noise_floor_dps = white_noise_floor_dps(p, C.j, res.fs_hz);
     const double f2 = cs.noise_floor_dps * cs.noise_floor_dps;
     cs.systematic_rms_dps = std::sqrt(std::max(0.0, cs.rms_dps * cs.rms_dps - f2));

@@ -15,12 +15,17 @@ namespace driftless::diagnose {
 struct AfterFit {
   std::array<std::vector<double>, 6> z;       // block means
   std::array<std::vector<double>, 6> bias;    // smoothed bias per block (RTS)
-  std::array<std::vector<float>, 6> e_drift;  // per sample, bias drift kept (NaN unusable)
-  std::array<std::vector<float>, 6> e;        // per sample, smoothed bias removed too
+  std::array<std::vector<float>, 6> e_drift;  // per sample, bias drift kept (NaN unusable); kSamples only
+  std::array<std::vector<float>, 6> e;        // per sample, smoothed bias removed too; kSamples only
+  // mean and rms of `e` over the fit samples, deg/s (kStats and kSamples)
+  std::array<double, 6> mean_dps{}, rms_dps{};
 };
+/// How much of the per-sample residual residual_after keeps: block means only; the per-sample
+/// statistics (mean, rms) without the series (a 1 h log's two float series are 17 MB); or both.
+enum class AfterDetail { kBlocks, kStats, kSamples };
 /// Computes the residual after `spec` / `fit` (an empty spec: the nuisance-only residual).
 AfterFit residual_after(const Channels& ch, const ColumnInputs& in, const Residual& res, const FitSpec& spec,
-                        const FitResult& fit, bool per_sample);
+                        const FitResult& fit, AfterDetail detail);
 
 /// Fills channel statistics: raw and nuisance-only residual (`before`, against `model`), after
 /// the selection (`after`, against `selected_model`: the model with the selected effects), noise

@@ -6,6 +6,7 @@
 #include <fmt/core.h>
 
 #include "diagnose/summary.hpp"
+#include "estimator/mpu6050.hpp"
 
 namespace driftless::diagnose {
 namespace {
@@ -30,7 +31,10 @@ std::string effect_text(const Candidate& c) {
 
 }  // namespace
 
-void decide_verdict(CompareResult& out) {
+namespace {
+
+// the verdict from the selection, the noise model and the whiteness tests
+void verdict_from_fit(CompareResult& out) {
   bool white_ok = true;
   for (const auto& cs : out.channels) white_ok = white_ok && cs.white;
   std::string noise;
@@ -61,6 +65,24 @@ void decide_verdict(CompareResult& out) {
   out.verdict = Verdict::kConsistent;
   out.statement = "consistent with the noise model: the residual is white and no candidate effect is supported by the data" +
                   noise_tail;
+}
+
+}  // namespace
+
+// an offset beyond the sensor's zero-rate tolerance is said, with its cause and fix, and a
+// comparison that would otherwise call the log consistent calls it unexplained
+void decide_verdict(CompareResult& out) {
+  verdict_from_fit(out);
+  if (out.offset_beyond_zro.empty()) return;
+  std::string list;
+  for (int c : out.offset_beyond_zro)
+    list += fmt::format("{}{} {:+.2f} deg/s", list.empty() ? "" : ", ", channel_name(c), out.channels[static_cast<std::size_t>(c)].turn_on_bias_dps);
+  if (out.verdict == Verdict::kConsistent) out.verdict = Verdict::kUnexplained;
+  out.statement += fmt::format(
+      "; the gyro differs from the reference by a constant rate beyond the sensor's zero-rate tolerance ({}; an MPU6050 "
+      "turns on within +-{:g} deg/s): the reference shows a rotation the gyro does not (check ref_q's frame and time "
+      "base, the latitude, the gyro's units; docs/log-format.md)",
+      list, mpu6050::kGyroZroToleranceDps);
 }
 
 }  // namespace driftless::diagnose

@@ -60,6 +60,9 @@ inline double sample_rate_hz(int dlpf_cfg, int smplrt_div) {
   return gyro_output_rate_hz(dlpf_cfg) / (1.0 + (smplrt_div & 0xFF));
 }
 
+/// Initial zero-rate output (ZRO) tolerance of the gyro at 25 degC, deg/s (product specification
+/// section 6.1: +-20 deg/s): a unit's turn-on bias lies within it.
+inline constexpr double kGyroZroToleranceDps = 20.0;
 /// Temperature register law: T (degC) = TEMP_OUT / 340 + 36.53.
 inline constexpr double kTempLsbPerDegC = 340.0;
 inline constexpr double kTempOffsetDegC = 36.53;

@@ -5,6 +5,8 @@
 
 #include <filesystem>
 
+#include <sys/resource.h>
+
 #include "diagnose/apply.hpp"
 #include "diagnose/compare.hpp"
 #include "diagnose/report.hpp"
@@ -53,6 +55,11 @@ void BM_CompareDiagnose1h(benchmark::State& state) {
     state.counters["selected"] = static_cast<double>(res.selected.size());
     state.counters["first_evidence"] = res.selected.empty() ? 0.0 : res.selected.front().evidence;
   }
+  // the process's peak resident set, MB (includes simulating the log when it was not cached:
+  // run twice for the diagnose figure alone)
+  rusage ru{};
+  getrusage(RUSAGE_SELF, &ru);
+  state.counters["peak_rss_MB"] = static_cast<double>(ru.ru_maxrss) / 1024.0;
 }
 BENCHMARK(BM_CompareDiagnose1h)->Unit(benchmark::kSecond)->Iterations(1)->MeasureProcessCPUTime()->UseRealTime();
 

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <set>
 #include <string>
+#include <vector>
 
 #include "tests/diagnose/compare_test_log.hpp"
 #include "tests/diagnose/compare_twin_log.hpp"
@@ -49,6 +50,26 @@ TEST(CompareDiagnose, CleanLogIsConsistentWithNoise) {
   }
   // THEN every seed is consistent with the noise model
   EXPECT_EQ(consistent, seeds);
+}
+
+TEST(CompareDiagnose, OffsetBeyondTheZeroRateToleranceIsLoud) {
+  // GIVEN a gyro 30 deg/s off the reference on sensor 1 x (beyond the MPU6050's +-20 deg/s
+  // zero-rate tolerance: the reference turns where the gyro does not) and 12 deg/s off on
+  // sensor 2 y (a turn-on bias an MPU6050 can have), and a model without either
+  const SensorParams p = base_sensor();
+  SensorParams off1 = p, off2 = p;
+  off1.constant_bias.value_dps += Eigen::Vector3d(30.0, 0.0, 0.0);
+  off2.constant_bias.value_dps += Eigen::Vector3d(0.0, 12.0, 0.0);
+  // WHEN compared
+  const CompareResult res = run(off1, off2, p, p, 4);
+  // THEN only gx1 is flagged, the comparison is not called consistent, and the statement says
+  // what to check
+  ASSERT_EQ(res.offset_beyond_zro, std::vector<int>{0}) << res.statement;
+  EXPECT_NEAR(res.channels[0].turn_on_bias_dps, 30.0, 0.5);
+  EXPECT_NEAR(res.channels[4].turn_on_bias_dps, 12.0, 0.5);
+  EXPECT_NE(res.verdict, Verdict::kConsistent) << res.statement;
+  EXPECT_NE(res.statement.find("zero-rate tolerance"), std::string::npos) << res.statement;
+  EXPECT_NE(res.statement.find("gyro1_x +30"), std::string::npos) << res.statement;
 }
 
 TEST(CompareDiagnose, ScaleFactorFoundAndApplied) {
