@@ -4,6 +4,7 @@
 #include <limits>
 #include <string>
 
+#include "importers/bag_records.hpp"
 #include "importers/imu_reader.hpp"
 #include "importers/reader_factories.hpp"
 #include "importers/stamp_ns.hpp"
@@ -31,8 +32,11 @@ class BagReader : public ImuReader {
   }
 
  private:
-  std::string choose_topic(const ImportOptions& opt);
+  std::string choose_topic(const std::vector<BagConnection>& conns, const ImportOptions& opt);
+  void open_library(const std::filesystem::path& path, const ImportOptions& opt);
   void set_epoch();
+  void set_epoch_direct();
+  bool read_direct(ImuBlock& out, std::size_t max_rows);
   static std::int64_t ns_of(const ros::Time& t) { return static_cast<std::int64_t>(t.sec) * 1'000'000'000 + t.nsec; }
   rosbag::Bag bag_;
   std::string topic_;
@@ -41,14 +45,15 @@ class BagReader : public ImuReader {
   std::uint64_t index_ = 0;
   double rate_scale_ = kDegPerRad;
   bool receive_time_ = false;
+  std::unique_ptr<BagScan> scan_;  // the direct path (bag_records.hpp), when it gives View's messages
+  std::vector<BagImu> msgs_;
 };
 
-std::string BagReader::choose_topic(const ImportOptions& opt) {
-  rosbag::View all(bag_);
+std::string BagReader::choose_topic(const std::vector<BagConnection>& conns, const ImportOptions& opt) {
   std::vector<std::string> imu, every;
-  for (const rosbag::ConnectionInfo* c : all.getConnections()) {
-    every.push_back(c->topic + " (" + c->datatype + ")");
-    if (c->datatype == "sensor_msgs/Imu") imu.push_back(c->topic);
+  for (const BagConnection& c : conns) {
+    every.push_back(c.topic + " (" + c.type + ")");
+    if (c.type == "sensor_msgs/Imu") imu.push_back(c.topic);
   }
   std::string list;
   for (const auto& t : every) list += (list.empty() ? "" : ", ") + t;
@@ -81,19 +86,57 @@ void BagReader::set_epoch() {
   }
 }
 
-BagReader::BagReader(const std::filesystem::path& path, const ImportOptions& opt) {
-  info_.source = path.string();
-  info_.format = Format::kBag;
+// rosbag's own reader: every bag it can open (compressed, chunks out of time order, ...)
+void BagReader::open_library(const std::filesystem::path& path, const ImportOptions& opt) {
   try {
     bag_.open(path.string(), rosbag::bagmode::Read);
   } catch (const std::exception& e) {
     throw ImportError(info_.source + ": not a readable ROS 1 bag (" + e.what() + ")");
   }
-  topic_ = choose_topic(opt);
+  std::vector<BagConnection> conns;
+  for (const rosbag::ConnectionInfo* c : rosbag::View(bag_).getConnections()) conns.push_back({c->id, c->topic, c->datatype});
+  topic_ = choose_topic(conns, opt);
   view_ = std::make_unique<rosbag::View>(bag_, rosbag::TopicQuery(topic_));
   it_ = view_->begin();
   info_.rows_estimate = view_->size();
   set_epoch();
+}
+
+void BagReader::set_epoch_direct() {
+  const BagImu* m = nullptr;
+  try {
+    m = scan_->peek();
+  } catch (const std::runtime_error& e) {
+    throw ImportError(where(1) + ": cannot read (" + e.what() + ")");
+  }
+  if (m == nullptr) return;
+  receive_time_ = m->stamp_ns == 0;
+  if (receive_time_) info_.assumptions.push_back("header stamps are zero: the bag's receive times are used");
+  info_.epoch_s = epoch_s_of(receive_time_ ? m->receive_ns : m->stamp_ns);
+}
+
+BagReader::BagReader(const std::filesystem::path& path, const ImportOptions& opt) {
+  info_.source = path.string();
+  info_.format = Format::kBag;
+  // the direct path when the bag allows it (same messages, same order), else librosbag
+  std::string why;
+  std::optional<std::vector<BagConnection>> conns;
+  try {
+    conns = BagScan::connections(path, why);
+    if (conns) {
+      topic_ = choose_topic(*conns, opt);
+      scan_ = BagScan::open(path, topic_, why);
+    }
+  } catch (const std::runtime_error&) {
+    scan_.reset();  // a damaged index: librosbag's verdict below
+  }
+  if (scan_) {
+    info_.rows_estimate = scan_->count();
+    set_epoch_direct();
+  } else {
+    info_.assumptions.clear();  // the topic is chosen again from librosbag's view
+    open_library(path, opt);
+  }
   info_.has_time = true;
   if (!opt.units.empty()) {
     rate_scale_ = parse_rate_unit(opt.units, "--units").scale;
@@ -105,9 +148,29 @@ BagReader::BagReader(const std::filesystem::path& path, const ImportOptions& opt
   for (int k = 0; k < 3; ++k) info_.channels.push_back({std::string("linear_acceleration.") + "xyz"[k], Quantity::kAccel, k});
 }
 
+bool BagReader::read_direct(ImuBlock& out, std::size_t max_rows) {
+  try {
+    scan_->next(msgs_, max_rows);
+  } catch (const std::runtime_error& e) {
+    throw ImportError(where(index_ + 1) + ": cannot read (" + e.what() + ")");
+  }
+  for (auto& v : out.values) v.reserve(msgs_.size());
+  for (const BagImu& m : msgs_) {
+    ++index_;
+    out.t_s.push_back(seconds_since(receive_time_ ? m.receive_ns : m.stamp_ns, info_.epoch_s));
+    for (int k = 0; k < 3; ++k) {
+      out.values[static_cast<std::size_t>(k)].push_back(m.w[k] * rate_scale_);
+      out.values[static_cast<std::size_t>(3 + k)].push_back(m.a[k]);
+    }
+    out.loc.push_back(index_);
+  }
+  return out.rows() > 0;
+}
+
 bool BagReader::read(ImuBlock& out, std::size_t max_rows) {
   out.clear();
   out.values.resize(6);
+  if (scan_) return read_direct(out, max_rows);
   try {
     for (; it_ != view_->end() && out.rows() < max_rows; ++it_) {
       ++index_;

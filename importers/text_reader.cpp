@@ -49,6 +49,25 @@ void append_block(ImuBlock& to, const ImuBlock& from) {
   }
 }
 
+// the end of the first n lines of [b, e) (each ends in a newline; e when there are fewer), and
+// how many lines that is: newlines counted 64 kB at a time, the last piece walked line by line
+const char* after_lines(const char* b, const char* e, std::size_t n, std::size_t& lines) {
+  constexpr std::ptrdiff_t kPiece = 1 << 16;
+  lines = 0;
+  while (e - b > kPiece) {
+    const auto k = static_cast<std::size_t>(std::count(b, b + kPiece, '\n'));
+    if (k >= n - lines) break;
+    lines += k;
+    b += kPiece;
+  }
+  for (; lines < n && b < e; ++lines) {
+    const void* nl = std::memchr(b, '\n', static_cast<std::size_t>(e - b));
+    if (nl == nullptr) return e;  // (a last line without its newline is left to the caller)
+    b = static_cast<const char*>(nl) + 1;
+  }
+  return b;
+}
+
 }  // namespace
 
 TextReader::TextReader(const std::filesystem::path& path, const ImportOptions& opt, bool euroc) : path_(path.string()) {
@@ -230,15 +249,17 @@ void TextReader::parse_lines(const char* b, const char* e, std::uint64_t first_l
 bool TextReader::parse_buffered_in_two(ImuBlock& out, std::size_t room) {
   constexpr std::size_t kMinBytes = 1u << 20;
   if (!eof_ && len_ - pos_ < kChunk / 2) refill();
-  // whole lines only, and no more bytes than rows may still come (a line holds at most one row)
+  // whole lines only, and no more lines than rows may still come (a line holds at most one row)
   const char* b = buf_.get() + pos_;
-  const char* e = b + std::min(len_ - pos_, room);
+  const char* e = b + (len_ - pos_);
   while (e > b && e[-1] != '\n') --e;
+  if (static_cast<std::size_t>(e - b) < kMinBytes) return false;
+  std::size_t lines = 0;
+  e = after_lines(b, e, room, lines);
   if (static_cast<std::size_t>(e - b) < kMinBytes) return false;
   const char* half = b + (e - b) / 2;
   const char* mid = static_cast<const char*>(std::memchr(half, '\n', static_cast<std::size_t>(e - half))) + 1;
   const auto first_half_lines = static_cast<std::uint64_t>(std::count(b, mid, '\n'));
-  const auto lines = first_half_lines + static_cast<std::uint64_t>(std::count(mid, e, '\n'));
   side_.clear();
   side_.values.resize(out.values.size());
   std::exception_ptr side_error;
@@ -266,12 +287,16 @@ bool TextReader::parse_buffered_in_two(ImuBlock& out, std::size_t room) {
 bool TextReader::read(ImuBlock& out, std::size_t max_rows) {
   out.clear();
   out.values.resize(info_.channels.size());
+  // the block's room at once (growing by doubling copies and faults in 2x the pages)
+  const std::size_t want = std::min<std::uint64_t>(max_rows, info_.rows_estimate + 1024);
+  out.t_s.reserve(want);
+  out.loc.reserve(want);
+  for (auto& v : out.values) v.reserve(want);
   std::string_view line;
-  while (out.rows() < max_rows) {
-    if (parse_buffered_in_two(out, max_rows - out.rows())) continue;
-    if (!next_line(line)) break;
-    take_line(line, line_no_, out);
+  while (out.rows() < max_rows && parse_buffered_in_two(out, max_rows - out.rows())) {
   }
+  // what is left of the block (too little for two threads, or the file's end): line by line
+  while (out.rows() < max_rows && next_line(line)) take_line(line, line_no_, out);
   return out.rows() > 0;
 }
 

@@ -24,6 +24,37 @@ void require(bool ok, const std::string& what) {
 Eigen::Quaterniond rz(double a) { return Eigen::Quaterniond(Eigen::AngleAxisd(a, Eigen::Vector3d::UnitZ())); }
 Eigen::Quaterniond rx(double a) { return Eigen::Quaterniond(Eigen::AngleAxisd(a, Eigen::Vector3d::UnitX())); }
 
+// a function of time with its first two derivatives (value, per s, per s^2): the closed-form
+// motions differentiate themselves through these operations
+struct Jet {
+  double v = 0, d = 0, dd = 0;
+};
+Jet operator+(const Jet& a, const Jet& b) { return {a.v + b.v, a.d + b.d, a.dd + b.dd}; }
+Jet operator-(const Jet& a, const Jet& b) { return {a.v - b.v, a.d - b.d, a.dd - b.dd}; }
+Jet operator+(const Jet& a, double c) { return {a.v + c, a.d, a.dd}; }
+Jet operator+(double c, const Jet& a) { return {c + a.v, a.d, a.dd}; }
+Jet operator-(const Jet& a, double c) { return {a.v - c, a.d, a.dd}; }
+Jet operator-(double c, const Jet& a) { return {c - a.v, -a.d, -a.dd}; }
+Jet operator*(const Jet& a, double c) { return {a.v * c, a.d * c, a.dd * c}; }
+Jet operator*(double c, const Jet& a) { return {c * a.v, c * a.d, c * a.dd}; }
+Jet operator/(const Jet& a, double c) { return {a.v / c, a.d / c, a.dd / c}; }
+Jet operator*(const Jet& a, const Jet& b) {
+  return {a.v * b.v, a.d * b.v + a.v * b.d, a.dd * b.v + 2 * a.d * b.d + a.v * b.dd};
+}
+Jet sin(const Jet& a) {
+  const double s = std::sin(a.v), c = std::cos(a.v);
+  return {s, c * a.d, c * a.dd - s * a.d * a.d};
+}
+Jet cos(const Jet& a) {
+  const double s = std::sin(a.v), c = std::cos(a.v);
+  return {c, -s * a.d, -s * a.dd - c * a.d * a.d};
+}
+// atan2(y(t), x) for a constant x > 0
+Jet atan2_const_x(const Jet& y, double x) {
+  const double den = x * x + y.v * y.v;
+  return {std::atan2(y.v, x), x * y.d / den, x * y.dd / den - 2 * x * y.v * y.d * y.d / (den * den)};
+}
+
 // ---------------------------------------------------------------------------------------------
 // static
 
@@ -219,62 +250,109 @@ class GroundVehicleMotion final : public Motion {
   }
 
   void pose(double t, Eigen::Vector3d& p, Eigen::Quaterniond& q) const override {
-    auto it = std::upper_bound(segs_.begin(), segs_.end(), t,
-                               [](double tt, const DriveSegment& s) { return tt < s.t0; });
-    const DriveSegment& seg = it == segs_.begin() ? segs_.front() : *(it - 1);
-    Eigen::Vector2d xy;
-    double psi = 0, v = 0, s = 0;
-    evaluate(seg, std::max(0.0, t - seg.t0), xy, psi, v, s);
-    // road bumps under the front and rear axles: heave, pitch, roll
-    const double half_wb = 0.5 * p_.wheelbase_m;
-    double side_f = 0, side_r = 0;
-    const double zf = road(s + half_wb, side_f), zr = road(s - half_wb, side_r);
-    double heave = 0.5 * (zf + zr);
-    double pitch = std::atan2(zr - zf, p_.wheelbase_m);  // about body y: front up = nose up = negative
-    double roll = (side_f * zf + side_r * zr) / 1.6 * 0.5;
-    double yaw = psi;
-    // vibration: engine at idle plus road-induced, growing with speed
-    const double k = std::min(1.0, v / p_.max_speed_mps);
-    const double amp = (p_.idle_vibration_deg + (p_.vibration_deg - p_.idle_vibration_deg) * k) * kRadPerDeg;
-    const double w = 2 * kPi;
-    roll += amp * (0.6 * std::sin(w * 11.3 * t + phase_[0]) + 0.4 * std::sin(w * 27.1 * t + phase_[1]));
-    pitch += amp * (0.6 * std::sin(w * 13.7 * t + phase_[2]) + 0.4 * std::sin(w * 31.9 * t + phase_[3]));
-    yaw += 0.3 * amp * std::sin(w * 9.1 * t + phase_[4]);
-    heave += p_.vibration_heave_m * k * std::sin(w * 15.3 * t + phase_[5]);
-    const Eigen::Quaterniond q_veh = quat_from_ypr(yaw, pitch, roll);
-    const Eigen::Vector3d p_veh(xy.x(), xy.y(), heave);
-    p = p_veh + q_veh * World::box_on_vehicle_m();
-    q = q_veh;
+    const VehicleAngles g = angles(t);
+    q = quat_from_ypr(g.yaw.v, g.pitch.v, g.roll.v);
+    p = Eigen::Vector3d(g.x.v, g.y.v, g.heave.v) + q * World::box_on_vehicle_m();
+  }
+  // the pose's exact derivatives: the drive, road and vibration are closed forms in t, so the
+  // rates and accelerations need no differencing (5 poses per call before, and a second
+  // difference over 2 ms is 1.3 % low on the 32 Hz vibration)
+  MotionState at(double t) const override {
+    const VehicleAngles g = angles(t);
+    MotionState s;
+    s.q_enu_from_body = quat_from_ypr(g.yaw.v, g.pitch.v, g.roll.v);
+    const Eigen::Matrix3d R = s.q_enu_from_body.toRotationMatrix();
+    // body rates of the ZYX angles (yaw psi, pitch theta, roll phi) and their time derivative
+    const double sf = std::sin(g.roll.v), cf = std::cos(g.roll.v);
+    const double st = std::sin(g.pitch.v), ct = std::cos(g.pitch.v);
+    const double f1 = g.roll.d, f2 = g.roll.dd, t1 = g.pitch.d, t2 = g.pitch.dd, y1 = g.yaw.d, y2 = g.yaw.dd;
+    s.w_body_radps = Eigen::Vector3d(f1 - y1 * st, t1 * cf + y1 * ct * sf, -t1 * sf + y1 * ct * cf);
+    s.dw_body_radps2 = Eigen::Vector3d(
+        f2 - y2 * st - y1 * ct * t1,
+        t2 * cf - t1 * sf * f1 + y2 * ct * sf - y1 * st * t1 * sf + y1 * ct * cf * f1,
+        -t2 * sf - t1 * cf * f1 + y2 * ct * cf - y1 * st * t1 * cf - y1 * ct * sf * f1);
+    const Eigen::Vector3d r = World::box_on_vehicle_m();
+    const Eigen::Vector3d& w = s.w_body_radps;
+    s.p_enu_m = Eigen::Vector3d(g.x.v, g.y.v, g.heave.v) + s.q_enu_from_body * r;
+    s.v_enu_mps = Eigen::Vector3d(g.x.d, g.y.d, g.heave.d) + R * w.cross(r);
+    s.a_enu_mps2 = Eigen::Vector3d(g.x.dd, g.y.dd, g.heave.dd) + R * (s.dw_body_radps2.cross(r) + w.cross(w.cross(r)));
+    return s;
   }
   Carrier carrier() const override { return Carrier::vehicle; }
 
  private:
-  static void evaluate(const DriveSegment& g, double tau, Eigen::Vector2d& xy, double& psi,
-                       double& v, double& s) {
+  // the vehicle's position (ENU east, north, up; m) and ZYX attitude angles (rad) at t
+  struct VehicleAngles {
+    Jet x, y, heave, yaw, pitch, roll;
+  };
+  VehicleAngles angles(double t) const {
+    auto it = std::upper_bound(segs_.begin(), segs_.end(), t,
+                               [](double tt, const DriveSegment& s) { return tt < s.t0; });
+    const DriveSegment& seg = it == segs_.begin() ? segs_.front() : *(it - 1);
+    VehicleAngles g;
+    Jet psi, v, s;
+    drive(seg, t - seg.t0, g.x, g.y, psi, v, s);
+    // road bumps under the front and rear axles: heave, pitch, roll
+    const double half_wb = 0.5 * p_.wheelbase_m;
+    double side_f = 0, side_r = 0;
+    const Jet zf = road(s + half_wb, side_f), zr = road(s - half_wb, side_r);
+    g.heave = 0.5 * (zf + zr);
+    g.pitch = atan2_const_x(zr - zf, p_.wheelbase_m);  // about body y: front up = nose up = negative
+    g.roll = (side_f * zf + side_r * zr) / 1.6 * 0.5;
+    g.yaw = psi;
+    // vibration: engine at idle plus road-induced, growing with speed
+    const Jet k = v.v < p_.max_speed_mps ? v / p_.max_speed_mps : Jet{1.0, 0, 0};
+    const Jet amp = (p_.idle_vibration_deg + (p_.vibration_deg - p_.idle_vibration_deg) * k) * kRadPerDeg;
+    const Jet T{t, 1, 0};
+    const double w = 2 * kPi;
+    auto wave = [&](double hz, int i) { return sin(w * hz * T + phase_[i]); };
+    g.roll = g.roll + amp * (0.6 * wave(11.3, 0) + 0.4 * wave(27.1, 1));
+    g.pitch = g.pitch + amp * (0.6 * wave(13.7, 2) + 0.4 * wave(31.9, 3));
+    g.yaw = g.yaw + 0.3 * amp * wave(9.1, 4);
+    g.heave = g.heave + p_.vibration_heave_m * k * wave(15.3, 5);
+    return g;
+  }
+  // one segment tau s after its start (held at its start before it: no motion)
+  static void drive(const DriveSegment& g, double tau, Jet& x, Jet& y, Jet& psi, Jet& v, Jet& s) {
+    const double live = tau > 0 ? 1.0 : 0.0;
+    tau = std::max(0.0, tau);
     if (g.yaw_rate == 0.0) {
-      const double ds = g.v0 * tau + 0.5 * g.accel * tau * tau;
-      psi = g.psi0;
-      v = std::max(0.0, g.v0 + g.accel * tau);
-      xy = g.p0 + ds * Eigen::Vector2d(std::cos(psi), std::sin(psi));
+      const double c = std::cos(g.psi0), sn = std::sin(g.psi0);
+      const double v_now = g.v0 + g.accel * tau;
+      const Jet ds{g.v0 * tau + 0.5 * g.accel * tau * tau, live * v_now, live * g.accel};
+      psi = {g.psi0, 0, 0};
+      v = {std::max(0.0, v_now), v_now > 0 ? live * g.accel : 0.0, 0};
+      x = g.p0.x() + ds * c;
+      y = g.p0.y() + ds * sn;
       s = g.s0 + ds;
     } else {
-      psi = g.psi0 + g.yaw_rate * tau;
-      v = g.v0;
+      psi = {g.psi0 + g.yaw_rate * tau, live * g.yaw_rate, 0};
+      v = {g.v0, 0, 0};
       const double rr = g.v0 / g.yaw_rate;
-      xy = g.p0 + rr * Eigen::Vector2d(std::sin(psi) - std::sin(g.psi0), std::cos(g.psi0) - std::cos(psi));
-      s = g.s0 + g.v0 * tau;
+      x = g.p0.x() + rr * (sin(psi) - std::sin(g.psi0));
+      y = g.p0.y() + rr * (std::cos(g.psi0) - cos(psi));
+      s = {g.s0 + g.v0 * tau, live * g.v0, 0};
     }
   }
+  // the end state of a segment dur s long (the next segment's start)
+  static void evaluate(const DriveSegment& g, double dur, Eigen::Vector2d& xy, double& psi, double& v, double& s) {
+    Jet jx, jy, jpsi, jv, js;
+    drive(g, dur, jx, jy, jpsi, jv, js);
+    xy = Eigen::Vector2d(jx.v, jy.v);
+    psi = jpsi.v;
+    v = jv.v;
+    s = js.v;
+  }
   // road height at arc length s (raised-cosine bumps), and the bump's side factor
-  double road(double s, double& side) const {
+  Jet road(const Jet& s, double& side) const {
     side = 0;
-    auto it = std::upper_bound(bumps_.begin(), bumps_.end(), s,
+    auto it = std::upper_bound(bumps_.begin(), bumps_.end(), s.v,
                                [](double ss, const Bump& b) { return ss < b.s; });
-    if (it == bumps_.begin()) return 0.0;
+    if (it == bumps_.begin()) return {};
     const Bump& b = *(it - 1);
-    if (s > b.s + b.length) return 0.0;
+    if (s.v > b.s + b.length) return {};
     side = b.side;
-    return b.height * 0.5 * (1.0 - std::cos(2 * kPi * (s - b.s) / b.length));
+    return b.height * 0.5 * (1.0 - cos(2 * kPi * (s - b.s) / b.length));
   }
 
   GroundVehicleParams p_;

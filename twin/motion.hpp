@@ -37,8 +37,9 @@ class Motion {
   /// What carries the box in renders.
   virtual Carrier carrier() const = 0;
   /// Pose and derivatives at t: central differences of pose() (O(h^2), h = 0.1 ms for rates,
-  /// 2 ms for accelerations), exact zeros for a static motion.
-  MotionState at(double t_s) const;
+  /// 2 ms for accelerations), exact zeros for a static motion; motions in closed form (the
+  /// ground vehicle) give their exact derivatives instead.
+  virtual MotionState at(double t_s) const;
 };
 
 /// A box standing still (the paper's 14 h static test), on the pan/tilt pedestal.

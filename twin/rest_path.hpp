@@ -47,6 +47,14 @@ class RestGate {
   double settle_s_;
   double loud_s_[2] = {-kNoTime, -kNoTime};  // last time platform i moved or was disturbed, s
   static constexpr double kNoTime = 1e300;
+  // the platforms' loads at the last interval's end `b`, N m: the next interval starts there
+  struct EndLoad {
+    MotionState base;
+    double angle_rad[2] = {0, 0};
+    double torque_nm[2] = {0, 0};
+    bool valid = false;
+  };
+  mutable EndLoad end_load_;
 };
 
 }  // namespace driftless::twin

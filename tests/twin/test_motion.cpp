@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "estimator/geometry.hpp"
 #include "estimator/input_error.hpp"
 #include "estimator/sample.hpp"
 #include "tests/temp_path.hpp"
@@ -87,6 +88,59 @@ TEST(Motion, GroundVehicleDrivesTurnsAndShakes) {
   EXPECT_GT(max_accel, 0.5);
   EXPECT_FALSE(m->is_static());
   EXPECT_EQ(m->carrier(), Carrier::vehicle);
+}
+
+// the derivative of f at t from 5-point differences (O(h^4)): central, and one-sided from the
+// left and the right; of the three, the one closest to `exact` (a stencil straddling a step of a
+// higher derivative, at a bump's edge or where the drive's acceleration changes, is no derivative,
+// but one side of the step is smooth)
+template <class F, class V>
+double diff_error(F f, double t, double h, const V& exact) {
+  const V central = (f(t - 2 * h) - 8 * f(t - h) + 8 * f(t + h) - f(t + 2 * h)) / (12 * h);
+  double best = (central - exact).norm();
+  for (const double g : {h, -h}) {
+    const V side = (25 * f(t) - 48 * f(t - g) + 36 * f(t - 2 * g) - 16 * f(t - 3 * g) + 3 * f(t - 4 * g)) / (12 * g);
+    best = std::min(best, (side - exact).norm());
+  }
+  return best;
+}
+
+// GIVEN the vehicle's closed-form derivatives, WHEN compared with differences of its own pose and
+// rates at 3 000 instants of a drive with turns, stops, bumps and vibration, THEN they agree to
+// the differences' round-off (positions of km over h = 0.1 ms: ~1e-8 m/s)
+TEST(Motion, GroundVehicleDerivativesAreThoseOfItsPose) {
+  MotionConfig cfg;
+  cfg.type = MotionType::ground_vehicle;
+  cfg.ground_vehicle.bumps_per_km = 300;  // a bump under an axle at many of the instants
+  const auto m = make_motion(cfg, 600, 5);
+  const double h = 1e-4;  // s
+  auto pos = [&](double t) -> Eigen::Vector3d { return m->at(t).p_enu_m; };
+  auto vel = [&](double t) -> Eigen::Vector3d { return m->at(t).v_enu_mps; };
+  auto rate = [&](double t) -> Eigen::Vector3d { return m->at(t).w_body_radps; };
+  auto quat = [&](double t) -> Eigen::Vector4d { return m->at(t).q_enu_from_body.coeffs(); };
+  double err_v = 0, err_w = 0, err_a = 0, err_dw = 0, max_dw = 0, max_a = 0;
+  for (int k = 0; k < 3000; ++k) {
+    const double t = 0.5 + 0.19937 * k;  // s, not on any round number
+    const MotionState s = m->at(t);
+    // dq/dt = q * (0, w) / 2 (w in body axes)
+    const Eigen::Quaterniond half_w(0, 0.5 * s.w_body_radps.x(), 0.5 * s.w_body_radps.y(), 0.5 * s.w_body_radps.z());
+    const Eigen::Vector4d dq = (s.q_enu_from_body * half_w).coeffs();
+    err_v = std::max(err_v, diff_error(pos, t, h, s.v_enu_mps));
+    err_w = std::max(err_w, diff_error(quat, t, h, dq));
+    err_a = std::max(err_a, diff_error(vel, t, h, s.a_enu_mps2));
+    err_dw = std::max(err_dw, diff_error(rate, t, h, s.dw_body_radps2));
+    max_a = std::max(max_a, s.a_enu_mps2.norm());
+    max_dw = std::max(max_dw, s.dw_body_radps2.norm());
+  }
+  EXPECT_LT(err_v, 1e-6);   // m/s
+  EXPECT_LT(err_w, 2e-9);   // 1/s (quaternion rate: half the body rate, rad/s)
+  EXPECT_LT(err_a, 1e-6);   // m/s^2
+  EXPECT_LT(err_dw, 1e-6);  // rad/s^2
+  // the differences compared something that moves: the 27-32 Hz vibration's angular acceleration
+  EXPECT_GT(max_dw, 1.0);
+  EXPECT_GT(max_a, 1.0);
+  std::printf("max differences: v %.2g m/s, dq/dt %.2g 1/s, a %.2g m/s^2, dw %.2g rad/s^2 (max |a| %.3g, |dw| %.3g)\n",
+              err_v, err_w, err_a, err_dw, max_a, max_dw);
 }
 
 TEST(Motion, ShipRollsWithItsPeriod) {
