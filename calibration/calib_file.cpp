@@ -22,6 +22,23 @@ void emit_num_or_null(YAML::Emitter& out, double v) {
   else out << YAML::Null;
 }
 
+
+// the hinge axes both writers put after format/method
+void emit_hinge_axes(YAML::Emitter& out, const Eigen::Vector3d& hinge1, const Eigen::Vector3d& hinge2) {
+  out << YAML::Key << "hinge1_axis" << YAML::Value;
+  yio::emit_vec3(out, hinge1);
+  out << YAML::Key << "hinge2_axis" << YAML::Value;
+  yio::emit_vec3(out, hinge2);
+}
+
+// the first keys of the rig block: where the data came from
+void emit_rig_origin(YAML::Emitter& out, const std::string& source, double latitude_deg, double sample_rate_hz) {
+  out << YAML::Key << "source" << YAML::Value << source;
+  out << YAML::Key << "latitude_deg" << YAML::Value;
+  emit_num_or_null(out, latitude_deg);
+  out << YAML::Key << "sample_rate_hz" << YAML::Value;
+  emit_num_or_null(out, sample_rate_hz);
+}
 }  // namespace
 
 void save_calib(const std::filesystem::path& path, const est::CalibFit& fit,
@@ -35,17 +52,10 @@ void save_calib(const std::filesystem::path& path, const est::CalibFit& fit,
   out << YAML::BeginMap;
   out << YAML::Key << "format" << YAML::Value << kCalibFormat;
   out << YAML::Key << "method" << YAML::Value << est::method_name(fit.method);
-  out << YAML::Key << "hinge1_axis" << YAML::Value;
-  yio::emit_vec3(out, rig.hinge1_axis);
-  out << YAML::Key << "hinge2_axis" << YAML::Value;
-  yio::emit_vec3(out, rig.hinge2_axis);
+  emit_hinge_axes(out, rig.hinge1_axis, rig.hinge2_axis);
 
   out << YAML::Key << "rig" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "source" << YAML::Value << rig.source;
-  out << YAML::Key << "latitude_deg" << YAML::Value;
-  emit_num_or_null(out, rig.latitude_deg);
-  out << YAML::Key << "sample_rate_hz" << YAML::Value;
-  emit_num_or_null(out, rig.sample_rate_hz);
+  emit_rig_origin(out, rig.source, rig.latitude_deg, rig.sample_rate_hz);
   out << YAML::Key << "earth_rate_removed" << YAML::Value << rig.earth_rate_removed;
   out << YAML::Key << "gyro_full_scale_dps" << YAML::Value << num(rig.plan.gyro_full_scale_dps);
   out << YAML::Key << "mean_temp_degc" << YAML::Value << YAML::Flow << YAML::BeginSeq;
@@ -145,16 +155,9 @@ void save_selfcal_calib(const std::filesystem::path& path, const SelfCalibration
   out << YAML::Key << "format" << YAML::Value << kCalibFormat;
   out << YAML::Key << "method" << YAML::Value << "selfcal";
   out << YAML::Key << "matrices" << YAML::Value << "nominal";
-  out << YAML::Key << "hinge1_axis" << YAML::Value;
-  yio::emit_vec3(out, sc.hinge1_axis);
-  out << YAML::Key << "hinge2_axis" << YAML::Value;
-  yio::emit_vec3(out, sc.hinge2_axis);
+  emit_hinge_axes(out, sc.hinge1_axis, sc.hinge2_axis);
   out << YAML::Key << "rig" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "source" << YAML::Value << sc.source;
-  out << YAML::Key << "latitude_deg" << YAML::Value;
-  emit_num_or_null(out, sc.latitude_deg);
-  out << YAML::Key << "sample_rate_hz" << YAML::Value;
-  emit_num_or_null(out, sc.sample_rate_hz);
+  emit_rig_origin(out, sc.source, sc.latitude_deg, sc.sample_rate_hz);
   out << YAML::EndMap;
   for (int i = 0; i < 2; ++i) {
     const auto iu = static_cast<std::size_t>(i);
