@@ -62,11 +62,17 @@ struct StreamInfo {
 /// A block of rows, channel-major: values[c][r]; t_s[r] in s since StreamInfo::epoch_s (NaN when no
 /// time); loc[r] the source
 /// line (text) or message number (bag), 1-based, for messages.
+/// A caller that wants only the values of a record without time sets `bare_untimed` before read():
+/// the text and .npy readers then leave t_s and loc empty when the source has no time (16 bytes a
+/// row not written), and rows() counts the values.
 struct ImuBlock {
   std::vector<double> t_s;
   std::vector<std::vector<double>> values;
   std::vector<std::uint64_t> loc;
-  std::size_t rows() const { return t_s.size(); }
+  bool bare_untimed = false;
+  std::size_t rows() const { return t_s.empty() && !values.empty() ? values.front().size() : t_s.size(); }
+  /// True when this read leaves t_s and loc empty (set, no time, and at least one channel).
+  bool bare(bool has_time) const { return bare_untimed && !has_time && !values.empty(); }
   void clear();
 };
 

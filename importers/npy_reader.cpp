@@ -221,12 +221,13 @@ bool NpyReader::read(ImuBlock& out, std::size_t max_rows) {
     out.values[c].resize(n);
     column(static_cast<std::size_t>(pick_[c]) * h_.item, n, scale_[c], out.values[c].data());
   }
+  next_ += rows;
+  if (out.bare(info_.has_time)) return true;
   out.t_s.resize(n);
   if (time_col_ >= 0) stamps(n, out.t_s.data());
   else std::fill(out.t_s.begin(), out.t_s.end(), kNaN);
   out.loc.resize(n);
-  for (std::size_t r = 0; r < n; ++r) out.loc[r] = next_ + r + 1;
-  next_ += rows;
+  for (std::size_t r = 0; r < n; ++r) out.loc[r] = next_ - rows + r + 1;
   return true;
 }
 

@@ -10,6 +10,11 @@
 #include <limits>
 #include <thread>
 
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <fast_float/fast_float.h>
 
 #include "importers/stamp_ns.hpp"
@@ -38,6 +43,14 @@ std::uint64_t estimate_rows(std::string_view head, std::uintmax_t file_bytes) {
   if (lines == 0 || head.empty()) return 0;
   const double bytes_per_line = static_cast<double>(head.size()) / static_cast<double>(lines);
   return static_cast<std::uint64_t>(static_cast<double>(file_bytes) / bytes_per_line) + 1;
+}
+
+void reserve_rows(ImuBlock& b, std::size_t rows, bool has_time) {
+  if (!b.bare(has_time)) {
+    b.t_s.reserve(rows);
+    b.loc.reserve(rows);
+  }
+  for (auto& v : b.values) v.reserve(rows);
 }
 
 // the rows of `from` behind those of `to`
@@ -94,10 +107,36 @@ TextReader::TextReader(const std::filesystem::path& path, const ImportOptions& o
   if (layout_.time_index >= 0) slot_[static_cast<std::size_t>(layout_.time_index)] = kTimeSlot;
   if (info_.has_time) set_epoch(head);
   std::rewind(file_);
+  if (map_file()) eof_ = true, len_ = map_bytes_;
 }
 
 TextReader::~TextReader() {
+  if (map_ != nullptr) ::munmap(const_cast<char*>(map_), map_bytes_);
   if (file_ != nullptr) std::fclose(file_);
+}
+
+// a regular file is parsed where the page cache holds it: no copy into a buffer, no refills
+bool TextReader::map_file() {
+  struct stat st {};
+  const int fd = ::fileno(file_);
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode) || st.st_size <= 0) return false;
+  const auto bytes = static_cast<std::size_t>(st.st_size);
+  void* p = ::mmap(nullptr, bytes, PROT_READ, MAP_PRIVATE, fd, 0);
+  if (p == MAP_FAILED) return false;
+  ::madvise(p, bytes, MADV_SEQUENTIAL);
+  map_ = static_cast<const char*>(p);
+  map_bytes_ = bytes;
+  return true;
+}
+
+void TextReader::release_parsed() {
+  constexpr std::size_t kReleaseBytes = 64u << 20;
+  if (map_ == nullptr || pos_ >= len_) return;  // (at the end the whole map goes at once)
+  const auto page = static_cast<std::size_t>(::sysconf(_SC_PAGESIZE));
+  const std::size_t upto = pos_ / page * page;
+  if (upto < released_ + kReleaseBytes) return;
+  ::madvise(const_cast<char*>(map_) + released_, upto - released_, MADV_DONTNEED);
+  released_ = upto;
 }
 
 std::string ImuReader::where(std::uint64_t loc) const { return info_.source + ":" + std::to_string(loc); }
@@ -126,7 +165,7 @@ void TextReader::refill() {
 
 bool TextReader::next_line(std::string_view& line) {
   for (;;) {
-    const char* base = buf_.get();
+    const char* base = data();
     const void* nl = pos_ < len_ ? std::memchr(base + pos_, '\n', len_ - pos_) : nullptr;
     if (nl != nullptr) {
       const std::size_t end = static_cast<std::size_t>(static_cast<const char*>(nl) - base);
@@ -191,7 +230,7 @@ void TextReader::parse_row(std::string_view line, std::uint64_t line_no, ImuBloc
   if (e > p && e[-1] == '\r') --e;
   std::size_t k = 0;
   double t = kNaN;
-  const std::size_t row = out.t_s.size();
+  const std::size_t row = out.rows();
   for (auto& v : out.values) v.push_back(kNaN);
   for (;;) {
     if (sep == ' ') {
@@ -225,6 +264,7 @@ void TextReader::parse_row(std::string_view line, std::uint64_t line_no, ImuBloc
     throw ImportError(where(line_no) + ": expected " + std::to_string(layout_.fields) + " fields as in line " +
                       std::to_string(layout_.data_line) + ", got " + std::to_string(k));
   }
+  if (out.bare(info_.has_time)) return;
   out.t_s.push_back(t);
   out.loc.push_back(line_no);
 }
@@ -237,50 +277,68 @@ void TextReader::take_line(std::string_view line, std::uint64_t line_no, ImuBloc
   parse_row(line, line_no, out);
 }
 
-void TextReader::parse_lines(const char* b, const char* e, std::uint64_t first_line, ImuBlock& out) const {
-  for (std::uint64_t no = first_line; b < e; ++no) {
+std::uint64_t TextReader::parse_lines(const char* b, const char* e, std::uint64_t first_line, ImuBlock& out) const {
+  std::uint64_t no = first_line;
+  for (; b < e; ++no) {
     const char* nl = static_cast<const char*>(std::memchr(b, '\n', static_cast<std::size_t>(e - b)));
     const char* end = nl == nullptr ? e : nl;
     take_line(std::string_view(b, static_cast<std::size_t>(end - b)), no, out);
     b = end + 1;
   }
+  return no - first_line;
 }
 
+// The second half is parsed before the first half's lines are counted: its lines are numbered
+// from the data line (it lies past the preamble, which is within the first 256 kB) and renumbered
+// after the join; on an error it is parsed again with the true numbers, so the message names the
+// right line.
 bool TextReader::parse_buffered_in_two(ImuBlock& out, std::size_t room) {
   constexpr std::size_t kMinBytes = 1u << 20;
   if (!eof_ && len_ - pos_ < kChunk / 2) refill();
-  // whole lines only, and no more lines than rows may still come (a line holds at most one row)
-  const char* b = buf_.get() + pos_;
+  const char* b = data() + pos_;
   const char* e = b + (len_ - pos_);
-  while (e > b && e[-1] != '\n') --e;
+  while (e > b && e[-1] != '\n') --e;  // whole lines only
   if (static_cast<std::size_t>(e - b) < kMinBytes) return false;
-  std::size_t lines = 0;
-  e = after_lines(b, e, room, lines);
-  if (static_cast<std::size_t>(e - b) < kMinBytes) return false;
+  // no more lines than rows may still come (a line holds at most one row, and at least one byte)
+  if (room < static_cast<std::size_t>(e - b)) {
+    std::size_t lines = 0;
+    e = after_lines(b, e, room, lines);
+    if (static_cast<std::size_t>(e - b) < kMinBytes) return false;
+  }
   const char* half = b + (e - b) / 2;
   const char* mid = static_cast<const char*>(std::memchr(half, '\n', static_cast<std::size_t>(e - half))) + 1;
-  const auto first_half_lines = static_cast<std::uint64_t>(std::count(b, mid, '\n'));
   side_.clear();
   side_.values.resize(out.values.size());
+  side_.bare_untimed = out.bare_untimed;
+  const std::size_t cap = out.values.empty() ? out.t_s.capacity() : out.values.front().capacity();
+  reserve_rows(side_, cap / 2 + cap / 16, info_.has_time);
   std::exception_ptr side_error;
+  std::uint64_t second_lines = 0;
   std::thread helper([&] {
     try {
-      parse_lines(mid, e, line_no_ + first_half_lines + 1, side_);
+      second_lines = parse_lines(mid, e, layout_.data_line, side_);
     } catch (...) {
       side_error = std::current_exception();
     }
   });
+  std::uint64_t first_lines = 0;
   try {
-    parse_lines(b, mid, line_no_ + 1, out);
+    first_lines = parse_lines(b, mid, line_no_ + 1, out);
   } catch (...) {
     helper.join();  // the earlier line's error is the one reported
     throw;
   }
   helper.join();
-  if (side_error) std::rethrow_exception(side_error);
+  const std::uint64_t second_first = line_no_ + first_lines + 1;
+  if (side_error) {
+    side_.clear();
+    parse_lines(mid, e, second_first, side_);  // throws the same error, numbered truly
+    std::rethrow_exception(side_error);
+  }
+  for (auto& l : side_.loc) l += second_first - layout_.data_line;
   append_block(out, side_);
   pos_ += static_cast<std::size_t>(e - b);
-  line_no_ += lines;
+  line_no_ += first_lines + second_lines;
   return true;
 }
 
@@ -288,15 +346,13 @@ bool TextReader::read(ImuBlock& out, std::size_t max_rows) {
   out.clear();
   out.values.resize(info_.channels.size());
   // the block's room at once (growing by doubling copies and faults in 2x the pages)
-  const std::size_t want = std::min<std::uint64_t>(max_rows, info_.rows_estimate + 1024);
-  out.t_s.reserve(want);
-  out.loc.reserve(want);
-  for (auto& v : out.values) v.reserve(want);
+  reserve_rows(out, std::min<std::uint64_t>(max_rows, info_.rows_estimate + 1024), info_.has_time);
   std::string_view line;
   while (out.rows() < max_rows && parse_buffered_in_two(out, max_rows - out.rows())) {
   }
   // what is left of the block (too little for two threads, or the file's end): line by line
   while (out.rows() < max_rows && next_line(line)) take_line(line, line_no_, out);
+  release_parsed();
   return out.rows() > 0;
 }
 

@@ -25,8 +25,14 @@ class TextReader : public ImuReader {
   static constexpr int kTimeSlot = -2;
   bool next_line(std::string_view& line);
   void refill();
-  /// Parses the whole lines of [b, e), the first being line `first_line`, into `out`.
-  void parse_lines(const char* b, const char* e, std::uint64_t first_line, ImuBlock& out) const;
+  /// Maps a regular file whole (read-only); false when it cannot be mapped (a pipe, an empty file).
+  bool map_file();
+  /// Gives back the mapped pages already parsed (the page cache keeps them; RSS stays bounded).
+  void release_parsed();
+  const char* data() const { return map_ != nullptr ? map_ : buf_.get(); }
+  /// Parses the whole lines of [b, e), the first being line `first_line`, into `out`; returns how
+  /// many lines it walked.
+  std::uint64_t parse_lines(const char* b, const char* e, std::uint64_t first_line, ImuBlock& out) const;
   /// One line: skipped (preamble, blank, comment) or parsed.
   void take_line(std::string_view line, std::uint64_t line_no, ImuBlock& out) const;
   void parse_row(std::string_view line, std::uint64_t line_no, ImuBlock& out) const;
@@ -42,6 +48,8 @@ class TextReader : public ImuReader {
   TextLayout layout_;
   std::vector<int> slot_;  // field -> channel, kTimeSlot, or -1 (not read)
   std::unique_ptr<char[]> buf_;  // not zero-filled: each chunk is read over it
+  const char* map_ = nullptr;    // the whole file when mapped (then buf_ is unused)
+  std::size_t map_bytes_ = 0, released_ = 0;
   std::size_t cap_ = 0, len_ = 0, pos_ = 0;
   std::uint64_t line_no_ = 0;
   bool eof_ = false;
