@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "estimator/allan_terms.hpp"
+#include "estimator/huge_pages.hpp"
 
 namespace driftless::est {
 namespace {
@@ -62,6 +63,7 @@ struct Phase {
 
 Phase phase_of(const double* r, std::size_t n, double mean) {
   Phase S{std::make_unique_for_overwrite<double[]>(n + 1), n + 1};
+  advise_huge_pages(S.v.get(), (n + 1) * sizeof(double));
   double acc = 0.0;
   S.v[0] = 0.0;
   for (std::size_t i = 0; i < n; ++i) S.v[i + 1] = acc += r[i] - mean;

@@ -1,5 +1,6 @@
 // Delimited text and EuRoC / TUM-VI imu0/data.csv: the layout from the first lines, then rows
-// streamed in 8 MB chunks, only the used fields parsed (fast_float).
+// parsed where the mapped file lies (a pipe: read in 8 MB chunks), only the used fields parsed
+// (fast_float).
 #include "importers/text_reader.hpp"
 
 #include <algorithm>
@@ -17,6 +18,7 @@
 
 #include <fast_float/fast_float.h>
 
+#include "estimator/huge_pages.hpp"
 #include "importers/stamp_ns.hpp"
 
 namespace driftless::importers {
@@ -37,6 +39,32 @@ bool parse_span(const char* b, const char* e, double& out) {
   return parse_field(std::string_view(b, static_cast<std::size_t>(e - b)), out);  // "nan" spellings
 }
 
+// the end of the field that starts at p (its separator, or e)
+const char* field_end(const char* p, const char* e, char sep) {
+  if (sep == ' ') {
+    while (p < e && *p != ' ' && *p != '\t') ++p;
+    return p;
+  }
+  const void* s = std::memchr(p, sep, static_cast<std::size_t>(e - p));
+  return s == nullptr ? e : static_cast<const char*>(s);
+}
+
+// a plain number field at p, parsed where it stands: its end is found from the number's own end
+// (no scan for the separator first). q: the field's end. False when the field is anything else
+// (empty, a nan spelling, trailing text): the caller then takes the general path, which gives the
+// same value for every field this one accepts.
+bool quick_value(const char* p, const char* e, char sep, const char*& q, double& v) {
+  const auto blank = [sep](char c) { return (c == ' ' || c == '\t') && c != sep; };
+  while (p < e && blank(*p)) ++p;
+  if (p < e && *p == '+') ++p;
+  const auto r = fast_float::from_chars(p, e, v);
+  if (r.ec != std::errc()) return false;
+  q = r.ptr;
+  if (sep == ' ') return q == e || *q == ' ' || *q == '\t';
+  while (q < e && blank(*q)) ++q;
+  return q == e || *q == sep;
+}
+
 // rows in the file if every line is as long as those of the first chunk
 std::uint64_t estimate_rows(std::string_view head, std::uintmax_t file_bytes) {
   const auto lines = static_cast<std::size_t>(std::count(head.begin(), head.end(), '\n'));
@@ -45,12 +73,18 @@ std::uint64_t estimate_rows(std::string_view head, std::uintmax_t file_bytes) {
   return static_cast<std::uint64_t>(static_cast<double>(file_bytes) / bytes_per_line) + 1;
 }
 
+// room for `rows` rows at once (growing by doubling copies and faults in 2x the pages), on huge pages
 void reserve_rows(ImuBlock& b, std::size_t rows, bool has_time) {
   if (!b.bare(has_time)) {
     b.t_s.reserve(rows);
     b.loc.reserve(rows);
+    est::advise_huge_pages(b.t_s);
+    est::advise_huge_pages(b.loc);
   }
-  for (auto& v : b.values) v.reserve(rows);
+  for (auto& v : b.values) {
+    v.reserve(rows);
+    est::advise_huge_pages(v);
+  }
 }
 
 // the rows of `from` behind those of `to`
@@ -229,7 +263,7 @@ void TextReader::parse_row(std::string_view line, std::uint64_t line_no, ImuBloc
   const char* e = p + line.size();
   if (e > p && e[-1] == '\r') --e;
   std::size_t k = 0;
-  double t = kNaN;
+  double t = kNaN, value = 0.0;
   const std::size_t row = out.rows();
   for (auto& v : out.values) v.push_back(kNaN);
   for (;;) {
@@ -237,24 +271,18 @@ void TextReader::parse_row(std::string_view line, std::uint64_t line_no, ImuBloc
       while (p < e && (*p == ' ' || *p == '\t')) ++p;
       if (p == e) break;
     }
+    const int slot = k < slot_.size() ? slot_[k] : -1;
     const char* q = p;
-    if (sep == ' ') {
-      while (q < e && *q != ' ' && *q != '\t') ++q;
+    if (slot >= 0 && quick_value(p, e, sep, q, value)) {
+      out.values[static_cast<std::size_t>(slot)][row] = value * layout_.picks[static_cast<std::size_t>(slot)].scale;
     } else {
-      const void* s = std::memchr(p, sep, static_cast<std::size_t>(e - p));
-      q = s == nullptr ? e : static_cast<const char*>(s);
-    }
-    if (k < slot_.size() && slot_[k] != -1) {
-      double v = 0.0;
-      const bool ok = slot_[k] == kTimeSlot ? stamp_s(p, q, t) : parse_span(p, q, v);
-      if (!ok) {
-        const std::string name = slot_[k] == kTimeSlot ? "time" : info_.channels[static_cast<std::size_t>(slot_[k])].name;
+      q = field_end(p, e, sep);
+      if (slot != -1 && !(slot == kTimeSlot ? stamp_s(p, q, t) : parse_span(p, q, value))) {
+        const std::string name = slot == kTimeSlot ? "time" : info_.channels[static_cast<std::size_t>(slot)].name;
         throw ImportError(where(line_no) + ": column '" + name + "' (" + std::to_string(k + 1) +
                           "): expected a number, got '" + std::string(p, q) + "'");
       }
-      if (slot_[k] != kTimeSlot) {
-        out.values[static_cast<std::size_t>(slot_[k])][row] = v * layout_.picks[static_cast<std::size_t>(slot_[k])].scale;
-      }
+      if (slot >= 0) out.values[static_cast<std::size_t>(slot)][row] = value * layout_.picks[static_cast<std::size_t>(slot)].scale;
     }
     ++k;
     if (q == e) break;
@@ -345,7 +373,6 @@ bool TextReader::parse_buffered_in_two(ImuBlock& out, std::size_t room) {
 bool TextReader::read(ImuBlock& out, std::size_t max_rows) {
   out.clear();
   out.values.resize(info_.channels.size());
-  // the block's room at once (growing by doubling copies and faults in 2x the pages)
   reserve_rows(out, std::min<std::uint64_t>(max_rows, info_.rows_estimate + 1024), info_.has_time);
   std::string_view line;
   while (out.rows() < max_rows && parse_buffered_in_two(out, max_rows - out.rows())) {

@@ -38,11 +38,14 @@ struct Table {
   std::vector<std::uint64_t> loc;
 };
 
-inline Table read_all(ImuReader& r, std::size_t block = 1000) {
+/// bare: ImuBlock::bare_untimed (an unstamped source then gives no t and no loc)
+inline Table read_all(ImuReader& r, std::size_t block = 1000, bool bare = false) {
   Table out;
   out.ch.resize(r.info().channels.size());
   ImuBlock b;
+  b.bare_untimed = bare;
   while (r.read(b, block)) {
+    EXPECT_EQ(b.rows(), b.values.empty() ? b.t_s.size() : b.values.front().size());
     out.t.insert(out.t.end(), b.t_s.begin(), b.t_s.end());
     out.loc.insert(out.loc.end(), b.loc.begin(), b.loc.end());
     for (std::size_t c = 0; c < out.ch.size(); ++c) out.ch[c].insert(out.ch[c].end(), b.values[c].begin(), b.values[c].end());

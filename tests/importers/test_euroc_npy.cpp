@@ -106,6 +106,15 @@ TEST(NpyImport, RealCountsAsDoublesAndAsInt16) {
     EXPECT_NEAR(tb.ch[2][i], t.ch[2][i], 1e-12);
   }
   EXPECT_EQ(tb.loc[4], 5u);
+  // and a caller that wants only the values of the unstamped array gets them without stamps or
+  // row numbers; the stamped one keeps its stamps
+  auto bare = open_imu(dir / "i2.npy", oc);
+  const Table tc = read_all(*bare, 1000, true);
+  EXPECT_TRUE(tc.t.empty());
+  EXPECT_TRUE(tc.loc.empty());
+  EXPECT_EQ(tc.ch, tb.ch);
+  auto stamped = open_imu(dir / "f8.npy", o);
+  EXPECT_EQ(read_all(*stamped, 1000, true).t, ta.t);
 }
 
 TEST(NpyImport, DamagedArraysAreRefusedWithTheRow) {

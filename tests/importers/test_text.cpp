@@ -186,6 +186,50 @@ TEST(TextImport, MissingValuesAreNaNAndBadRowsNameFileAndLine) {
 namespace driftless::importers::test {
 namespace {
 
+TEST(TextImport, FieldsParsedWhereTheyStandReadAsTheirSpelling) {
+  // GIVEN number spellings around separators: signs, blanks and tabs, exponents, a bare point,
+  // missing values, and the same values blank-separated (the reader parses a plain number where
+  // it stands and takes every other field the general way)
+  const auto dir = scratch("spellings");
+  const std::string rows = " +1.25 ;\t-2e-3\t;3.\nnan;;1.0E+2\n-0;7; 0.5\n";
+  std::string semi = "gx;gy;gz\n", blank = "gx gy gz\n";
+  for (int i = 0; i < 3; ++i) semi += rows;
+  for (int i = 0; i < 3; ++i) blank += " +1.25 \t-2e-3\t3.\nnan nan 1.0E+2\n-0  7 \t 0.5\n";
+  write_text(dir / "semi.csv", semi);
+  write_text(dir / "blank.txt", blank);
+  ImportOptions o;
+  o.units = "deg/s";
+  o.time_column = "none";
+  for (const char* name : {"semi.csv", "blank.txt"}) {
+    auto r = open_imu(dir / name, o);
+    const Table t = read_all(*r, 1000, true);
+    // THEN each value is its spelling's, missing ones NaN; an unstamped bare read has no t or loc
+    ASSERT_EQ(t.ch.size(), 3u) << name;
+    ASSERT_EQ(t.ch[0].size(), 9u) << name;
+    EXPECT_TRUE(t.t.empty() && t.loc.empty()) << name;
+    for (std::size_t k = 0; k < 9; k += 3) {
+      EXPECT_EQ(t.ch[0][k], 1.25) << name;
+      EXPECT_EQ(t.ch[1][k], -2e-3) << name;
+      EXPECT_EQ(t.ch[2][k], 3.0) << name;
+      EXPECT_TRUE(std::isnan(t.ch[0][k + 1]) && std::isnan(t.ch[1][k + 1])) << name;
+      EXPECT_EQ(t.ch[2][k + 1], 100.0) << name;
+      EXPECT_TRUE(t.ch[0][k + 2] == 0.0 && std::signbit(t.ch[0][k + 2])) << name;
+      EXPECT_EQ(t.ch[1][k + 2], 7.0) << name;
+      EXPECT_EQ(t.ch[2][k + 2], 0.5) << name;
+    }
+  }
+  // and a number followed by text in its field is refused, naming it
+  write_text(dir / "trail.csv", "gx;gy;gz\n1;2;3\n1;2;3\n1;2;3\n1;2;3\n1;2;3\n1;2;3\n1;2.5x;3\n");
+  try {
+    auto r = open_imu(dir / "trail.csv", o);
+    read_all(*r);
+    FAIL() << "2.5x accepted";
+  } catch (const ImportError& e) {
+    EXPECT_NE(std::string(e.what()).find("trail.csv:8: column 'gy' (2): expected a number, got '2.5x'"), std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(TextImport, LongFilesParsedOnTwoThreadsGiveTheSameRowsAndLineNumbers) {
   // GIVEN a 3 MB file (the reader parses whole buffered stretches of 1 MB and more on two threads)
   const auto dir = scratch("two_threads");
