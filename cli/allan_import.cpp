@@ -91,8 +91,9 @@ bool all_finite(const std::vector<double>& v) {
 
 }  // namespace
 
-// The whole record is asked for as one block: a gap-free channel with no missing value is then
-// taken over as it is (no copy of its 40 MB at 5 M samples).
+// A text record is asked for as one block: a gap-free channel with no missing value is then taken
+// over as it is (no copy of its 40 MB at 5 M samples). Binary readers stage each block's raw rows
+// (.npy: the file's bytes; bags: the messages), so they keep blocks of 2^20 rows.
 Loaded load_imported(const InputArgs& a) {
   auto reader = importers::open_imu(a.source(), a.import_options());
   Loaded out = start_meta(*reader);
@@ -104,17 +105,21 @@ Loaded load_imported(const InputArgs& a) {
   std::size_t nan_rows = 0;
   std::vector<bool> pending(out.channels.size(), false);
   const std::size_t estimate = reader->info().rows_estimate + reader->info().rows_estimate / 16;
-  while (reader->read(b, std::max(kBlockRows, estimate))) {
+  const auto format = reader->info().format;
+  const bool whole = format == importers::Format::kText || format == importers::Format::kEuroc;
+  while (reader->read(b, whole ? std::max(kBlockRows, estimate) : kBlockRows)) {
     if (first && reader->info().has_time) mon.learn(b.t_s);
     const auto gaps = gap_rows(b, mon, reader->info().has_time, a.gaps_ignore);
     for (std::size_t c = 0; c < map.size(); ++c) {
       if (map[c] < 0) continue;
       Channel& ch = out.channels[static_cast<std::size_t>(map[c])];
-      if (first && gaps.empty() && all_finite(b.values[c])) {
+      if (first && whole && gaps.empty() && all_finite(b.values[c])) {
         ch.x = std::move(b.values[c]);
         continue;
       }
-      if (ch.x.capacity() == 0) ch.x.reserve(estimate);  // one allocation (growing by doubling costs more than parsing)
+      // room at once (growing by doubling copies and faults in the pages again), geometric beyond the estimate
+      const std::size_t need = ch.x.size() + b.rows();
+      if (ch.x.capacity() < need) ch.x.reserve(std::max({estimate, need, ch.x.size() + ch.x.size() / 2}));
       bool brk = pending[static_cast<std::size_t>(map[c])];
       append_channel(ch, b.values[c], gaps, brk, a.gaps_ignore, nan_rows);
       pending[static_cast<std::size_t>(map[c])] = brk;
