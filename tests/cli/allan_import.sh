@@ -50,6 +50,9 @@ PY
 "$bin" allan --in "$t/imu.npy" --time-column 1 --out "$t/npy" > "$t/npy.txt"
 jq -e '.format == "npy"' "$t/npy/allan_fit.json" > /dev/null || fail "npy"
 same "$(n_of "$t/npy" col2)" "$(n_of "$t/ref" gyro_x)" 1e-6 || fail "streamed N differs from the in-memory one"
+# and read into memory (--exact): the same doubles as the log's, so the same N
+"$bin" allan --in "$t/imu.npy" --time-column 1 --exact --out "$t/npyx" > /dev/null
+same "$(n_of "$t/npyx" col2)" "$(n_of "$t/ref" gyro_x)" 1e-12 || fail "npy read into memory: N differs from the log's"
 
 # explicit taus, three deviations, the round trip, plots
 "$bin" allan --in "$real" --columns gyro_x --taus 1,10,100,1000,3000 --dev adev,mdev,hdev --validate 3 --plot \
