@@ -308,9 +308,10 @@ est::Calibration CalibFile::to_filter_calibration() const {
   return cal;
 }
 
-CalibFile load_calib(const std::filesystem::path& path) {
-  const std::string file = path.string();
-  const fields::Node root = twin::load_yaml_file(path);
+CalibFile load_calib(const std::filesystem::path& path) { return parse_calib(twin::read_yaml_text(path), path.string()); }
+
+CalibFile parse_calib(const std::string& yaml_text, const std::string& file) {
+  const fields::Node root = twin::parse_yaml(yaml_text, file);
   if (!root.is_map()) throw InputError(file, root.line, "", "not a calibration file (expected a YAML map)");
   const fields::Context ctx{file, ""};
   CalibDoc doc;
