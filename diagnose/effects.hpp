@@ -41,7 +41,10 @@ struct EffectInfo {
 };
 const EffectInfo& effect_info(Effect e);
 inline const char* effect_id(Effect e) { return effect_info(e).id; }
+/// The family in text and HTML: "physical", "box", "signal chain", "ADC", "noise model".
 const char* family_name(Family f);
+/// The family in diagnosis.json: physical|box|signal_chain|adc|noise_model.
+const char* family_id(Family f);
 
 /// Which model value a fitted parameter is (the field --apply writes).
 enum class Param : std::uint8_t {
