@@ -26,6 +26,7 @@ const char* cause_key(est::HealthCause c) {
     case est::HealthCause::kLoneRejection: return "lone_rejection";
     case est::HealthCause::kUnobservable: return "unobservable";
     case est::HealthCause::kRelocks: return "relocks";
+    case est::HealthCause::kLateLock: return "late_lock";
   }
   return "?";
 }
@@ -89,8 +90,12 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
                          100.0 * f.value, position_text(f.positions_deg));
     case est::HealthCause::kRejections:
       return fmt::format("{:.1f} % of the updates were rejected by the NIS gate: noise or bias wander "
-                         "larger than configured, or a model that does not fit; use --tune auto",
-                         100.0 * f.value);
+                         "larger than configured (use --tune auto), or a model that does not fit{}",
+                         100.0 * f.value,
+                         cfg.self_calibration ? std::string()
+                                              : " (an uncalibrated MEMS gyro on a moving box: g-sensitivity, scale "
+                                                "and misalignment; estimate them with --selfcal, or calibrate with "
+                                                "'driftless calibrate' and pass --calib)");
     case est::HealthCause::kLoneRejection:
       return fmt::format("one update rejected by the NIS gate (t = {:.2f} s, NIS {:.3g}): a lone outlier, "
                          "which the gate is there to remove; the estimate is unaffected. Repeated rejections "
@@ -104,6 +109,11 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
       return fmt::format("the filter lost lock and re-locked {:g} time(s) (see relocks): a bias jump, a new "
                          "sensor, or a model that does not fit; check the log around those times",
                          f.value);
+    case est::HealthCause::kLateLock:
+      return fmt::format("locked only at t = {:.1f} s, with {:g} accepted update(s) after it: too few to check "
+                         "the NIS against its band or to compare the attitude; record a longer log or more "
+                         "flips after the lock",
+                         f.value, f.suggested);
   }
   return "?";
 }

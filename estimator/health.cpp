@@ -125,6 +125,13 @@ void HealthMonitor::add_lock_findings(HealthReport& h, const DriftlessFilter& fi
     add(h, f);
     return;
   }
+  if (h.nis_updates < limits_.min_updates_after_lock) {
+    HealthFinding f;
+    f.cause = HealthCause::kLateLock;
+    f.value = h.lock_t_s;
+    f.suggested = double(h.nis_updates);
+    add(h, f);
+  }
   if (!h.unobservable.empty()) {
     HealthFinding f;
     f.cause = HealthCause::kUnobservable;

@@ -33,6 +33,7 @@ enum class HealthCause {
   kLoneRejection,        // at most HealthLimits::lone_rejections rejected: outliers the gate is for (a note)
   kUnobservable,         // some bias components kept (most of) their prior sigma
   kRelocks,              // the gate lost lock and re-locked
+  kLateLock,             // locked, but too few accepted updates after the lock to check the NIS
 };
 
 /// One check that did not pass, with the numbers that describe() turns into text.
@@ -42,7 +43,8 @@ struct HealthFinding {
   double value = kNaN;        // the measured quantity (fraction, NIS mean, ...; kLoneRejection: its NIS)
   double suggested = kNaN;    // kNoiseUnder/Overstated: nis_mean / dof, the factor by which the
                               // innovation variance exceeds (or falls short of) what S predicts;
-                              // kNeverLocked: the rejected fraction; kLoneRejection: its time, s
+                              // kNeverLocked: the rejected fraction; kLoneRejection: its time, s;
+                              // kLateLock: the accepted updates after the lock (value: lock time, s)
   // kRejectionsAtPosition: the (plat1, plat2) angle pairs (deg) where most updates were rejected
   std::vector<std::array<double, 2>> positions_deg;
   std::vector<int> components;  // kUnobservable: 0..5 = b1_x .. b2_z
@@ -63,6 +65,10 @@ struct HealthLimits {
                                             // when the others together reject under a quarter
                                             // as often
   double unobservable_ratio = 0.5;     // final sigma / prior sigma above this = unobservable
+  // fewer accepted updates than this after the lock: the NIS mean is not checked (its band is
+  // as wide as the chi-square of a few dof) and the attitude comparison has almost nothing to
+  // compare: degraded, not ok (a log that locks at its last update said "ok" with NIS "nan")
+  std::uint64_t min_updates_after_lock = 3;
 };
 
 /// The health block of summary.json.

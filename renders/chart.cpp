@@ -1,6 +1,5 @@
 #include "renders/chart.hpp"
 
-#include <GL/gl.h>
 
 #include <algorithm>
 #include <cmath>
@@ -10,6 +9,7 @@
 #include <fmt/core.h>
 
 #include "estimator/sample.hpp"
+#include "renders/gl_api.hpp"
 
 namespace driftless::render {
 
@@ -132,41 +132,41 @@ constexpr float kDim[3] = {0.7f, 0.72f, 0.75f};
 
 // pixel coordinates, origin bottom left, for everything drawn after it
 void begin_2d(int w, int h) {
-  glViewport(0, 0, w, h);
-  glMatrixMode(GL_PROJECTION);
-  glLoadIdentity();
-  glOrtho(0, w, 0, h, -1, 1);
-  glMatrixMode(GL_MODELVIEW);
-  glLoadIdentity();
-  glDisable(GL_DEPTH_TEST);
-  glDisable(GL_LIGHTING);
-  glDisable(GL_TEXTURE_2D);
-  glDisable(GL_CULL_FACE);
-  glEnable(GL_BLEND);
-  glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+  gl_api().Viewport(0, 0, w, h);
+  gl_api().MatrixMode(GL_PROJECTION);
+  gl_api().LoadIdentity();
+  gl_api().Ortho(0, w, 0, h, -1, 1);
+  gl_api().MatrixMode(GL_MODELVIEW);
+  gl_api().LoadIdentity();
+  gl_api().Disable(GL_DEPTH_TEST);
+  gl_api().Disable(GL_LIGHTING);
+  gl_api().Disable(GL_TEXTURE_2D);
+  gl_api().Disable(GL_CULL_FACE);
+  gl_api().Enable(GL_BLEND);
+  gl_api().BlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
 }
 
 // text with its baseline at pixel (x, y); mjr_text works in relative coordinates
 void text_at(const std::string& s, int x, int y, const float rgb[3], const mjrContext& con, int w, int h) {
-  glViewport(0, 0, w, h);
+  gl_api().Viewport(0, 0, w, h);
   mjr_text(mjFONT_NORMAL, s.c_str(), &con, static_cast<float>(x) / w, static_cast<float>(y) / h, rgb[0], rgb[1],
            rgb[2]);
   begin_2d(w, h);
 }
 
 void line_sample(int x, int y, int len, const float rgb[3], bool dashed) {
-  glLineWidth(2.0f);
+  gl_api().LineWidth(2.0f);
   if (dashed) {
-    glEnable(GL_LINE_STIPPLE);
-    glLineStipple(2, 0x0F0F);
+    gl_api().Enable(GL_LINE_STIPPLE);
+    gl_api().LineStipple(2, 0x0F0F);
   }
   const float k = dashed ? kReferenceLighten : 0.0f;
-  glColor4f(rgb[0] + k * (1 - rgb[0]), rgb[1] + k * (1 - rgb[1]), rgb[2] + k * (1 - rgb[2]), 1.0f);
-  glBegin(GL_LINES);
-  glVertex2f(static_cast<float>(x), static_cast<float>(y));
-  glVertex2f(static_cast<float>(x + len), static_cast<float>(y));
-  glEnd();
-  glDisable(GL_LINE_STIPPLE);
+  gl_api().Color4f(rgb[0] + k * (1 - rgb[0]), rgb[1] + k * (1 - rgb[1]), rgb[2] + k * (1 - rgb[2]), 1.0f);
+  gl_api().Begin(GL_LINES);
+  gl_api().Vertex2f(static_cast<float>(x), static_cast<float>(y));
+  gl_api().Vertex2f(static_cast<float>(x + len), static_cast<float>(y));
+  gl_api().End();
+  gl_api().Disable(GL_LINE_STIPPLE);
 }
 
 
@@ -192,18 +192,18 @@ struct PlotArea {
 };
 
 void draw_axes(const PlotArea& a, const Ticks& xt, const mjrContext& con, int w, int h) {
-  glLineWidth(1.0f);
-  glColor4f(1.0f, 1.0f, 1.0f, 0.18f);
-  glBegin(GL_LINES);
+  gl_api().LineWidth(1.0f);
+  gl_api().Color4f(1.0f, 1.0f, 1.0f, 0.18f);
+  gl_api().Begin(GL_LINES);
   for (double v : a.y.ticks.values) {
-    glVertex2f(static_cast<float>(a.px.left), a.to_y(v));
-    glVertex2f(static_cast<float>(a.px.left + a.px.width), a.to_y(v));
+    gl_api().Vertex2f(static_cast<float>(a.px.left), a.to_y(v));
+    gl_api().Vertex2f(static_cast<float>(a.px.left + a.px.width), a.to_y(v));
   }
   for (double t : xt.values) {
-    glVertex2f(a.to_x(t), static_cast<float>(a.px.bottom));
-    glVertex2f(a.to_x(t), static_cast<float>(a.px.bottom + a.px.height));
+    gl_api().Vertex2f(a.to_x(t), static_cast<float>(a.px.bottom));
+    gl_api().Vertex2f(a.to_x(t), static_cast<float>(a.px.bottom + a.px.height));
   }
-  glEnd();
+  gl_api().End();
   const int ch = con.charHeight;
   for (double v : a.y.ticks.values) {
     const std::string s = fmt::format("{:.{}f}", v, a.y.ticks.decimals);
@@ -218,28 +218,28 @@ void draw_axes(const PlotArea& a, const Ticks& xt, const mjrContext& con, int w,
 }
 
 void draw_lines(const StripChart& chart, const PlotArea& a, double t_now_s) {
-  glEnable(GL_SCISSOR_TEST);
-  glScissor(a.px.left, a.px.bottom, a.px.width + 1, a.px.height + 1);
+  gl_api().Enable(GL_SCISSOR_TEST);
+  gl_api().Scissor(a.px.left, a.px.bottom, a.px.width + 1, a.px.height + 1);
   // reference lines last, dashed and lighter, so both show where they agree
   for (int pass = 0; pass < 2; ++pass) {
     for (std::size_t i = 0; i < chart.lines().size(); ++i) {
       const auto& line = chart.lines()[i];
       if (line.dashed != (pass == 1)) continue;
       if (line.dashed) {
-        glEnable(GL_LINE_STIPPLE);
-        glLineStipple(2, 0x0F0F);
+        gl_api().Enable(GL_LINE_STIPPLE);
+        gl_api().LineStipple(2, 0x0F0F);
       }
-      glLineWidth(line.dashed ? 1.5f : 2.0f);
+      gl_api().LineWidth(line.dashed ? 1.5f : 2.0f);
       const float k = line.dashed ? kReferenceLighten : 0.0f;
-      glColor4f(line.rgb[0] + k * (1 - line.rgb[0]), line.rgb[1] + k * (1 - line.rgb[1]),
+      gl_api().Color4f(line.rgb[0] + k * (1 - line.rgb[0]), line.rgb[1] + k * (1 - line.rgb[1]),
                 line.rgb[2] + k * (1 - line.rgb[2]), 1.0f);
-      glBegin(GL_LINE_STRIP);
-      for (const auto& [t, v] : chart.points(i, t_now_s)) glVertex2f(a.to_x(t), a.to_y(v));
-      glEnd();
-      glDisable(GL_LINE_STIPPLE);
+      gl_api().Begin(GL_LINE_STRIP);
+      for (const auto& [t, v] : chart.points(i, t_now_s)) gl_api().Vertex2f(a.to_x(t), a.to_y(v));
+      gl_api().End();
+      gl_api().Disable(GL_LINE_STIPPLE);
     }
   }
-  glDisable(GL_SCISSOR_TEST);
+  gl_api().Disable(GL_SCISSOR_TEST);
 }
 
 // as many round time ticks as their labels leave room for
@@ -271,13 +271,13 @@ std::pair<double, double> data_range(const StripChart& chart, double t_now_s, do
 
 void fill_rect(const PixelRect& r, float red, float green, float blue, float alpha, int w, int h) {
   begin_2d(w, h);
-  glColor4f(red, green, blue, alpha);
-  glBegin(GL_QUADS);
-  glVertex2f(static_cast<float>(r.left), static_cast<float>(r.bottom));
-  glVertex2f(static_cast<float>(r.left + r.width), static_cast<float>(r.bottom));
-  glVertex2f(static_cast<float>(r.left + r.width), static_cast<float>(r.bottom + r.height));
-  glVertex2f(static_cast<float>(r.left), static_cast<float>(r.bottom + r.height));
-  glEnd();
+  gl_api().Color4f(red, green, blue, alpha);
+  gl_api().Begin(GL_QUADS);
+  gl_api().Vertex2f(static_cast<float>(r.left), static_cast<float>(r.bottom));
+  gl_api().Vertex2f(static_cast<float>(r.left + r.width), static_cast<float>(r.bottom));
+  gl_api().Vertex2f(static_cast<float>(r.left + r.width), static_cast<float>(r.bottom + r.height));
+  gl_api().Vertex2f(static_cast<float>(r.left), static_cast<float>(r.bottom + r.height));
+  gl_api().End();
 }
 
 void draw_chart(const StripChart& chart, const PixelRect& r, double t_now_s, const mjrContext& con, int w, int h) {

@@ -4,7 +4,7 @@
 #include <cstring>
 #include <vector>
 
-#include <GL/osmesa.h>
+#include "renders/gl_api.hpp"
 
 namespace driftless::render {
 
@@ -20,26 +20,27 @@ GlContext::GlContext() : impl_(std::make_unique<Impl>()) {
     throw GlUnavailable(std::string("no OpenGL context: disabled by ") + kNoGlEnv + "=" + no_gl +
                         " (unset it to render)");
   }
+  const GlApi& api = gl_api();
   // 24-bit depth and 8-bit stencil, as MuJoCo's renderer expects
-  impl_->ctx = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, nullptr);
+  impl_->ctx = api.CreateContextExt(OSMESA_RGBA, 24, 8, 0, nullptr);
   if (impl_->ctx == nullptr) {
     throw GlUnavailable(
-        "no OpenGL context: OSMesaCreateContextExt failed (is Mesa's libOSMesa installed? "
-        "Debian: libosmesa6)");
+        "no OpenGL context: OSMesaCreateContextExt refused an RGBA context with 24-bit depth "
+        "and 8-bit stencil (libOSMesa loaded; is it Mesa's, with the gallium llvmpipe driver?)");
   }
-  if (!OSMesaMakeCurrent(impl_->ctx, impl_->window_rgba.data(), GL_UNSIGNED_BYTE, 64, 64)) {
-    OSMesaDestroyContext(impl_->ctx);
+  if (!api.MakeCurrent(impl_->ctx, impl_->window_rgba.data(), GL_UNSIGNED_BYTE, 64, 64)) {
+    api.DestroyContext(impl_->ctx);
     impl_->ctx = nullptr;
     throw GlUnavailable("no OpenGL context: OSMesaMakeCurrent failed");
   }
 }
 
 GlContext::~GlContext() {
-  if (impl_ && impl_->ctx != nullptr) OSMesaDestroyContext(impl_->ctx);
+  if (impl_ && impl_->ctx != nullptr) gl_api().DestroyContext(impl_->ctx);
 }
 
 std::string GlContext::renderer() const {
-  const auto* s = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+  const auto* s = reinterpret_cast<const char*>(gl_api().GetString(GL_RENDERER));
   return s != nullptr ? std::string(s) : std::string("unknown");
 }
 

@@ -90,4 +90,12 @@ grep -q "cam_fixed" "$work/err.txt" || fail "bad camera message: $(cat "$work/er
 n=$(ffprobe -v error -count_frames -select_streams v:0 -show_entries stream=nb_read_frames \
     -of default=nw=1:nk=1 "$work/s.mp4")
 [ "$n" = 10 ] || fail "scenario render: $n frames (want 10)"
+
+# 6. only `render` maps the GL stack: the program does not need libOSMesa (and its libLLVM) at
+#    start-up; renders/gl_api.cpp loads it when a context is made (step 5 proved that works)
+if command -v readelf > /dev/null; then
+  if readelf -d "$bin" | grep -E "NEEDED.*(libOSMesa|libLLVM|libGL)" > "$work/needed.txt"; then
+    fail "driftless links the GL stack at start-up: $(cat "$work/needed.txt")"
+  fi
+fi
 echo "render: ok"

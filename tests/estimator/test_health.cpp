@@ -278,5 +278,29 @@ TEST(HealthTest, ANisMeanAboveThe95BandIsANoteUntilThe999Band) {
   EXPECT_TRUE(has(bad, HealthCause::kNoiseUnderstated));
 }
 
+TEST(HealthTest, ALockAtTheEndOfTheLogIsDegradedNotOk) {
+  // GIVEN the healthy log of AHealthyLogIsOk, and the same log cut half a standstill after its lock
+  auto p = mpu_like(11);
+  p.gm_sigma_dps = 0.0;
+  EstimatorConfig cfg;
+  cfg.q_override_dps2_per_s = 1e-14;
+  const HealthReport full = run_synth(p, "late_lock_full.csv", cfg).health;
+  ASSERT_TRUE(full.locked);
+  EXPECT_FALSE(has(full, HealthCause::kLateLock)) << causes(full);
+  p.duration_s = full.lock_t_s + 0.5 * p.standstill_s;
+  const HealthReport cut = run_synth(p, "late_lock_cut.csv", cfg).health;
+  // THEN the cut log locks at the same update, but with fewer than 3 accepted updates after it the
+  // NIS cannot be checked: degraded with the late lock named, never "ok" with a NIS mean of nan
+  EXPECT_TRUE(cut.locked);
+  EXPECT_DOUBLE_EQ(cut.lock_t_s, full.lock_t_s);
+  EXPECT_LT(cut.nis_updates, HealthLimits{}.min_updates_after_lock);
+  EXPECT_EQ(cut.verdict, HealthVerdict::kDegraded) << causes(cut);
+  ASSERT_TRUE(has(cut, HealthCause::kLateLock)) << causes(cut);
+  const auto late = std::find_if(cut.findings.begin(), cut.findings.end(),
+                                 [](const HealthFinding& f) { return f.cause == HealthCause::kLateLock; });
+  EXPECT_DOUBLE_EQ(late->value, cut.lock_t_s);
+  EXPECT_DOUBLE_EQ(late->suggested, double(cut.nis_updates));
+}
+
 }  // namespace
 }  // namespace driftless::est
