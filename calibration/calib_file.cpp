@@ -1,192 +1,300 @@
-// calib.yaml writer and reader.
+// calib.yaml writer and reader: one table per block drives parse, allowed keys and emit
+// (estimator/fields.hpp); the two writers (calibrate, estimate --selfcal) fill the same document.
 #include "calibration/calib_file.hpp"
 
 #include <cmath>
-#include <fstream>
 #include <stdexcept>
 
-#include <yaml-cpp/yaml.h>
-
-#include "calibration/yaml_io.hpp"
 #include "estimator/geometry.hpp"
 #include "estimator/output_file.hpp"
+#include "twin/yaml_doc.hpp"
 
 namespace driftless::calib {
 namespace {
 
-constexpr const char* kPosKey[2] = {"minus90", "plus90"};
-constexpr const char* kSensorKey[2] = {"sensor1", "sensor2"};
+using fields::Table;
+using Vec3 = Eigen::Vector3d;
+using Mat3 = Eigen::Matrix3d;
 
-void emit_num_or_null(YAML::Emitter& out, double v) {
-  if (std::isfinite(v)) out << yio::num(v);
-  else out << YAML::Null;
+// ---- the document: what the file holds, block by block ----
+
+// rig.segments[k]: a plan segment's span and axis, and the plateau samples it gave
+struct SpanRecord {
+  PlanSegment seg;
+  bool has_samples = false;
+  std::size_t samples_used = 0;
+};
+
+struct RigBlock {
+  std::string source;
+  double latitude_deg = kNaN;    // deg, null when unknown
+  double sample_rate_hz = kNaN;  // Hz, null when unknown
+  bool has_conditions = false;   // the keys below (calibrate writes them; a self-calibration not)
+  bool earth_rate_removed = false;
+  double gyro_full_scale_dps = 250.0;
+  std::array<double, 2> mean_temp_degc{kNaN, kNaN};
+  std::vector<SpanRecord> segments;
+};
+
+// sensorN.minus90 / plus90: M, and with a fit its sigma, inverse, residuals and biases
+struct PositionBlock {
+  est::SensorPositionFit fit;
+  bool has_fit = false;
+};
+
+struct GBlock {
+  Mat3 G_dps_per_g = Mat3::Zero();
+  Mat3 G_sigma = Mat3::Zero();       // deg/s per g, 1-sigma
+  bool has_fit = false;              // b0, residual, segments (the rig's fit)
+  Vec3 b0_dps = Vec3::Zero();
+  bool has_tc = false;
+  Vec3 bias_tc_dps_per_degc = Vec3::Zero();
+  Vec3 residual_rms_dps = Vec3::Zero();
+  std::size_t segments = 0;
+};
+
+struct TempBlock {
+  Vec3 tc_dps_per_degc = Vec3::Zero();
+  Vec3 tc_sigma_dps_per_degc = Vec3::Zero();
+  double final_temp_degc = kNaN;
+};
+
+struct SensorBlock {
+  std::array<PositionBlock, 2> pos;  // [minus90, plus90]
+  bool has_errors = false;
+  est::CalibErrors errors;           // informational; readers ignore it
+  bool has_g = false;
+  GBlock g;
+  bool has_temp = false;
+  TempBlock temp;
+};
+
+enum class Matrices { kCalibrated, kNominal };
+
+struct CalibDoc {
+  std::string format = kCalibFormat;
+  std::string method = "unknown";
+  bool has_matrices = false;
+  Matrices matrices = Matrices::kCalibrated;
+  Vec3 hinge1_axis = Vec3::UnitZ();
+  Vec3 hinge2_axis = Vec3::UnitX();
+  RigBlock rig;
+  std::array<SensorBlock, 2> sensor;
+};
+
+// ---- the tables ----
+
+const Table<SpanRecord>& span_table() {
+  using S = SpanRecord;
+  static const Table<S> t = [] {
+    Table<S> rows = {fields::text<S>("name", [](auto& r) -> auto& { return r.seg.name; }),
+                     fields::vector<S>("axis_box", "", [](auto& r) -> auto& { return r.seg.axis_box; })};
+    append_span_rows(rows, &S::seg);
+    rows.push_back(fields::optional_row(fields::integer<S>("samples_used", &S::samples_used, 0, INT64_MAX),
+                                        &S::has_samples));
+    return rows;
+  }();
+  return t;
 }
 
-
-// the hinge axes both writers put after format/method
-void emit_hinge_axes(YAML::Emitter& out, const Eigen::Vector3d& hinge1, const Eigen::Vector3d& hinge2) {
-  out << YAML::Key << "hinge1_axis" << YAML::Value;
-  yio::emit_vec3(out, hinge1);
-  out << YAML::Key << "hinge2_axis" << YAML::Value;
-  yio::emit_vec3(out, hinge2);
+// [sensor 1, sensor 2] in degC, null where a sensor has no temperature
+fields::Row<RigBlock> mean_temp_row() {
+  return fields::custom<RigBlock>(
+      "mean_temp", "degc",
+      [](RigBlock& b, const fields::Node& n, const fields::Reading& r) {
+        if (!n.is_list() || n.items.size() != 2) r.fail(n, "expected [sensor 1, sensor 2] in degC (null: unknown)");
+        for (std::size_t i = 0; i < 2; ++i)
+          b.mean_temp_degc[i] = n.items[i].is_null() ? kNaN : fields::read_number(n.items[i], r);
+      },
+      [](const RigBlock& b) -> std::optional<fields::Node> {
+        std::vector<fields::Node> xs;
+        for (double v : b.mean_temp_degc) xs.push_back(std::isfinite(v) ? fields::Node::scalar(exact_number(v)) : fields::Node{});
+        return fields::Node::list(std::move(xs));
+      });
 }
 
-// the first keys of the rig block: where the data came from
-void emit_rig_origin(YAML::Emitter& out, const std::string& source, double latitude_deg, double sample_rate_hz) {
-  out << YAML::Key << "source" << YAML::Value << source;
-  out << YAML::Key << "latitude_deg" << YAML::Value;
-  emit_num_or_null(out, latitude_deg);
-  out << YAML::Key << "sample_rate_hz" << YAML::Value;
-  emit_num_or_null(out, sample_rate_hz);
+const Table<RigBlock>& rig_table() {
+  using R = RigBlock;
+  static const Table<R> t = [] {
+    Table<R> rows = {fields::text<R>("source", &R::source),
+                     fields::number_or_null<R>("latitude", "deg", &R::latitude_deg),
+                     fields::number_or_null<R>("sample_rate", "hz", &R::sample_rate_hz)};
+    for (auto row : {fields::flag<R>("earth_rate_removed", &R::earth_rate_removed),
+                     fields::number<R>("gyro_full_scale", "dps", &R::gyro_full_scale_dps), mean_temp_row(),
+                     fields::block_list<R>("segments", &R::segments, &span_table)})
+      rows.push_back(fields::optional_row(row, &R::has_conditions));
+    return rows;
+  }();
+  return t;
 }
+
+const Table<est::SegmentBias>& bias_table() {
+  using B = est::SegmentBias;
+  static const Table<B> t = {fields::text<B>("segment", &B::segment), fields::vector<B>("value", "", &B::bias_dps),
+                             fields::vector<B>("sigma", "", &B::sigma_dps)};
+  return t;
+}
+
+const Table<PositionBlock>& position_table() {
+  using P = PositionBlock;
+  static const Table<P> t = [] {
+    Table<P> rows = {fields::matrix3<P>("M", "", [](auto& p) -> auto& { return p.fit.M; }, false)};
+    const auto fit = [](fields::Row<P> row) { return fields::optional_row(std::move(row), &P::has_fit); };
+    rows.push_back(fit(fields::matrix3<P>("M_sigma", "", [](auto& p) -> auto& { return p.fit.M_sigma; }, false)));
+    rows.push_back(fit(fields::matrix3<P>("M_inv", "", [](auto& p) -> auto& { return p.fit.M_inv; }, false)));
+    rows.push_back(fit(fields::matrix3<P>("M_inv_sigma", "", [](auto& p) -> auto& { return p.fit.M_inv_sigma; }, false)));
+    rows.push_back(fit(fields::vector<P>("residual_rms", "dps", [](auto& p) -> auto& { return p.fit.residual_rms_dps; })));
+    rows.push_back(fit(fields::vector<P>("residual_max", "dps", [](auto& p) -> auto& { return p.fit.residual_max_dps; })));
+    rows.push_back(fit(fields::integer<P>("samples", [](auto& p) -> auto& { return p.fit.n_samples; }, 0, INT64_MAX)));
+    // bias_dps: every value and sigma in the list is in deg/s (a whole key: the list takes no other unit)
+    rows.push_back(fit(fields::block_list<P>("bias_dps", [](auto& p) -> auto& { return p.fit.biases; }, &bias_table)));
+    return rows;
+  }();
+  return t;
+}
+
+const Table<est::CalibErrors>& errors_table() {
+  using E = est::CalibErrors;
+  static const Table<E> t = {
+      fields::vector<E>("scale_error", "pct", [](auto& e) -> auto& { return e.scale_error; }),
+      fields::vector<E>("nonorthogonality", "deg", &E::nonorthogonality_deg),
+      fields::vector<E>("tilt_minus90", "deg", [](auto& e) -> auto& { return e.tilt_box_deg[0]; }),
+      fields::vector<E>("tilt_plus90", "deg", [](auto& e) -> auto& { return e.tilt_box_deg[1]; }),
+      fields::number<E>("travel_error", "deg", &E::travel_error_deg),
+      fields::number<E>("travel_offaxis", "deg", &E::travel_offaxis_deg),
+  };
+  return t;
+}
+
+const Table<GBlock>& g_table() {
+  using G = GBlock;
+  static const Table<G> t = {
+      fields::matrix3<G>("G", "dps_per_g", &G::G_dps_per_g, false),
+      fields::matrix3<G>("G_sigma", "", &G::G_sigma, false),
+      fields::optional_row(fields::vector<G>("b0", "dps", &G::b0_dps), &G::has_fit),
+      fields::optional_row(fields::vector<G>("bias_tc", "dps_per_degc", &G::bias_tc_dps_per_degc), &G::has_tc),
+      fields::optional_row(fields::vector<G>("residual_rms", "dps", &G::residual_rms_dps), &G::has_fit),
+      fields::optional_row(fields::integer<G>("segments", &G::segments, 0, INT64_MAX), &G::has_fit),
+  };
+  return t;
+}
+
+const Table<TempBlock>& temp_table() {
+  using T = TempBlock;
+  static const Table<T> t = {
+      fields::vector<T>("bias_tc", "dps_per_degc", &T::tc_dps_per_degc),
+      fields::vector<T>("bias_tc_sigma", "dps_per_degc", &T::tc_sigma_dps_per_degc),
+      fields::number_or_null<T>("final_temp", "degc", &T::final_temp_degc),
+  };
+  return t;
+}
+
+// the temperature block: both coefficients and their 1-sigma, which cannot be negative
+fields::Row<SensorBlock> temperature_row() {
+  fields::Row<SensorBlock> row = fields::block<SensorBlock>("temperature", &SensorBlock::temp, &temp_table,
+                                                            {"bias_tc_dps_per_degc", "bias_tc_sigma_dps_per_degc"});
+  auto read = row.read;
+  row.read = [read](SensorBlock& s, const fields::Node& n, const fields::Reading& r) {
+    read(s, n, r);
+    if ((s.temp.tc_sigma_dps_per_degc.array() < 0.0).any())
+      r.ctx.fail(*n.find("bias_tc_sigma_dps_per_degc"), r.ctx.key("bias_tc_sigma_dps_per_degc"),
+                 "a sigma must be >= 0 deg/s per degC");
+  };
+  return fields::optional_row(std::move(row), &SensorBlock::has_temp);
+}
+
+const Table<SensorBlock>& sensor_table() {
+  using S = SensorBlock;
+  static const Table<S> t = {
+      fields::block<S>("minus90", [](auto& s) -> auto& { return s.pos[0]; }, &position_table, {"M"}),
+      fields::block<S>("plus90", [](auto& s) -> auto& { return s.pos[1]; }, &position_table, {"M"}),
+      fields::optional_row(fields::block<S>("errors", &S::errors, &errors_table), &S::has_errors),
+      fields::optional_row(fields::block<S>("g_sensitivity", &S::g, &g_table, {"G_dps_per_g"}), &S::has_g),
+      temperature_row(),
+  };
+  return t;
+}
+
+const Table<CalibDoc>& calib_table() {
+  using D = CalibDoc;
+  static const Table<D> t = {
+      fields::text<D>("format", &D::format),
+      fields::text<D>("method", &D::method),
+      fields::optional_row(fields::choice<D>("matrices", &D::matrices,
+                                             fields::Names<Matrices>{{"calibrated", Matrices::kCalibrated},
+                                                                     {"nominal", Matrices::kNominal}}),
+                           &D::has_matrices),
+      fields::vector<D>("hinge1_axis", "", &D::hinge1_axis),
+      fields::vector<D>("hinge2_axis", "", &D::hinge2_axis),
+      fields::block<D>("rig", &D::rig, &rig_table),
+      fields::block<D>("sensor1", [](auto& d) -> auto& { return d.sensor[0]; }, &sensor_table, {"minus90", "plus90"}),
+      fields::block<D>("sensor2", [](auto& d) -> auto& { return d.sensor[1]; }, &sensor_table, {"minus90", "plus90"}),
+  };
+  return t;
+}
+
+void write_doc(const std::filesystem::path& path, const CalibDoc& doc, const std::string& comment) {
+  io::write_file(path, twin::to_yaml(fields::write_block(calib_table(), doc), comment) + "\n");
+}
+
 }  // namespace
 
 void save_calib(const std::filesystem::path& path, const est::CalibFit& fit,
                 const RigConditions& rig, const est::GSensitivityFit* g) {
-  using yio::num;
-  const est::CalibMatrices mats = fit.matrices();
-  YAML::Emitter out;
-  out << YAML::Comment(
-      "driftless calibrate output (docs/calibration.md). Convention: y_i = M^-1 w_box + b_i,\n"
-      "so M (box_from_sensor) replaces R_i in eq. (1)-(2) and M^-1 replaces R_i^T. Units: deg/s, deg.");
-  out << YAML::BeginMap;
-  out << YAML::Key << "format" << YAML::Value << kCalibFormat;
-  out << YAML::Key << "method" << YAML::Value << est::method_name(fit.method);
-  emit_hinge_axes(out, rig.hinge1_axis, rig.hinge2_axis);
-
-  out << YAML::Key << "rig" << YAML::Value << YAML::BeginMap;
-  emit_rig_origin(out, rig.source, rig.latitude_deg, rig.sample_rate_hz);
-  out << YAML::Key << "earth_rate_removed" << YAML::Value << rig.earth_rate_removed;
-  out << YAML::Key << "gyro_full_scale_dps" << YAML::Value << num(rig.plan.gyro_full_scale_dps);
-  out << YAML::Key << "mean_temp_degc" << YAML::Value << YAML::Flow << YAML::BeginSeq;
-  emit_num_or_null(out, rig.mean_temp_c[0]);
-  emit_num_or_null(out, rig.mean_temp_c[1]);
-  out << YAML::EndSeq;
-  out << YAML::Key << "segments" << YAML::Value << YAML::BeginSeq;
+  CalibDoc doc;
+  doc.method = est::method_name(fit.method);
+  doc.hinge1_axis = rig.hinge1_axis;
+  doc.hinge2_axis = rig.hinge2_axis;
+  doc.rig = RigBlock{rig.source, rig.latitude_deg, rig.sample_rate_hz, true, rig.earth_rate_removed,
+                     rig.plan.gyro_full_scale_dps, rig.mean_temp_c, {}};
   for (std::size_t k = 0; k < rig.plan.segments.size(); ++k) {
-    const auto& s = rig.plan.segments[k];
-    out << YAML::Flow << YAML::BeginMap;
-    out << YAML::Key << "name" << YAML::Value << s.name;
-    out << YAML::Key << "axis_box" << YAML::Value;
-    yio::emit_vec3(out, s.axis_box);
-    emit_segment_span(out, s);
-    if (k < rig.samples_used.size())
-      out << YAML::Key << "samples_used" << YAML::Value << rig.samples_used[k];
-    out << YAML::EndMap;
+    const bool counted = k < rig.samples_used.size();
+    doc.rig.segments.push_back(SpanRecord{rig.plan.segments[k], counted, counted ? rig.samples_used[k] : 0});
   }
-  out << YAML::EndSeq << YAML::EndMap;
-
-  for (int i = 0; i < 2; ++i) {
-    out << YAML::Key << kSensorKey[i] << YAML::Value << YAML::BeginMap;
-    for (int p = 0; p < 2; ++p) {
-      const est::SensorPositionFit& f = fit.fit[i][p];
-      out << YAML::Key << kPosKey[p] << YAML::Value << YAML::BeginMap;
-      out << YAML::Key << "M" << YAML::Value;
-      yio::emit_mat3(out, f.M);
-      out << YAML::Key << "M_sigma" << YAML::Value;
-      yio::emit_mat3(out, f.M_sigma);
-      out << YAML::Key << "M_inv" << YAML::Value;
-      yio::emit_mat3(out, f.M_inv);
-      out << YAML::Key << "M_inv_sigma" << YAML::Value;
-      yio::emit_mat3(out, f.M_inv_sigma);
-      out << YAML::Key << "residual_rms_dps" << YAML::Value;
-      yio::emit_vec3(out, f.residual_rms_dps);
-      out << YAML::Key << "residual_max_dps" << YAML::Value;
-      yio::emit_vec3(out, f.residual_max_dps);
-      out << YAML::Key << "samples" << YAML::Value << f.n_samples;
-      out << YAML::Key << "bias_dps" << YAML::Value << YAML::BeginSeq;
-      for (const auto& b : f.biases) {
-        out << YAML::Flow << YAML::BeginMap << YAML::Key << "segment" << YAML::Value << b.segment;
-        out << YAML::Key << "value" << YAML::Value;
-        yio::emit_vec3(out, b.bias_dps);
-        out << YAML::Key << "sigma" << YAML::Value;
-        yio::emit_vec3(out, b.sigma_dps);
-        out << YAML::EndMap;
-      }
-      out << YAML::EndSeq << YAML::EndMap;
-    }
-    // the physical errors M shows (informational; readers ignore them)
-    const est::CalibErrors e = est::describe_errors(mats, i, i == 0 ? rig.hinge1_axis : rig.hinge2_axis);
-    out << YAML::Key << "errors" << YAML::Value << YAML::BeginMap;
-    out << YAML::Key << "scale_error_pct" << YAML::Value;
-    yio::emit_vec3(out, 100.0 * e.scale_error);
-    out << YAML::Key << "nonorthogonality_deg" << YAML::Value;
-    yio::emit_vec3(out, e.nonorthogonality_deg);
-    out << YAML::Key << "tilt_minus90_deg" << YAML::Value;
-    yio::emit_vec3(out, e.tilt_box_deg[0]);
-    out << YAML::Key << "tilt_plus90_deg" << YAML::Value;
-    yio::emit_vec3(out, e.tilt_box_deg[1]);
-    out << YAML::Key << "travel_error_deg" << YAML::Value << num(e.travel_error_deg);
-    out << YAML::Key << "travel_offaxis_deg" << YAML::Value << num(e.travel_offaxis_deg);
-    out << YAML::EndMap;
+  const est::CalibMatrices mats = fit.matrices();
+  for (std::size_t i = 0; i < 2; ++i) {
+    SensorBlock& s = doc.sensor[i];
+    for (std::size_t p = 0; p < 2; ++p) s.pos[p] = PositionBlock{fit.fit[i][p], true};
+    // the physical errors M shows, for people to read
+    s.has_errors = true;
+    s.errors = est::describe_errors(mats, static_cast<int>(i), i == 0 ? rig.hinge1_axis : rig.hinge2_axis);
+    s.errors.scale_error *= 100.0;  // written in %
     // y += G f: the gyro's response to specific force, from the per-segment biases
-    if (g && g->valid) {
-      const auto iu = static_cast<std::size_t>(i);
-      out << YAML::Key << "g_sensitivity" << YAML::Value << YAML::BeginMap;
-      out << YAML::Key << "G_dps_per_g" << YAML::Value;
-      yio::emit_mat3(out, g->G_dps_per_g[iu]);
-      out << YAML::Key << "G_sigma" << YAML::Value;
-      yio::emit_mat3(out, g->G_sigma[iu]);
-      out << YAML::Key << "b0_dps" << YAML::Value;
-      yio::emit_vec3(out, g->b0_dps[iu]);
-      if (g->temperature_term) {
-        out << YAML::Key << "bias_tc_dps_per_degc" << YAML::Value;
-        yio::emit_vec3(out, g->bias_tc_dps_per_degc[iu]);
-      }
-      out << YAML::Key << "residual_rms_dps" << YAML::Value;
-      yio::emit_vec3(out, g->residual_rms_dps[iu]);
-      out << YAML::Key << "segments" << YAML::Value << g->segments;
-      out << YAML::EndMap;
+    s.has_g = g != nullptr && g->valid;
+    if (s.has_g) {
+      s.g = GBlock{g->G_dps_per_g[i], g->G_sigma[i], true, g->b0_dps[i], g->temperature_term,
+                   g->bias_tc_dps_per_degc[i], g->residual_rms_dps[i], g->segments};
     }
-    out << YAML::EndMap;
   }
-  out << YAML::EndMap;
-  io::write_file(path, std::string(out.c_str()) + "\n");
+  write_doc(path, doc,
+            "driftless calibrate output (docs/calibration.md). Convention: y_i = M^-1 w_box + b_i,\n"
+            "so M (box_from_sensor) replaces R_i in eq. (1)-(2) and M^-1 replaces R_i^T. Units: deg/s, deg.");
 }
 
 void save_selfcal_calib(const std::filesystem::path& path, const SelfCalibration& sc) {
-  using yio::num;
-  YAML::Emitter out;
-  out << YAML::Comment(
-      "driftless estimate --selfcal output (docs/calibration.md). Convention as driftless calibrate's:\n"
-      "y_i = M^-1 w_box + b_i + G_i f_i + k_i (T_i - T_ref); M here are the nominal rotations (not\n"
-      "calibrated). Units: deg/s, deg, deg/s per g, deg/s per degC, degC.");
-  out << YAML::BeginMap;
-  out << YAML::Key << "format" << YAML::Value << kCalibFormat;
-  out << YAML::Key << "method" << YAML::Value << "selfcal";
-  out << YAML::Key << "matrices" << YAML::Value << "nominal";
-  emit_hinge_axes(out, sc.hinge1_axis, sc.hinge2_axis);
-  out << YAML::Key << "rig" << YAML::Value << YAML::BeginMap;
-  emit_rig_origin(out, sc.source, sc.latitude_deg, sc.sample_rate_hz);
-  out << YAML::EndMap;
-  for (int i = 0; i < 2; ++i) {
-    const auto iu = static_cast<std::size_t>(i);
-    const Eigen::Vector3d axis = (i == 0 ? sc.hinge1_axis : sc.hinge2_axis).normalized();
-    out << YAML::Key << kSensorKey[i] << YAML::Value << YAML::BeginMap;
-    for (int p = 0; p < 2; ++p) {
-      out << YAML::Key << kPosKey[p] << YAML::Value << YAML::BeginMap << YAML::Key << "M" << YAML::Value;
-      yio::emit_mat3(out, geo::rot_about_axis_deg(axis, p == 0 ? -90.0 : 90.0));
-      out << YAML::EndMap;
-    }
-    out << YAML::Key << "g_sensitivity" << YAML::Value << YAML::BeginMap << YAML::Key << "G_dps_per_g" << YAML::Value;
-    yio::emit_mat3(out, sc.G_dps_per_g[iu]);
-    out << YAML::Key << "G_sigma" << YAML::Value;
-    yio::emit_mat3(out, sc.G_sigma[iu]);
-    out << YAML::EndMap;
-    if (sc.temp_states) {
-      out << YAML::Key << "temperature" << YAML::Value << YAML::BeginMap << YAML::Key << "bias_tc_dps_per_degc"
-          << YAML::Value;
-      yio::emit_vec3(out, sc.temp_coef_dps_per_degc[iu]);
-      out << YAML::Key << "bias_tc_sigma_dps_per_degc" << YAML::Value;
-      yio::emit_vec3(out, sc.temp_coef_sigma_dps_per_degc[iu]);
-      out << YAML::Key << "final_temp_degc" << YAML::Value;
-      emit_num_or_null(out, sc.temp_ref_c[iu]);
-      out << YAML::EndMap;
-    }
-    out << YAML::EndMap;
+  CalibDoc doc;
+  doc.method = "selfcal";
+  doc.has_matrices = true;
+  doc.matrices = Matrices::kNominal;
+  doc.hinge1_axis = sc.hinge1_axis;
+  doc.hinge2_axis = sc.hinge2_axis;
+  doc.rig.source = sc.source;
+  doc.rig.latitude_deg = sc.latitude_deg;
+  doc.rig.sample_rate_hz = sc.sample_rate_hz;
+  for (std::size_t i = 0; i < 2; ++i) {
+    SensorBlock& s = doc.sensor[i];
+    const Vec3 axis = (i == 0 ? sc.hinge1_axis : sc.hinge2_axis).normalized();
+    for (std::size_t p = 0; p < 2; ++p) s.pos[p].fit.M = geo::rot_about_axis_deg(axis, p == 0 ? -90.0 : 90.0);
+    s.has_g = true;
+    s.g.G_dps_per_g = sc.G_dps_per_g[i];
+    s.g.G_sigma = sc.G_sigma[i];
+    s.has_temp = sc.temp_states;
+    s.temp = TempBlock{sc.temp_coef_dps_per_degc[i], sc.temp_coef_sigma_dps_per_degc[i], sc.temp_ref_c[i]};
   }
-  out << YAML::EndMap;
-  io::write_file(path, std::string(out.c_str()) + "\n");
+  write_doc(path, doc,
+            "driftless estimate --selfcal output (docs/calibration.md). Convention as driftless calibrate's:\n"
+            "y_i = M^-1 w_box + b_i + G_i f_i + k_i (T_i - T_ref); M here are the nominal rotations (not\n"
+            "calibrated). Units: deg/s, deg, deg/s per g, deg/s per degC, degC.");
 }
 
 est::Calibration CalibFile::to_filter_calibration() const {
@@ -199,63 +307,36 @@ est::Calibration CalibFile::to_filter_calibration() const {
 }
 
 CalibFile load_calib(const std::filesystem::path& path) {
-  using namespace yio;
   const std::string file = path.string();
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(file);
-  } catch (const YAML::Exception& e) {
-    throw InputError(file, static_cast<std::size_t>(e.mark.line) + 1, "",
-                     "cannot read calibration file: " + e.msg);
-  }
-  if (!root.IsMap()) throw InputError(file, 0, "", "not a calibration file (expected a YAML map)");
-  const std::string fmt_id = as_string(root["format"], file, "format");
-  if (fmt_id != kCalibFormat)
-    fail(file, root["format"], "format", std::string("expected '") + kCalibFormat + "', got '" + fmt_id + "'");
+  const fields::Node root = twin::load_yaml_file(path);
+  if (!root.is_map()) throw InputError(file, root.line, "", "not a calibration file (expected a YAML map)");
+  const fields::Context ctx{file, ""};
+  CalibDoc doc;
+  const auto given = fields::read_block(calib_table(), doc, root, ctx);
+  fields::require(calib_table(), given, root, ctx, {"format"});
+  if (doc.format != kCalibFormat)
+    ctx.fail(*root.find("format"), "format", std::string("expected '") + kCalibFormat + "', got '" + doc.format + "'");
+  fields::require(calib_table(), given, root, ctx, {"sensor1", "sensor2"});
   CalibFile c;
-  c.method = root["method"] ? as_string(root["method"], file, "method") : "unknown";
-  if (root["matrices"]) {
-    const std::string m = as_string(root["matrices"], file, "matrices");
-    if (m != "nominal" && m != "calibrated") fail(file, root["matrices"], "matrices", "expected nominal or calibrated, got '" + m + "'");
-    c.matrices_nominal = m == "nominal";
-  }
-  if (root["hinge1_axis"]) c.hinge1_axis = as_vec3(root["hinge1_axis"], file, "hinge1_axis");
-  if (root["hinge2_axis"]) c.hinge2_axis = as_vec3(root["hinge2_axis"], file, "hinge2_axis");
-  if (const YAML::Node rig = root["rig"]) {
-    if (rig["latitude_deg"] && !rig["latitude_deg"].IsNull())
-      c.latitude_deg = as_double(rig["latitude_deg"], file, "rig.latitude_deg");
-    if (rig["earth_rate_removed"]) c.earth_rate_removed = rig["earth_rate_removed"].as<bool>(false);
-    if (rig["source"]) c.source = as_string(rig["source"], file, "rig.source");
-  }
-  for (int i = 0; i < 2; ++i) {
-    const YAML::Node s = root[kSensorKey[i]];
-    if (!s || !s.IsMap()) fail(file, root, kSensorKey[i], "missing (expected sensor1 and sensor2 maps)");
-    for (int p = 0; p < 2; ++p) {
-      const std::string key = std::string(kSensorKey[i]) + "." + kPosKey[p];
-      const YAML::Node n = s[kPosKey[p]];
-      if (!n || !n.IsMap()) fail(file, s, key, "missing (expected minus90 and plus90 maps)");
-      c.M.M(i, p) = as_mat3(n["M"], file, key + ".M");
-      c.M_sigma[i][p] = n["M_sigma"] ? as_mat3(n["M_sigma"], file, key + ".M_sigma")
-                                     : Eigen::Matrix3d::Zero();
-      c.residual_rms_dps[i][p] = n["residual_rms_dps"]
-                                     ? as_vec3(n["residual_rms_dps"], file, key + ".residual_rms_dps")
-                                     : Eigen::Vector3d::Zero();
+  c.method = doc.method;
+  c.matrices_nominal = doc.has_matrices && doc.matrices == Matrices::kNominal;
+  c.hinge1_axis = doc.hinge1_axis;
+  c.hinge2_axis = doc.hinge2_axis;
+  c.latitude_deg = doc.rig.latitude_deg;
+  c.earth_rate_removed = doc.rig.earth_rate_removed;
+  c.source = doc.rig.source;
+  for (std::size_t i = 0; i < 2; ++i) {
+    const SensorBlock& s = doc.sensor[i];
+    for (std::size_t p = 0; p < 2; ++p) {
+      c.M.M(static_cast<int>(i), static_cast<int>(p)) = s.pos[p].fit.M;
+      c.M_sigma[i][p] = s.pos[p].fit.M_sigma;
+      c.residual_rms_dps[i][p] = s.pos[p].fit.residual_rms_dps;
     }
-    if (const YAML::Node gs = s["g_sensitivity"]) {
-      const std::string key = std::string(kSensorKey[i]) + ".g_sensitivity.G_dps_per_g";
-      c.G_dps_per_g[static_cast<std::size_t>(i)] = as_mat3(gs["G_dps_per_g"], file, key);
-      c.has_g_sensitivity = true;
-    }
-    if (const YAML::Node tn = s["temperature"]) {
-      const std::string key = std::string(kSensorKey[i]) + ".temperature.";
-      const auto iu = static_cast<std::size_t>(i);
-      c.temp_coef_dps_per_degc[iu] = as_vec3(tn["bias_tc_dps_per_degc"], file, key + "bias_tc_dps_per_degc");
-      c.temp_coef_sigma_dps_per_degc[iu] =
-          as_vec3(tn["bias_tc_sigma_dps_per_degc"], file, key + "bias_tc_sigma_dps_per_degc");
-      if ((c.temp_coef_sigma_dps_per_degc[iu].array() < 0.0).any())
-        fail(file, tn["bias_tc_sigma_dps_per_degc"], key + "bias_tc_sigma_dps_per_degc", "a sigma must be >= 0 deg/s per degC");
-      c.has_temp_coef = true;
-    }
+    c.has_g_sensitivity = c.has_g_sensitivity || s.has_g;
+    c.G_dps_per_g[i] = s.g.G_dps_per_g;
+    c.has_temp_coef = c.has_temp_coef || s.has_temp;
+    c.temp_coef_dps_per_degc[i] = s.temp.tc_dps_per_degc;
+    c.temp_coef_sigma_dps_per_degc[i] = s.temp.tc_sigma_dps_per_degc;
   }
   with_location(file, 0, "", [&] { c.M.validate(); });
   return c;

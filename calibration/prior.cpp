@@ -2,10 +2,10 @@
 #include "calibration/prior.hpp"
 
 #include <Eigen/SVD>
-#include <yaml-cpp/yaml.h>
 
-#include "calibration/yaml_io.hpp"
+#include "estimator/fields.hpp"
 #include "estimator/geometry.hpp"
+#include "twin/yaml_doc.hpp"
 
 namespace driftless::calib {
 
@@ -32,66 +32,146 @@ SensorPrior sensor_prior(const est::CalibMatrices& m, int sensor, const Eigen::V
 
 namespace {
 
-// the effects M determines: scale factor, misalignment and mounting (see sensor_prior)
-void emit_matrix_effects(YAML::Emitter& out, const SensorPrior& s) {
-  using yio::num;
-  out << YAML::Key << "scale_factor" << YAML::Value << YAML::BeginMap << YAML::Key << "enabled" << YAML::Value << true
-      << YAML::Key << "value_pct" << YAML::Value;
-  yio::emit_vec3(out, s.scale_pct);
-  out << YAML::Key << "sigma_pct" << YAML::Value << 0 << YAML::EndMap;
-  out << YAML::Key << "misalignment" << YAML::Value << YAML::BeginMap << YAML::Key << "enabled" << YAML::Value << true
-      << YAML::Key << "matrix_pct" << YAML::Value;
-  yio::emit_mat3(out, s.misalignment_pct);
-  out << YAML::Key << "sigma_pct" << YAML::Value << 0 << YAML::EndMap;
-  out << YAML::Key << "mounting_misalignment" << YAML::Value << YAML::BeginMap << YAML::Key << "enabled" << YAML::Value
-      << true << YAML::Key << "angles_deg" << YAML::Value;
-  yio::emit_vec3(out, s.mounting_deg);
-  out << YAML::Key << "sigma_deg" << YAML::Value << 0 << YAML::EndMap;
+using fields::Table;
+
+// ---- the prior file: emit-only tables, in the keys of the scenario's model block
+//      (twin/scenario.cpp, twin/sensor/sensor_params.cpp read it back) ----
+
+// one sensor's effects; which blocks appear depends on what calib.yaml holds
+struct PriorEffects {
+  bool matrices = false;  // scale factor, misalignment and mounting (calibrated M)
+  SensorPrior s;
+  bool has_g = false;
+  Eigen::Matrix3d G_dps_per_g = Eigen::Matrix3d::Zero();
+  bool has_temp = false;
+  Eigen::Vector3d tc_dps_per_degc = Eigen::Vector3d::Zero();
+  Eigen::Vector3d tc_sigma_dps_per_degc = Eigen::Vector3d::Zero();  // 0: the calibrated value, no draw
+  bool enabled = true;
+  double sigma = 0.0;  // every run-to-run sigma of the planted effects
+};
+
+struct PriorBox {
+  Eigen::Vector3d hinge1_axis = Eigen::Vector3d::UnitZ();
+  Eigen::Vector3d hinge2_axis = Eigen::Vector3d::UnitX();
+  bool has_stops = false;  // nominal matrices (a self-calibration) say nothing about the stops
+  std::array<Eigen::Vector2d, 2> stop_error_deg{Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};
+};
+
+struct PriorModel {
+  PriorBox box;
+  std::array<PriorEffects, 2> effects;
+};
+
+// each effect block: {enabled: true, value, sigma: 0} in the sensor catalogue's keys
+const Table<PriorEffects>& scale_table() {
+  using E = PriorEffects;
+  static const Table<E> t = {fields::flag<E>("enabled", &E::enabled),
+                             fields::vector<E>("value", "pct", [](auto& e) -> auto& { return e.s.scale_pct; }),
+                             fields::number<E>("sigma", "pct", &E::sigma)};
+  return t;
+}
+
+const Table<PriorEffects>& misalignment_table() {
+  using E = PriorEffects;
+  static const Table<E> t = {fields::flag<E>("enabled", &E::enabled),
+                             fields::matrix3<E>("matrix", "pct", [](auto& e) -> auto& { return e.s.misalignment_pct; }, false),
+                             fields::number<E>("sigma", "pct", &E::sigma)};
+  return t;
+}
+
+const Table<PriorEffects>& mounting_table() {
+  using E = PriorEffects;
+  static const Table<E> t = {fields::flag<E>("enabled", &E::enabled),
+                             fields::vector<E>("angles", "deg", [](auto& e) -> auto& { return e.s.mounting_deg; }),
+                             fields::number<E>("sigma", "deg", &E::sigma)};
+  return t;
+}
+
+const Table<PriorEffects>& g_table() {
+  using E = PriorEffects;
+  static const Table<E> t = {fields::flag<E>("enabled", &E::enabled),
+                             fields::matrix3<E>("matrix", "dps_per_g", &E::G_dps_per_g, false),
+                             fields::number<E>("sigma", "dps_per_g", &E::sigma)};
+  return t;
+}
+
+const Table<PriorEffects>& temp_table() {
+  using E = PriorEffects;
+  static const Table<E> t = {fields::vector<E>("bias_tc", "dps_per_degc", &E::tc_dps_per_degc),
+                             fields::vector<E>("bias_tc_sigma", "dps_per_degc", &E::tc_sigma_dps_per_degc)};
+  return t;
+}
+
+// a sub-block of `effects`, the same PriorEffects through another table, written when `when` holds
+fields::Row<PriorEffects> effect_row(const char* stem, const Table<PriorEffects>& (*table)(), bool PriorEffects::*when) {
+  return fields::written_if<PriorEffects>(fields::block<PriorEffects>(stem, [](auto& e) -> auto& { return e; }, table),
+                                          [when](const PriorEffects& e) { return e.*when; });
+}
+
+const Table<PriorEffects>& effects_table() {
+  using E = PriorEffects;
+  static const Table<E> t = {
+      effect_row("scale_factor", &scale_table, &E::matrices),
+      effect_row("misalignment", &misalignment_table, &E::matrices),
+      effect_row("mounting_misalignment", &mounting_table, &E::matrices),
+      effect_row("g_sensitivity", &g_table, &E::has_g),
+      effect_row("temperature", &temp_table, &E::has_temp),
+  };
+  return t;
+}
+
+const Table<PriorEffects>& sensor_table() {
+  static const Table<PriorEffects> t = {
+      fields::block<PriorEffects>("effects", [](auto& e) -> auto& { return e; }, &effects_table)};
+  return t;
+}
+
+const Table<PriorBox>& box_table() {
+  using B = PriorBox;
+  static const Table<B> t = [] {
+    Table<B> rows = {fields::vector<B>("hinge1_axis", "", &B::hinge1_axis),
+                     fields::vector<B>("hinge2_axis", "", &B::hinge2_axis)};
+    for (std::size_t i = 0; i < 2; ++i) {
+      rows.push_back(fields::written_if<B>(
+          fields::vector<B>(i == 0 ? "stop1_error" : "stop2_error", "deg", [i](auto& b) -> auto& { return b.stop_error_deg[i]; }),
+          [](const B& b) { return b.has_stops; }));
+    }
+    return rows;
+  }();
+  return t;
+}
+
+const Table<PriorModel>& model_table() {
+  using M = PriorModel;
+  static const Table<M> t = {
+      fields::block<M>("box", &M::box, &box_table),
+      fields::block<M>("sensor1", [](auto& m) -> auto& { return m.effects[0]; }, &sensor_table),
+      fields::block<M>("sensor2", [](auto& m) -> auto& { return m.effects[1]; }, &sensor_table),
+  };
+  return t;
 }
 
 }  // namespace
 
 std::string model_prior_yaml(const CalibFile& c) {
-  using yio::num;
-  YAML::Emitter out;
-  out << YAML::Comment("model prior from a calibration (" + c.source +
-                       "), written by --prior-out; docs/calibration.md");
-  out << YAML::BeginMap << YAML::Key << "model" << YAML::Value << YAML::BeginMap;
-  const SensorPrior s[2] = {sensor_prior(c.M, 0, c.hinge1_axis), sensor_prior(c.M, 1, c.hinge2_axis)};
-  out << YAML::Key << "box" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "hinge1_axis" << YAML::Value;
-  yio::emit_vec3(out, c.hinge1_axis);
-  out << YAML::Key << "hinge2_axis" << YAML::Value;
-  yio::emit_vec3(out, c.hinge2_axis);
-  // nominal matrices (a self-calibration) say nothing about the stops: the scenario's stay
-  for (int i = 0; i < 2 && !c.matrices_nominal; ++i) {
-    out << YAML::Key << (i == 0 ? "stop1_error_deg" : "stop2_error_deg") << YAML::Value << YAML::Flow
-        << YAML::BeginSeq << num(s[i].stop_error_deg[0]) << num(s[i].stop_error_deg[1]) << YAML::EndSeq;
+  PriorModel m;
+  m.box.hinge1_axis = c.hinge1_axis;
+  m.box.hinge2_axis = c.hinge2_axis;
+  m.box.has_stops = !c.matrices_nominal;
+  for (std::size_t i = 0; i < 2; ++i) {
+    PriorEffects& e = m.effects[i];
+    e.s = sensor_prior(c.M, static_cast<int>(i), i == 0 ? c.hinge1_axis : c.hinge2_axis);
+    m.box.stop_error_deg[i] = e.s.stop_error_deg;
+    e.matrices = !c.matrices_nominal;
+    e.has_g = c.has_g_sensitivity;
+    e.G_dps_per_g = c.G_dps_per_g[i];
+    e.has_temp = c.has_temp_coef;
+    e.tc_dps_per_degc = c.temp_coef_dps_per_degc[i];
   }
-  out << YAML::EndMap;
-  for (int i = 0; i < 2; ++i) {
-    const auto iu = static_cast<std::size_t>(i);
-    out << YAML::Key << (i == 0 ? "sensor1" : "sensor2") << YAML::Value << YAML::BeginMap;
-    out << YAML::Key << "effects" << YAML::Value << YAML::BeginMap;
-    if (!c.matrices_nominal) emit_matrix_effects(out, s[i]);
-    if (c.has_g_sensitivity) {
-      out << YAML::Key << "g_sensitivity" << YAML::Value << YAML::BeginMap << YAML::Key << "enabled"
-          << YAML::Value << true << YAML::Key << "matrix_dps_per_g" << YAML::Value;
-      yio::emit_mat3(out, c.G_dps_per_g[iu]);
-      out << YAML::Key << "sigma_dps_per_g" << YAML::Value << 0 << YAML::EndMap;
-    }
-    if (c.has_temp_coef) {
-      out << YAML::Key << "temperature" << YAML::Value << YAML::BeginMap << YAML::Key << "bias_tc_dps_per_degc"
-          << YAML::Value;
-      yio::emit_vec3(out, c.temp_coef_dps_per_degc[iu]);
-      out << YAML::Key << "bias_tc_sigma_dps_per_degc" << YAML::Value;
-      yio::emit_vec3(out, Eigen::Vector3d::Zero());
-      out << YAML::EndMap;
-    }
-    out << YAML::EndMap << YAML::EndMap;
-  }
-  out << YAML::EndMap << YAML::EndMap;
-  return std::string(out.c_str()) + "\n";
+  fields::Node root = fields::Node::map();
+  root.add("model", fields::write_block(model_table(), m));
+  return twin::to_yaml(root, "model prior from a calibration (" + c.source +
+                                 "), written by --prior-out; docs/calibration.md") + "\n";
 }
 
 }  // namespace driftless::calib

@@ -3,16 +3,14 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <set>
 #include <stdexcept>
 
 #include <fmt/core.h>
-#include <yaml-cpp/yaml.h>
 
-#include "calibration/yaml_io.hpp"
 #include "estimator/geometry.hpp"
 #include "estimator/output_file.hpp"
+#include "twin/yaml_doc.hpp"
 
 namespace driftless::calib {
 namespace {
@@ -127,111 +125,129 @@ RigPlan standard_plan(const ProcedureParams& p) {
   return plan;
 }
 
-RigPlan parse_rig_plan(const YAML::Node& node, const std::string& file) {
-  using namespace yio;
-  if (!node || !node.IsMap()) throw InputError(file, 0, "", "a rig plan must be a YAML map");
+namespace {
+
+// ---- the plan file: one table per block drives parse, allowed keys and emit ----
+
+bool is_custom(const PlanSegment& s) { return s.orientation == "custom"; }
+
+const fields::Table<PlanSegment>& segment_table() {
+  using S = PlanSegment;
+  static const fields::Table<S> t = [] {
+    fields::Table<S> rows = {
+        fields::text<S>("name", &S::name),
+        fields::text<S>("orientation", &S::orientation),
+        fields::written_if<S>(fields::vector<S>("axis_box", "", &S::axis_box), is_custom),
+    };
+    append_span_rows(rows, [](auto& s) -> auto& { return s; });
+    rows.push_back(fields::number<S>("half_period", "s", &S::half_period_s));
+    rows.push_back(fields::number<S>("first_sign", "", &S::first_sign));
+    rows.push_back(fields::number<S>("settle", "s", &S::settle_s));
+    return rows;
+  }();
+  return t;
+}
+
+// `defaults:` holds the segment keys every segment may leave out
+const fields::Table<PlanSegment>& defaults_table() {
+  using S = PlanSegment;
+  static const fields::Table<S> t = {
+      fields::number<S>("rate", "dps", &S::rate_dps),
+      fields::number<S>("half_period", "s", &S::half_period_s),
+      fields::number<S>("settle", "s", &S::settle_s),
+  };
+  return t;
+}
+
+// the whole file; segments are read after the map, so `defaults:` may stand anywhere
+struct PlanDoc {
+  std::string format = kRigPlanFormat;
   RigPlan plan;
-  if (const auto f = node["format"]; f && as_string(f, file, "format") != kRigPlanFormat)
-    fail(file, f, "format", std::string("expected '") + kRigPlanFormat + "'");
-  if (const auto n = node["gyro_full_scale_dps"]) plan.gyro_full_scale_dps = as_double(n, file, "gyro_full_scale_dps");
-  if (const auto n = node["max_rate_fraction"]) plan.max_rate_fraction = as_double(n, file, "max_rate_fraction");
-  if (const auto n = node["latitude_deg"]) plan.latitude_deg = as_double(n, file, "latitude_deg");
   PlanSegment defaults;
-  if (const auto d = node["defaults"]) {
-    if (const auto n = d["rate_dps"]) defaults.rate_dps = as_double(n, file, "defaults.rate_dps");
-    if (const auto n = d["half_period_s"]) defaults.half_period_s = as_double(n, file, "defaults.half_period_s");
-    if (const auto n = d["settle_s"]) defaults.settle_s = as_double(n, file, "defaults.settle_s");
+  fields::Node segments;
+};
+
+const fields::Table<PlanDoc>& plan_table() {
+  using D = PlanDoc;
+  static const fields::Table<D> t = {
+      fields::text<D>("format", &D::format),
+      fields::number<D>("gyro_full_scale", "dps", [](auto& d) -> auto& { return d.plan.gyro_full_scale_dps; }),
+      fields::number<D>("max_rate_fraction", "", [](auto& d) -> auto& { return d.plan.max_rate_fraction; }),
+      fields::written_if<D>(fields::number<D>("latitude", "deg", [](auto& d) -> auto& { return d.plan.latitude_deg; }),
+                            [](const D& d) { return std::isfinite(d.plan.latitude_deg); }),
+      fields::custom<D>(
+          "defaults", "",
+          [](D& d, const fields::Node& n, const fields::Reading& r) { fields::read_block(defaults_table(), d.defaults, n, r.ctx); },
+          [](const D&) -> std::optional<fields::Node> { return std::nullopt; }),
+      fields::custom<D>(
+          "segments", "", [](D& d, const fields::Node& n, const fields::Reading&) { d.segments = n; },
+          [](const D& d) -> std::optional<fields::Node> {
+            std::vector<fields::Node> items;
+            for (const auto& s : d.plan.segments) items.push_back(fields::write_block(segment_table(), s, true));
+            return fields::Node::list(std::move(items), false);
+          }),
+  };
+  return t;
+}
+
+// one segment: the defaults, then its keys; a named orientation gives the table axis, `custom`
+// takes axis_box (normalised)
+PlanSegment read_segment(const fields::Node& n, const fields::Context& ctx, const PlanSegment& defaults) {
+  PlanSegment seg = defaults;
+  const auto given = fields::read_block(segment_table(), seg, n, ctx);
+  fields::require(segment_table(), given, n, ctx,
+                  {"name", "orientation", "plat1_deg", "plat2_deg", "t_start_s", "t_end_s"});
+  const fields::Node* axis = n.find("axis_box");
+  if (is_custom(seg)) {
+    if (axis == nullptr) ctx.fail(n, ctx.key("axis_box"), "missing (orientation: custom needs axis_box [x, y, z])");
+    if (seg.axis_box.norm() < 1e-6) ctx.fail(*axis, ctx.key("axis_box"), "zero vector");
+    seg.axis_box.normalize();
+    return seg;
   }
-  const YAML::Node segs = node["segments"];
-  if (!segs || !segs.IsSequence()) fail(file, node, "segments", "expected a list of segments");
-  static const std::set<std::string> kKeys = {"name", "orientation", "axis_box", "plat1_deg",
-                                              "plat2_deg", "t_start_s", "t_end_s", "rate_dps",
-                                              "half_period_s", "first_sign", "settle_s"};
-  for (std::size_t i = 0; i < segs.size(); ++i) {
-    const YAML::Node s = segs[i];
-    const std::string key = "segments[" + std::to_string(i) + "]";
-    if (!s.IsMap()) fail(file, s, key, "expected a map");
-    for (const auto& kv : s) {
-      const std::string k = kv.first.Scalar();
-      if (!kKeys.count(k)) fail(file, kv.first, key + "." + k, "unknown key (see docs/calibration.md)");
-    }
-    PlanSegment seg = defaults;
-    seg.name = as_string(s["name"], file, key + ".name");
-    seg.orientation = as_string(s["orientation"], file, key + ".orientation");
-    if (seg.orientation == "custom") {
-      seg.axis_box = as_vec3(s["axis_box"], file, key + ".axis_box");
-      if (seg.axis_box.norm() < 1e-6) fail(file, s["axis_box"], key + ".axis_box", "zero vector");
-      seg.axis_box.normalize();
-    } else {
-      try {
-        seg.axis_box = orientation_axis(seg.orientation);
-      } catch (const std::invalid_argument& e) {
-        fail(file, s["orientation"], key + ".orientation", e.what());
-      }
-      if (s["axis_box"]) fail(file, s["axis_box"], key + ".axis_box", "only with orientation: custom");
-    }
-    seg.plat1_deg = as_double(s["plat1_deg"], file, key + ".plat1_deg");
-    seg.plat2_deg = as_double(s["plat2_deg"], file, key + ".plat2_deg");
-    seg.t_start_s = as_double(s["t_start_s"], file, key + ".t_start_s");
-    seg.t_end_s = as_double(s["t_end_s"], file, key + ".t_end_s");
-    if (const auto n = s["rate_dps"]) seg.rate_dps = as_double(n, file, key + ".rate_dps");
-    if (const auto n = s["half_period_s"]) seg.half_period_s = as_double(n, file, key + ".half_period_s");
-    if (const auto n = s["first_sign"]) seg.first_sign = as_double(n, file, key + ".first_sign");
-    if (const auto n = s["settle_s"]) seg.settle_s = as_double(n, file, key + ".settle_s");
-    plan.segments.push_back(seg);
+  try {
+    seg.axis_box = orientation_axis(seg.orientation);
+  } catch (const std::invalid_argument& e) {
+    ctx.fail(*n.find("orientation"), ctx.key("orientation"), e.what());
   }
-  with_location(file, 0, "", [&] { plan.validate(); });
-  return plan;
+  if (axis != nullptr) ctx.fail(*axis, ctx.key("axis_box"), "only with orientation: custom");
+  return seg;
+}
+
+}  // namespace
+
+RigPlan read_rig_plan(const fields::Node& root, const std::string& file) {
+  if (!root.is_map()) throw InputError(file, root.line, "", "a rig plan must be a YAML map (docs/calibration.md)");
+  const fields::Context ctx{file, ""};
+  PlanDoc doc;
+  const auto given = fields::read_block(plan_table(), doc, root, ctx);
+  if (doc.format != kRigPlanFormat)
+    ctx.fail(*root.find("format"), "format", std::string("expected '") + kRigPlanFormat + "', got '" + doc.format + "'");
+  fields::require(plan_table(), given, root, ctx, {"segments"});
+  if (!doc.segments.is_list()) ctx.fail(doc.segments, "segments", "expected a list of segments");
+  for (std::size_t i = 0; i < doc.segments.items.size(); ++i) {
+    const fields::Context seg_ctx{file, "segments[" + std::to_string(i) + "]"};
+    doc.plan.segments.push_back(read_segment(doc.segments.items[i], seg_ctx, doc.defaults));
+  }
+  with_location(file, 0, "", [&] { doc.plan.validate(); });
+  return doc.plan;
+}
+
+RigPlan parse_rig_plan(const std::string& yaml_text, const std::string& file) {
+  return read_rig_plan(twin::parse_yaml(yaml_text, file), file);
 }
 
 RigPlan load_rig_plan(const std::filesystem::path& path) {
-  YAML::Node node;
-  try {
-    node = YAML::LoadFile(path.string());
-  } catch (const YAML::Exception& e) {
-    throw InputError(path.string(), static_cast<std::size_t>(e.mark.line) + 1, "",
-                     "cannot read rig plan: " + e.msg);
-  }
-  return parse_rig_plan(node, path.string());
+  return read_rig_plan(twin::load_yaml_file(path), path.string());
 }
 
-void emit_segment_span(YAML::Emitter& out, const PlanSegment& s) {
-  using yio::num;
-  out << YAML::Key << "plat1_deg" << YAML::Value << num(s.plat1_deg);
-  out << YAML::Key << "plat2_deg" << YAML::Value << num(s.plat2_deg);
-  out << YAML::Key << "t_start_s" << YAML::Value << num(s.t_start_s);
-  out << YAML::Key << "t_end_s" << YAML::Value << num(s.t_end_s);
-  out << YAML::Key << "rate_dps" << YAML::Value << num(s.rate_dps);
+std::string rig_plan_yaml(const RigPlan& plan) {
+  PlanDoc doc;
+  doc.plan = plan;
+  return twin::to_yaml(fields::write_block(plan_table(), doc),
+                       "rig plan for driftless calibrate --plan (docs/calibration.md)") + "\n";
 }
 
-void save_rig_plan(const std::filesystem::path& path, const RigPlan& plan) {
-  using yio::num;
-  YAML::Emitter out;
-  out << YAML::Comment("rig plan for driftless calibrate --plan (docs/calibration.md)");
-  out << YAML::BeginMap;
-  out << YAML::Key << "format" << YAML::Value << kRigPlanFormat;
-  out << YAML::Key << "gyro_full_scale_dps" << YAML::Value << num(plan.gyro_full_scale_dps);
-  out << YAML::Key << "max_rate_fraction" << YAML::Value << num(plan.max_rate_fraction);
-  if (std::isfinite(plan.latitude_deg))
-    out << YAML::Key << "latitude_deg" << YAML::Value << num(plan.latitude_deg);
-  out << YAML::Key << "segments" << YAML::Value << YAML::BeginSeq;
-  for (const auto& s : plan.segments) {
-    out << YAML::Flow << YAML::BeginMap;
-    out << YAML::Key << "name" << YAML::Value << s.name;
-    out << YAML::Key << "orientation" << YAML::Value << s.orientation;
-    if (s.orientation == "custom") {
-      out << YAML::Key << "axis_box" << YAML::Value;
-      yio::emit_vec3(out, s.axis_box);
-    }
-    emit_segment_span(out, s);
-    out << YAML::Key << "half_period_s" << YAML::Value << num(s.half_period_s);
-    out << YAML::Key << "first_sign" << YAML::Value << num(s.first_sign);
-    out << YAML::Key << "settle_s" << YAML::Value << num(s.settle_s);
-    out << YAML::EndMap;
-  }
-  out << YAML::EndSeq << YAML::EndMap;
-  io::write_file(path, std::string(out.c_str()) + "\n");
-}
+void save_rig_plan(const std::filesystem::path& path, const RigPlan& plan) { io::write_file(path, rig_plan_yaml(plan)); }
 
 namespace {
 

@@ -4,6 +4,7 @@
 
 #include <array>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -11,12 +12,8 @@
 #include <Eigen/Geometry>
 
 #include "estimator/calibration.hpp"
+#include "estimator/fields.hpp"
 #include "estimator/log.hpp"
-
-namespace YAML {
-class Node;
-class Emitter;
-}
 
 namespace driftless::calib {
 
@@ -77,14 +74,30 @@ struct ProcedureParams {
 };
 RigPlan standard_plan(const ProcedureParams& p);
 
-/// Reads a plan from YAML (throws std::invalid_argument naming `file` and the key).
-RigPlan parse_rig_plan(const YAML::Node& node, const std::string& file);
+/// Reads a plan from a parsed YAML document (throws InputError naming `file`, line and key).
+RigPlan read_rig_plan(const fields::Node& root, const std::string& file);
+/// Reads a plan from YAML text (`file` names it in errors).
+RigPlan parse_rig_plan(const std::string& yaml_text, const std::string& file);
 RigPlan load_rig_plan(const std::filesystem::path& path);
-/// Writes a plan as YAML (load_rig_plan reads it back).
+/// The plan as YAML text (load_rig_plan reads it back).
+std::string rig_plan_yaml(const RigPlan& plan);
+/// Writes rig_plan_yaml(plan) to `path`.
 void save_rig_plan(const std::filesystem::path& path, const RigPlan& plan);
-/// Emits a segment's positions and span into an open YAML map (plat1_deg, plat2_deg in deg,
-/// t_start_s, t_end_s in s, rate_dps in deg/s): the keys the plan and the calibration file share.
-void emit_segment_span(YAML::Emitter& out, const PlanSegment& s);
+
+/// The rows a plan segment and a calib.yaml segment share, in this order: plat1_deg, plat2_deg
+/// (deg), t_start_s, t_end_s (s), rate_dps (deg/s). `seg` gives the PlanSegment inside a T.
+template <class T, class Seg>
+void append_span_rows(fields::Table<T>& rows, Seg seg) {
+  using S = PlanSegment;
+  const auto field = [seg](double S::*m) {
+    return [seg, m](auto& t) -> auto& { return std::invoke(seg, t).*m; };
+  };
+  rows.push_back(fields::number<T>("plat1", "deg", field(&S::plat1_deg)));
+  rows.push_back(fields::number<T>("plat2", "deg", field(&S::plat2_deg)));
+  rows.push_back(fields::number<T>("t_start", "s", field(&S::t_start_s)));
+  rows.push_back(fields::number<T>("t_end", "s", field(&S::t_end_s)));
+  rows.push_back(fields::number<T>("rate", "dps", field(&S::rate_dps)));
+}
 
 /// What extract_segments found.
 struct ExtractReport {

@@ -5,20 +5,18 @@
 #include <cmath>
 #include <fstream>
 #include <memory>
-#include <set>
 #include <sstream>
 #include <stdexcept>
 
 #include <fmt/core.h>
-#include <yaml-cpp/yaml.h>
 
-#include "calibration/yaml_io.hpp"
 #include "estimator/geometry.hpp"
 #include "twin/flip_schedule.hpp"
 #include "twin/motion.hpp"
 #include "twin/sensor/sensor_model.hpp"
 #include "twin/simulator.hpp"
 #include "twin/world.hpp"
+#include "twin/yaml_doc.hpp"
 
 namespace driftless::calib {
 
@@ -244,37 +242,31 @@ std::string read_text(const std::filesystem::path& path) {
   return ss.str();
 }
 
-RigParams parse_rig(const YAML::Node& n, const std::string& file) {
-  using namespace yio;
-  static const std::set<std::string> kKeys = {
-      "rate_dps", "segment_s", "half_period_s", "settle_s", "gap_s", "start_s", "orientations",
-      "gyro_full_scale_dps", "table_accel_dps2", "remount_s", "method"};
-  if (!n.IsMap()) fail(file, n, "calibration", "expected a map (docs/calibration.md)");
-  for (const auto& kv : n)
-    if (!kKeys.count(kv.first.Scalar()))
-      fail(file, kv.first, "calibration." + kv.first.Scalar(), "unknown key (see docs/calibration.md)");
-  RigParams r;
-  auto& p = r.procedure;
-  p.gap_s = 8.0;
-  const auto num = [&](const char* k, double& v) {
-    if (n[k]) v = as_double(n[k], file, std::string("calibration.") + k);
+// the calibration: block, one table (docs/calibration.md)
+const fields::Table<RigParams>& rig_table() {
+  using R = RigParams;
+  const auto proc = [](double ProcedureParams::*m) { return [m](auto& r) -> auto& { return r.procedure.*m; }; };
+  static const fields::Table<R> t = {
+      fields::number<R>("rate", "dps", proc(&ProcedureParams::rate_dps)),
+      fields::number<R>("segment", "s", proc(&ProcedureParams::segment_s)),
+      fields::number<R>("half_period", "s", proc(&ProcedureParams::half_period_s)),
+      fields::number<R>("settle", "s", proc(&ProcedureParams::settle_s)),
+      fields::number<R>("gap", "s", proc(&ProcedureParams::gap_s)),
+      fields::number<R>("start", "s", proc(&ProcedureParams::start_s)),
+      fields::text_list<R>("orientations", [](auto& r) -> auto& { return r.procedure.orientations; }),
+      fields::number<R>("gyro_full_scale", "dps", proc(&ProcedureParams::gyro_full_scale_dps)),
+      fields::number<R>("table_accel", "dps2", &R::table_accel_dps2),
+      fields::number<R>("remount", "s", &R::remount_s),
+      fields::text<R>("method", &R::method),
   };
-  num("rate_dps", p.rate_dps);
-  num("segment_s", p.segment_s);
-  num("half_period_s", p.half_period_s);
-  num("settle_s", p.settle_s);
-  num("gap_s", p.gap_s);
-  num("start_s", p.start_s);
-  num("gyro_full_scale_dps", p.gyro_full_scale_dps);
-  num("table_accel_dps2", r.table_accel_dps2);
-  num("remount_s", r.remount_s);
-  if (n["method"]) r.method = as_string(n["method"], file, "calibration.method");
-  if (const auto o = n["orientations"]) {
-    if (!o.IsSequence()) fail(file, o, "calibration.orientations", "expected a list such as [XY, YZ, XZ]");
-    p.orientations.clear();
-    for (const auto& x : o) p.orientations.push_back(as_string(x, file, "calibration.orientations"));
-  }
-  with_location(file, line_of(n), "calibration", [&] { r.validate(); });
+  return t;
+}
+
+RigParams parse_rig(const fields::Node& n, const std::string& file) {
+  RigParams r;
+  r.procedure.gap_s = 8.0;
+  fields::read_block(rig_table(), r, n, fields::Context{file, "calibration"});
+  with_location(file, n.line, "calibration", [&] { r.validate(); });
   return r;
 }
 
@@ -297,32 +289,24 @@ void RigParams::validate() const {
 
 CalibScenario load_calib_scenario(const std::filesystem::path& path) {
   const std::string file = path.string();
-  std::string text = read_text(path);
-  YAML::Node root;
-  try {
-    root = YAML::Load(text);
-  } catch (const YAML::Exception& e) {
-    throw InputError(file, static_cast<std::size_t>(e.mark.line) + 1, "", "broken YAML: " + e.msg);
-  }
-  if (!root.IsMap() || !root["calibration"]) {
+  const std::string text = read_text(path);
+  const fields::Node root = twin::parse_yaml(text, file);
+  const fields::Node* block = root.is_map() ? root.find("calibration") : nullptr;
+  if (block == nullptr) {
     throw InputError(file, 0, "", "no `calibration:` block: not a calibration scenario "
                                   "(see models/scenarios/calibration.yaml, docs/calibration.md)");
   }
   CalibScenario cs;
-  cs.rig = parse_rig(root["calibration"], file);
+  cs.rig = parse_rig(*block, file);
   // hand the rest to the scenario parser with the calibration lines blanked (line numbers kept)
-  int first = -1, next = 1 << 30;
-  for (const auto& kv : root) {
-    const int line = kv.first.Mark().line;
-    if (kv.first.Scalar() == "calibration") first = line;
-  }
-  for (const auto& kv : root) {
-    const int line = kv.first.Mark().line;
-    if (line > first) next = std::min(next, line);
-  }
+  std::size_t first = 0, next = SIZE_MAX;
+  for (const auto& e : root.entries)
+    if (e.key == "calibration") first = e.line;
+  for (const auto& e : root.entries)
+    if (e.line > first) next = std::min(next, e.line);
   std::istringstream in(text);
   std::string out, l;
-  for (int i = 0; std::getline(in, l); ++i) out += (i >= first && i < next ? std::string() : l) + "\n";
+  for (std::size_t line = 1; std::getline(in, l); ++line) out += (line >= first && line < next ? std::string() : l) + "\n";
   cs.scenario = parse_scenario(out, file, path.parent_path());
   cs.rig.procedure.start_s = std::max(cs.rig.procedure.start_s, 1.0);
   return cs;

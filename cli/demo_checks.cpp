@@ -1,5 +1,6 @@
 #include "cli/demo_checks.hpp"
 
+#include <charconv>
 #include <cmath>
 #include <fstream>
 
@@ -9,9 +10,10 @@
 #include <unistd.h>
 
 #include <fmt/core.h>
-#include <yaml-cpp/yaml.h>
 
+#include "estimator/fields.hpp"
 #include "estimator/log.hpp"
+#include "twin/yaml_doc.hpp"
 
 namespace driftless::cli {
 
@@ -19,24 +21,35 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// a JSON file read back (JSON is YAML); a null node when it cannot be read
-YAML::Node load_json(const fs::path& p, std::string& why) {
+using fields::Node;
+
+// a JSON file read back through the YAML reader (JSON is YAML); a null node when it cannot be read
+Node load_json(const fs::path& p, std::string& why) {
   try {
-    return YAML::LoadFile(p.string());
+    return twin::load_yaml_file(p);
   } catch (const std::exception& e) {
-    why = fmt::format("cannot read {}: {}", p.string(), e.what());
-    return YAML::Node();
+    why = e.what();
+    return Node{};
   }
 }
 
-double number(const YAML::Node& n) {
-  if (!n || !n.IsScalar() || n.Scalar() == "null") return kNaN;
-  try {
-    return n.as<double>();
-  } catch (const YAML::Exception&) {
-    return kNaN;
-  }
+// the value under `key` of a map, or a null node: a JSON field the check reads leniently
+const Node& at(const Node& n, std::string_view key) {
+  static const Node kNone;
+  const Node* v = n.is_map() ? n.find(key) : nullptr;
+  return v != nullptr ? *v : kNone;
 }
+
+// a number, NaN when the field is missing, null or not a number
+double number(const Node& n) {
+  if (!n.is_scalar()) return kNaN;
+  double v = kNaN;
+  const char* b = n.text.data();
+  const auto [ptr, ec] = std::from_chars(b, b + n.text.size(), v);
+  return ec == std::errc() && ptr == b + n.text.size() ? v : kNaN;
+}
+
+std::string text(const Node& n) { return n.is_scalar() ? n.text : std::string(); }
 
 // runs a program (looked up on PATH) and returns its standard output; false when it failed
 bool capture(const std::vector<std::string>& args, std::string& out) {
@@ -98,50 +111,52 @@ OutputCheck check_log(const fs::path& log, std::uint64_t expected_rows) {
 std::vector<OutputCheck> check_estimate(const fs::path& dir) {
   const fs::path summary = dir / "summary.json";
   std::string why;
-  const YAML::Node j = load_json(summary, why);
+  const Node j = load_json(summary, why);
   OutputCheck lock{summary, "the DriftLess filter locked on (every bias sigma below the lock level)", false, {}};
   OutputCheck att{dir / "attitude.csv", "the attitude comparison with and without DriftLess, from lock", false, {}};
-  if (!j) {
-    lock.detail = att.detail = why;
+  if (!j.is_map()) {
+    lock.detail = att.detail = why.empty() ? summary.string() + ": not a JSON object" : why;
     return {lock, att};
   }
-  const double start = number(j["attitude_start_s"]);
+  const double start = number(at(j, "attitude_start_s"));
   double sigma_max = 0.0;
-  for (const auto& v : j["final_sigma_dps"]) sigma_max = std::max(sigma_max, number(v));
+  for (const auto& v : at(j, "final_sigma_dps").items) sigma_max = std::max(sigma_max, number(v));
   lock.ok = std::isfinite(start);
   lock.detail = lock.ok ? fmt::format("locked at t = {:.1f} s", start)
                         : fmt::format("never locked: after {} updates in {:.0f} s the largest bias sigma is {:.3g} deg/s; "
                                       "a few minutes of flips are needed (each update sees one pair of positions)",
-                                      number(j["updates"]), number(j["t_last_s"]) - number(j["t_first_s"]), sigma_max);
+                                      number(at(j, "updates")), number(at(j, "t_last_s")) - number(at(j, "t_first_s")), sigma_max);
   // the estimate's own health verdict (docs/estimator.md 6.1): a degraded filter still locked,
   // but the demo says so with the cause instead of a bare "ok"
-  const YAML::Node health = j["health"];
-  if (lock.ok && health && health["verdict"] && health["verdict"].as<std::string>() != "ok") {
-    lock.detail += "; health " + health["verdict"].as<std::string>();
-    if (health["findings"] && health["findings"].size() > 0) lock.detail += ": " + health["findings"][0]["text"].as<std::string>();
+  const std::string verdict = text(at(at(j, "health"), "verdict"));
+  if (lock.ok && !verdict.empty() && verdict != "ok") {
+    lock.detail += "; health " + verdict;
+    const auto& findings = at(at(j, "health"), "findings").items;
+    if (!findings.empty()) lock.detail += ": " + text(at(findings[0], "text"));
   }
-  const double drift = number(j["attitude_drift_deg_per_h"]["with_driftless"]);
+  const double drift = number(at(at(j, "attitude_drift_deg_per_h"), "with_driftless"));
   att.ok = lock.ok && std::isfinite(drift);
   att.detail = att.ok ? fmt::format("drift {:.2f} deg/h with DriftLess, {:.2f} deg/h with the bias fixed at lock", drift,
-                                    number(j["attitude_drift_deg_per_h"]["bias_fixed_at_start"]))
+                                    number(at(at(j, "attitude_drift_deg_per_h"), "bias_fixed_at_start")))
                       : "no comparison: it starts when the filter locks on";
   return {lock, att};
 }
 
 std::vector<OutputCheck> check_figures(const fs::path& dir) {
   std::string why;
-  const YAML::Node j = load_json(dir / "summary.json", why);
+  const Node j = load_json(dir / "summary.json", why);
   std::vector<OutputCheck> out;
-  if (!j || !j["figures"] || j["figures"].size() == 0) {
-    out.push_back({dir / "fig4_bias.png", "the paper's figures", false, j ? "summary.json lists no figures" : why});
+  const auto& figures = at(j, "figures").items;
+  if (figures.empty()) {
+    out.push_back({dir / "fig4_bias.png", "the paper's figures", false, j.is_map() ? "summary.json lists no figures" : why});
     return out;
   }
-  for (const auto& f : j["figures"]) {
-    const std::string stem = f["name"].as<std::string>();
+  for (const auto& f : figures) {
+    const std::string stem = text(at(f, "name"));
     OutputCheck c{dir / (stem + ".png"), fmt::format("{} (PNG + SVG, gnuplot script beside)", stem), false, {}};
     const auto [w, h] = png_size(c.path);
-    if (!f["written"].as<bool>()) {
-      c.detail = "not drawn: " + f["reason"].as<std::string>();
+    if (text(at(f, "written")) != "true") {
+      c.detail = "not drawn: " + text(at(f, "reason"));
     } else if (w <= 0) {
       c.detail = "summary.json says drawn, but there is no PNG picture";
     } else {
@@ -158,9 +173,9 @@ OutputCheck check_report(const fs::path& dir) {
   std::ifstream in(c.path, std::ios::binary);
   const std::string html((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   std::string why;
-  const YAML::Node d = load_json(dir / "diagnosis.json", why);
+  const Node d = load_json(dir / "diagnosis.json", why);
   const bool whole = html.rfind("</html>") != std::string::npos;
-  const std::string verdict = d && d["verdict"] ? d["verdict"].as<std::string>() : std::string();
+  const std::string verdict = text(at(d, "verdict"));
   c.ok = whole && !verdict.empty();
   c.detail = !whole ? "report.html is missing or cut off" : verdict.empty() ? "diagnosis.json names no verdict: " + why
                                                                              : "verdict: " + verdict;
@@ -171,12 +186,13 @@ OutputCheck check_video(const fs::path& video, std::uint64_t min_frames) {
   OutputCheck c{video, "the rendered video", false, {}};
   std::string why;
   const fs::path sidecar = fs::path(video).replace_extension(".json");
-  const YAML::Node claim = load_json(sidecar, why);
-  if (!claim) {
+  const Node claim = load_json(sidecar, why);
+  if (!claim.is_map()) {
     c.detail = "no " + sidecar.filename().string() + " from the renderer: " + why;
     return c;
   }
-  const auto frames = claim["frames"].as<std::uint64_t>(0);
+  const double frames_claimed = number(at(claim, "frames"));
+  const auto frames = std::isfinite(frames_claimed) && frames_claimed >= 0 ? static_cast<std::uint64_t>(frames_claimed) : 0;
   std::string out;
   if (!capture({"ffprobe", "-v", "error", "-count_frames", "-select_streams", "v:0", "-show_entries",
                 "stream=nb_read_frames,width,height", "-of", "csv=p=0", video.string()},
@@ -189,7 +205,7 @@ OutputCheck check_video(const fs::path& video, std::uint64_t min_frames) {
   long n = -1;
   std::sscanf(out.c_str(), "%d,%d,%ld", &w, &h, &n);
   c.ok = n >= 0 && static_cast<std::uint64_t>(n) == frames && frames >= min_frames &&
-         w == claim["width"].as<int>(0) && h == claim["height"].as<int>(0);
+         w == number(at(claim, "width")) && h == number(at(claim, "height"));
   c.detail = fmt::format("decodes to {} frames of {}x{} px (the renderer wrote {}; at least {} expected)", n, w, h,
                          frames, min_frames);
   return c;

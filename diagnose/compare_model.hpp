@@ -9,7 +9,6 @@
 #include <vector>
 
 #include <Eigen/Core>
-#include <yaml-cpp/yaml.h>
 
 #include "diagnose/replay.hpp"
 #include "twin/scenario.hpp"

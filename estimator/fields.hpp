@@ -13,11 +13,13 @@
 //   fields::Node n = fields::write_block(motor_table(), motor);  // emit, every value explicit
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <initializer_list>
 #include <iosfwd>
+#include <limits>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -152,17 +154,35 @@ void read_key(const Table<T>& rows, T& obj, const std::string& key, const Node& 
 }
 
 /// Reads a map into obj: every key must be a row's (or one of `extra`, which the caller handles).
+/// Returns which rows the map gave (by row index), for `require`.
 template <class T>
-void read_block(const Table<T>& rows, T& obj, const Node& map, const Context& ctx,
-                std::initializer_list<std::string_view> extra = {}) {
+std::vector<bool> read_block(const Table<T>& rows, T& obj, const Node& map, const Context& ctx,
+                             std::initializer_list<std::string_view> extra = {}) {
   if (!map.is_map()) ctx.fail(map, ctx.path, "expected a mapping (key: value lines)");
   const auto specs = key_specs(rows);
+  std::vector<bool> given(rows.size(), false);
   for (const auto& e : map.entries) {
     bool skip = false;
     for (auto x : extra) skip = skip || e.key == x;
     if (skip) continue;
     const Resolved res = resolve_key(specs, e.key, ctx, Node::at_line(e.line), extra);
     rows[res.row].read(obj, e.value, Reading{ctx.child(e.key), res.scale, res.unit});
+    given[res.row] = true;
+  }
+  return given;
+}
+
+/// Throws InputError "missing" naming the first row of `keys` (canonical keys) that `given`
+/// (read_block's answer) does not hold; `map` points the error at the block's line.
+template <class T>
+void require(const Table<T>& rows, const std::vector<bool>& given, const Node& map, const Context& ctx,
+             const std::vector<std::string>& keys) {
+  for (const auto& k : keys) {
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      if (rows[i].key() == k && !(i < given.size() && given[i])) {
+        ctx.fail(map, ctx.key(k), "missing (this block needs " + k + ")");
+      }
+    }
   }
 }
 
@@ -289,6 +309,23 @@ Row<T> integer_list(std::string stem, Acc acc, std::int64_t lo, std::int64_t hi)
           }};
 }
 
+/// A list of text values [a, b, c].
+template <class T, class Acc>
+Row<T> text_list(std::string stem, Acc acc) {
+  return {std::move(stem), "",
+          [acc](T& o, const Node& n, const Reading& r) mutable {
+            if (!n.is_list()) r.fail(n, "expected a list [a, b, ...]");
+            auto& v = detail::at(acc, o);
+            v.clear();
+            for (const auto& x : n.items) v.push_back(read_text(x, r));
+          },
+          [acc](const T& o) mutable -> std::optional<Node> {
+            std::vector<Node> items;
+            for (const auto& x : detail::at(acc, o)) items.push_back(Node::scalar(x));
+            return Node::list(std::move(items));
+          }};
+}
+
 /// An enumeration written as a name: `names` lists {name, value} pairs.
 template <class E>
 using Names = std::vector<std::pair<std::string, E>>;
@@ -321,14 +358,77 @@ Row<T> choice(std::string stem, Acc acc, Names<E> names) {
           }};
 }
 
-/// A nested block read and written through its own table.
+/// A nested block read and written through its own table; `required` lists the keys it must give.
 template <class T, class Acc, class S>
-Row<T> block(std::string stem, Acc acc, const Table<S>& (*table)()) {
+Row<T> block(std::string stem, Acc acc, const Table<S>& (*table)(), std::vector<std::string> required = {}) {
   return {std::move(stem), "",
-          [acc, table](T& o, const Node& n, const Reading& r) mutable {
-            read_block(table(), detail::at(acc, o), n, r.ctx);
+          [acc, table, required](T& o, const Node& n, const Reading& r) mutable {
+            const auto given = read_block(table(), detail::at(acc, o), n, r.ctx);
+            require(table(), given, n, r.ctx, required);
           },
           [acc, table](const T& o) mutable -> std::optional<Node> { return write_block(table(), detail::at(acc, o)); }};
+}
+
+/// A list of blocks [{...}, {...}], each read through `table` into a fresh S; written one item a
+/// line, each item a flow map.
+template <class T, class Acc, class S>
+Row<T> block_list(std::string stem, Acc acc, const Table<S>& (*table)()) {
+  return {std::move(stem), "",
+          [acc, table](T& o, const Node& n, const Reading& r) mutable {
+            if (!n.is_list()) r.fail(n, "expected a list of blocks ({key: value, ...} items)");
+            auto& v = detail::at(acc, o);
+            v.clear();
+            for (std::size_t i = 0; i < n.items.size(); ++i) {
+              v.emplace_back();
+              read_block(table(), v.back(), n.items[i], Context{r.ctx.file, r.ctx.path + "[" + std::to_string(i) + "]"});
+            }
+          },
+          [acc, table](const T& o) mutable -> std::optional<Node> {
+            std::vector<Node> items;
+            for (const auto& x : detail::at(acc, o)) items.push_back(write_block(table(), x, true));
+            return Node::list(std::move(items), false);
+          }};
+}
+
+/// A number that may be `null` (read as NaN; NaN is written as null): a value not known.
+template <class T, class Acc>
+Row<T> number_or_null(std::string stem, std::string unit, Acc acc) {
+  return {std::move(stem), std::move(unit),
+          [acc](T& o, const Node& n, const Reading& r) mutable {
+            detail::at(acc, o) = n.is_null() ? std::numeric_limits<double>::quiet_NaN() : read_number(n, r);
+          },
+          [acc](const T& o) mutable -> std::optional<Node> {
+            const double v = detail::at(acc, o);
+            return std::isfinite(v) ? detail::number_node(v) : Node{};
+          }};
+}
+
+/// An optional row: reading it sets the flag `has`, and it is written only when the flag is set.
+/// Rows that are always given together may share one flag.
+template <class T, class Flag>
+Row<T> optional_row(Row<T> row, Flag has) {
+  auto read = row.read;
+  auto write = row.write;
+  row.read = [read, has](T& o, const Node& n, const Reading& r) mutable {
+    read(o, n, r);
+    detail::at(has, o) = true;
+  };
+  row.write = [write, has](const T& o) mutable -> std::optional<Node> {
+    if (!detail::at(has, o)) return std::nullopt;
+    return write(o);
+  };
+  return row;
+}
+
+/// A row written only when `when(obj)` holds (read as usual).
+template <class T>
+Row<T> written_if(Row<T> row, std::function<bool(const T&)> when) {
+  auto write = row.write;
+  row.write = [write, when](const T& o) -> std::optional<Node> {
+    if (!when(o)) return std::nullopt;
+    return write(o);
+  };
+  return row;
 }
 
 /// A row with its own reader and writer (a block of a shape the factories do not cover).

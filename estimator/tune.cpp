@@ -3,6 +3,10 @@
 #include <algorithm>
 #include <cmath>
 
+#include <Eigen/QR>
+
+#include "estimator/stats.hpp"
+
 namespace driftless::est {
 namespace {
 
@@ -33,20 +37,45 @@ void NoiseTuner::push(const Sample& s) {
   for (int i = 0; i < st.closed; ++i) use_piece(detector_.closed(i));
 }
 
+// a fit needs this many pairs per coefficient, or the position pair's noise is taken unfitted
+constexpr std::uint64_t kPairsPerCoefficient = 4;
+// a motion fit is used when noise alone would remove as much in 1 position pair of 1000
+constexpr double kMotionFitSignificance = 0.999;
+
+// the block's fused body rate and specific force in box axes (zero force without accel columns:
+// that coefficient is then not identified and the rank-revealing solve drops it)
+NoiseTuner::Regressors NoiseTuner::regressors(const StandstillSegment& seg) const {
+  const Eigen::Matrix3d M1 = geometry_.body_from_sensor(1, seg.plat1_deg);
+  const Eigen::Matrix3d M2 = geometry_.body_from_sensor(2, seg.plat2_deg);
+  Regressors x = Regressors::Zero();
+  x.head<3>() = 0.5 * (M1 * seg.mean_gyro1_dps() + M2 * seg.mean_gyro2_dps());
+  if (seg.n_accel > 0) {
+    x.tail<3>() = 0.5 * (M1 * seg.sum_accel1_mps2 + M2 * seg.sum_accel2_mps2) / double(seg.n_accel);
+  }
+  return x;
+}
+
 // one block: a noise pair with the previous block of the same standstill, and part of the visit
 void NoiseTuner::use_piece(const StandstillSegment& seg) {
   if (seg.n == 0) return;
   if (!std::isfinite(rate_hz_)) rate_hz_ = detector_.rate_hz(seg);
   const Eigen::Vector3d r = geometry_.body_from_sensor(1, seg.plat1_deg) * seg.mean_gyro1_dps() -
                             geometry_.body_from_sensor(2, seg.plat2_deg) * seg.mean_gyro2_dps();
+  const Regressors x = regressors(seg);
   const std::pair<long, long> key{tenth_deg(seg.plat1_deg), tenth_deg(seg.plat2_deg)};
   const bool same_standstill = have_block_ && seg.t_rest_s == block_rest_s_ && key == visit_key_;
-  if (same_standstill) {
-    // E|r_a - r_b|^2 = 6 sigma^2 (1/n_a + 1/n_b): two sensors, three axes each
-    noise_sq_ += (r - block_r_).squaredNorm();
-    noise_w_ += 6.0 * (1.0 / double(seg.n) + 1.0 / double(block_n_));
+  if (same_standstill && x.allFinite() && block_x_.allFinite()) {
+    // weighted so that each pair's noise has the same variance: 6 sigma^2 in |dr|^2
+    const double w = 1.0 / (1.0 / double(seg.n) + 1.0 / double(block_n_));
+    const Eigen::Vector3d dr = r - block_r_;
+    const Regressors dx = x - block_x_;
+    MotionFit& m = motion_[key];
+    m.xx += w * dx * dx.transpose();
+    m.xr += w * dx * dr.transpose();
+    m.rr += w * dr.squaredNorm();
+    ++m.pairs;
     ++noise_pairs_;
-  } else {
+  } else if (!same_standstill) {
     close_visit();
     visit_key_ = key;
   }
@@ -54,11 +83,13 @@ void NoiseTuner::use_piece(const StandstillSegment& seg) {
   block_rest_s_ = seg.t_rest_s;
   block_n_ = seg.n;
   block_r_ = r;
-  // the visit's mean residual and its midpoint (weighted by samples)
+  block_x_ = x;
+  // the visit's mean residual and regressors, and its midpoint (weighted by samples)
   const double t_mid = 0.5 * (seg.t_first_s + seg.t_last_s);
   visit_.t_mid_s = visit_.n == 0 ? t_mid : (visit_.t_mid_s * double(visit_.n) + t_mid * double(seg.n)) /
                                                double(visit_.n + seg.n);
   visit_.r_sum += r * double(seg.n);
+  visit_.x_sum += x * double(seg.n);
   visit_.n += seg.n;
 }
 
@@ -68,11 +99,40 @@ void NoiseTuner::close_visit() {
   auto it = last_visit_.find(visit_key_);
   if (it != last_visit_.end()) {
     const Visit& a = it->second;
-    const Eigen::Vector3d d = visit_.r_sum / double(visit_.n) - a.r_sum / double(a.n);
-    wander_.push_back({d.squaredNorm(), visit_.t_mid_s - a.t_mid_s, 1.0 / double(visit_.n) + 1.0 / double(a.n)});
+    wander_.push_back({visit_.r_sum / double(visit_.n) - a.r_sum / double(a.n),
+                       visit_.x_sum / double(visit_.n) - a.x_sum / double(a.n), visit_key_,
+                       visit_.t_mid_s - a.t_mid_s, 1.0 / double(visit_.n) + 1.0 / double(a.n)});
   }
   last_visit_[visit_key_] = visit_;
   visit_ = Visit{};
+}
+
+// least squares of the pairs' dr on dx; the rank decides how many coefficients the noise pays for
+void NoiseTuner::MotionFit::solve() {
+  ss = rr;
+  dof = 3.0 * double(pairs);
+  if (pairs < kPairsPerCoefficient * 6) return;
+  // scale the columns so that the rank threshold compares like with like (rates and forces)
+  Eigen::Matrix<double, 6, 1> scale;
+  for (int i = 0; i < 6; ++i) scale[i] = xx(i, i) > 0.0 ? 1.0 / std::sqrt(xx(i, i)) : 0.0;
+  const Eigen::Matrix<double, 6, 6> a = scale.asDiagonal() * xx * scale.asDiagonal();
+  Eigen::CompleteOrthogonalDecomposition<Eigen::Matrix<double, 6, 6>> cod;
+  cod.setThreshold(1e-9);
+  cod.compute(a);
+  const auto rank = static_cast<std::uint64_t>(cod.rank());
+  if (rank == 0 || rank >= pairs) return;
+  const Eigen::Matrix<double, 6, 3> c = scale.asDiagonal() * cod.solve(scale.asDiagonal() * xr);
+  const double ss_fit = std::max(rr - (xr.transpose() * c).trace(), 0.0);
+  const double dof_fit = 3.0 * double(pairs - rank);
+  // what the fit removed against what noise alone removes: chi-square with 3 rank dof, scaled by
+  // the noise variance measured in what is left
+  const double removed = (rr - ss_fit) / (ss_fit / dof_fit);
+  if (!(removed > chi2_quantile(kMotionFitSignificance, 3.0 * double(rank)))) return;
+  fitted = true;
+  coef = c;
+  xx_inv = scale.asDiagonal() * cod.pseudoInverse() * scale.asDiagonal();
+  ss = ss_fit;
+  dof = dof_fit;
 }
 
 TuneResult NoiseTuner::finish() {
@@ -82,16 +142,29 @@ TuneResult NoiseTuner::finish() {
   t.block_s = limits_.block_s;
   t.sample_rate_hz = rate_hz_;
   t.noise_block_pairs = noise_pairs_;
-  if (noise_pairs_ < limits_.min_noise_block_pairs || !(noise_w_ > 0.0) || !std::isfinite(rate_hz_)) return t;
-  const double sigma2 = noise_sq_ / noise_w_;  // (deg/s)^2 per sample and axis
+  double ss = 0.0, dof = 0.0;
+  for (auto& [key, m] : motion_) {
+    m.solve();
+    ss += m.ss;
+    dof += m.dof;
+  }
+  if (noise_pairs_ < limits_.min_noise_block_pairs || !(dof > 0.0) || !std::isfinite(rate_hz_)) return t;
+  const double sigma2 = ss / (2.0 * dof);  // (deg/s)^2 per sample and axis: E[SS] = 2 sigma^2 dof
   t.noise_estimated = sigma2 > 0.0;
   t.noise_density_dps_rthz = std::sqrt(sigma2 / rate_hz_);
-  // K^2 = sum(|dr|^2 - 6 sigma^2 w) / sum(6 dt)
+  // K^2 = sum(|dr - coef^T dx|^2 - 6 sigma^2 w) / sum(6 dt)
   t.wander_pairs = wander_.size();
   if (wander_.size() < limits_.min_wander_pairs) return t;
   double num = 0.0, den = 0.0;
   for (const auto& p : wander_) {
-    num += p.sq - 6.0 * sigma2 * p.inv_n;
+    const auto m = motion_.find(p.key);
+    Eigen::Vector3d motion = Eigen::Vector3d::Zero();
+    double coef_error = 0.0;  // E|(coef - true)^T dx|^2 = 6 sigma^2 dx^T (X^T W X)^-1 dx
+    if (m != motion_.end() && m->second.fitted) {
+      motion = m->second.coef.transpose() * p.dx;
+      coef_error = 6.0 * sigma2 * p.dx.dot(m->second.xx_inv * p.dx);
+    }
+    num += (p.dr - motion).squaredNorm() - 6.0 * sigma2 * p.inv_n - coef_error;
     den += 6.0 * p.dt_s;
   }
   if (den > 0.0 && num > 0.0) {

@@ -3,11 +3,18 @@
 // sensor the defaults do not describe (another MEMS part, 10x the MPU6050's noise) needs no
 // hand-written configuration.
 //  - noise density N: every standstill is cut into blocks of block_s; the eq. (2) residual
-//    r = M1 y1 - M2 y2 (body rate and Earth rate cancel) of consecutive blocks differs only by
-//    noise, E|r_a - r_b|^2 = 6 sigma^2 (1/n_a + 1/n_b) with sigma^2 = N^2 f_s per sample and axis
-//    (an Allan variance of the residual at tau = block_s, where the white noise dominates);
+//    r = M1 y1 - M2 y2 (body rate and Earth rate cancel) of consecutive blocks differs by noise,
+//    E|r_a - r_b|^2 = 6 sigma^2 (1/n_a + 1/n_b) with sigma^2 = N^2 f_s per sample and axis (an
+//    Allan variance of the residual at tau = block_s, where the white noise dominates), plus, on
+//    a moving box, what its motion leaves in r through sensor errors the residual does not cancel
+//    (scale factor and misalignment times the body-rate change, g-sensitivity times the change of
+//    specific force). Per position pair that part is linear in the change of the fused body rate
+//    and of the specific force; it is fitted by least squares and the noise is measured in what
+//    is left, E[SS] = 6 sigma^2 (pairs - fitted coefficients per axis);
 //  - bias random walk K (Q = K^2 per second): visits to the same platform positions differ by the
-//    bias change plus noise, E|r_j - r_k|^2 = 6 K^2 dt + 6 sigma^2 (1/n_j + 1/n_k).
+//    bias change plus noise (and the same motion term, taken out with the same fit when the fit
+//    is significant; its coefficients' own error adds 6 sigma^2 dx^T (X^T W X)^-1 dx),
+//    E|r_j - r_k|^2 = 6 K^2 dt + 6 sigma^2 (1/n_j + 1/n_k).
 // Eigen + std only.
 #pragma once
 
@@ -51,12 +58,31 @@ class NoiseTuner {
   TuneResult finish();
 
  private:
+  // the motion regressors of a block: fused body rate (deg/s) and specific force (m/s^2), box axes
+  using Regressors = Eigen::Matrix<double, 6, 1>;
   struct Visit {
     double t_mid_s = kNaN;
     std::size_t n = 0;
     Eigen::Vector3d r_sum = Eigen::Vector3d::Zero();  // sum of n * block residual
+    Regressors x_sum = Regressors::Zero();            // sum of n * block regressors
+  };
+  // per position pair: the weighted normal equations of r_a - r_b on x_a - x_b (w = 1 / (1/n_a + 1/n_b))
+  struct MotionFit {
+    Eigen::Matrix<double, 6, 6> xx = Eigen::Matrix<double, 6, 6>::Zero();
+    Eigen::Matrix<double, 6, 3> xr = Eigen::Matrix<double, 6, 3>::Zero();
+    double rr = 0.0;
+    std::uint64_t pairs = 0;
+    // after solve(): the fit is kept only when the motion explains more of the pairs' spread
+    // than noise would (chi-square test at kMotionFitSignificance), else coef = 0 and ss = rr
+    bool fitted = false;
+    Eigen::Matrix<double, 6, 3> coef = Eigen::Matrix<double, 6, 3>::Zero();
+    Eigen::Matrix<double, 6, 6> xx_inv = Eigen::Matrix<double, 6, 6>::Zero();  // pseudo-inverse
+    double ss = 0.0;    // weighted residual sum of squares after the fit
+    double dof = 0.0;   // 3 (pairs - rank), or 3 pairs without a fit
+    void solve();
   };
   void use_piece(const StandstillSegment& seg);
+  Regressors regressors(const StandstillSegment& seg) const;
   void close_visit();
 
   TuneLimits limits_;
@@ -68,11 +94,14 @@ class NoiseTuner {
   double block_rest_s_ = kNaN;
   std::size_t block_n_ = 0;
   Eigen::Vector3d block_r_ = Eigen::Vector3d::Zero();
-  // sums of the two estimates
-  double noise_sq_ = 0.0, noise_w_ = 0.0;
+  Regressors block_x_ = Regressors::Zero();
+  std::map<std::pair<long, long>, MotionFit> motion_;  // per position pair (0.1 deg keys)
   std::uint64_t noise_pairs_ = 0;
   struct WanderPair {
-    double sq, dt_s, inv_n;
+    Eigen::Vector3d dr;
+    Regressors dx;
+    std::pair<long, long> key;
+    double dt_s, inv_n;
   };
   std::vector<WanderPair> wander_;
   // the standstill being collected, and the last visit per position pair (0.1 deg keys)

@@ -7,7 +7,6 @@
 #include <sstream>
 #include <stdexcept>
 
-#include <yaml-cpp/yaml.h>
 
 #include "estimator/numbers.hpp"
 #include "estimator/output_file.hpp"
@@ -17,6 +16,7 @@
 #include "estimator/random.hpp"
 #include "twin/simulator.hpp"
 #include "twin/fast_box.hpp"
+#include "twin/yaml_doc.hpp"
 
 namespace driftless::studies {
 
@@ -38,21 +38,20 @@ std::vector<std::string> split_path(const std::string& path) {
   return parts;
 }
 
-// writes `value` (YAML text) at the dotted path, creating maps on the way
-void set_path(YAML::Node root, const std::string& path, const YAML::Node& value) {
+// writes `value` at the dotted path of a YAML document, creating maps on the way
+void set_path(fields::Node& root, const std::string& path, fields::Node value) {
   const auto parts = split_path(path);
   if (parts.empty()) throw std::invalid_argument("sweep: empty key path");
-  std::vector<YAML::Node> chain{root};
-  for (std::size_t i = 0; i + 1 < parts.size(); ++i) {
-    YAML::Node next = chain.back()[parts[i]];
-    if (!next.IsDefined() || next.IsNull()) {
-      chain.back()[parts[i]] = YAML::Node(YAML::NodeType::Map);
-      next = chain.back()[parts[i]];
-    }
-    if (!next.IsMap()) throw std::invalid_argument("sweep: key path '" + path + "': '" + parts[i] + "' is not a map");
-    chain.push_back(next);
+  fields::Node* at = &root;
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    if (at->is_null()) *at = fields::Node::map();
+    if (!at->is_map()) throw std::invalid_argument("sweep: key path '" + path + "': '" + (i == 0 ? std::string("the top") : parts[i - 1]) + "' is not a map");
+    fields::Node* next = nullptr;
+    for (auto& e : at->entries)
+      if (e.key == parts[i]) next = &e.value;
+    at = next != nullptr ? next : &at->add(parts[i], fields::Node{});
   }
-  chain.back()[parts.back()] = value;
+  *at = std::move(value);
 }
 
 std::string number_text(double v) { return exact_number(v); }
@@ -96,7 +95,7 @@ RunSetup SetupBuilder::build(const RunSpec& spec) const {
     }
   }
   RunSetup s;
-  YAML::Node root = YAML::Load(base_yaml_);
+  fields::Node root = twin::parse_yaml(base_yaml_, "the sweep's base scenario");
   for (const auto& o : ov) {
     if (o.path.rfind("estimator.", 0) == 0) {
       set_config_value(s.estimator, o.path.substr(10), o.text);
@@ -111,13 +110,13 @@ RunSetup SetupBuilder::build(const RunSpec& spec) const {
       else if (k == "eval_start_s") s.eval_start_s = o.number;
       else throw std::invalid_argument("sweep: unknown key '" + k + "' (fault.kind, fault.sensor, fault.axis, fault.t_s, fault.size)");
     } else {
-      set_path(root, o.path, YAML::Load(o.text));
+      set_path(root, o.path, twin::parse_yaml(o.text, cfg_.file.string() + ": " + o.path));
     }
   }
-  root["seed"] = spec.seed;
-  if (cfg_.duration_s > 0) root["duration_s"] = cfg_.duration_s;
+  set_path(root, "seed", fields::Node::scalar(std::to_string(spec.seed)));
+  if (cfg_.duration_s > 0) set_path(root, "duration_s", fields::Node::scalar(exact_number(cfg_.duration_s)));
   const std::string where = cfg_.file.string() + " run " + std::to_string(spec.index);
-  s.scenario = parse_scenario(YAML::Dump(root), where, base_dir_);
+  s.scenario = parse_scenario(twin::to_yaml(root), where, base_dir_);
   s.estimator.validate();
   if (s.fault_kind < 0 || s.fault_kind > 4) throw std::invalid_argument("sweep: fault.kind must be 0..4");
   if (s.fault_sensor != 1 && s.fault_sensor != 2) throw std::invalid_argument("sweep: fault.sensor must be 1 or 2");

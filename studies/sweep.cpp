@@ -15,27 +15,15 @@
 #include <stdexcept>
 #include <thread>
 
-#include <yaml-cpp/yaml.h>
-
+#include "estimator/fields.hpp"
 #include "estimator/input_error.hpp"
 #include "estimator/numbers.hpp"
 #include "estimator/output_file.hpp"
 #include "report/gnuplot.hpp"
+#include "twin/yaml_doc.hpp"
 
 namespace driftless::studies {
 namespace {
-
-[[noreturn]] void fail(const std::string& file, const YAML::Node& n, const std::string& msg) {
-  throw InputError(file, static_cast<std::size_t>(n.Mark().line + 1), "", msg);
-}
-
-double as_double(const std::string& file, const YAML::Node& n, const std::string& key) {
-  try {
-    return n.as<double>();
-  } catch (const YAML::Exception&) {
-    fail(file, n, "'" + key + "' must be a number");
-  }
-}
 
 // a CSV number: exact, NaN as an empty field
 std::string fmt_double(double v) { return std::isnan(v) ? std::string() : exact_number(v); }
@@ -83,109 +71,209 @@ std::size_t SweepConfig::points() const {
   return n;
 }
 
+namespace {
+
+using fields::Node;
+using fields::Reading;
+using fields::Table;
+
+// a value that may be one text or a list of texts (`set: a.b` or `set: [a.b, c.d]`)
+fields::Row<std::vector<std::string>> one_or_more(const char* stem) {
+  using V = std::vector<std::string>;
+  return fields::custom<V>(
+      stem, "",
+      [](V& v, const Node& n, const Reading& r) {
+        v.clear();
+        if (!n.is_list()) return v.push_back(fields::read_text(n, r));
+        for (const auto& x : n.items) v.push_back(fields::read_text(x, r));
+      },
+      [](const V& v) -> std::optional<Node> {
+        std::vector<Node> xs;
+        for (const auto& x : v) xs.push_back(Node::scalar(x));
+        return Node::list(std::move(xs));
+      });
+}
+
+template <class T, class Acc>
+fields::Row<T> texts(const char* stem, Acc acc) {
+  const auto row = one_or_more(stem);
+  return fields::custom<T>(
+      stem, "", [row, acc](T& o, const Node& n, const Reading& r) { row.read(std::invoke(acc, o), n, r); },
+      [row, acc](const T& o) { return row.write(std::invoke(acc, o)); });
+}
+
+// a grid axis given as a map; `range: [from, to, step]` comes before `values` whatever the order
+struct AxisDoc {
+  GridAxis axis;
+  std::vector<double> range_values;
+};
+
+fields::Row<AxisDoc> range_row() {
+  return fields::custom<AxisDoc>(
+      "range", "",
+      [](AxisDoc& a, const Node& n, const Reading& r) {
+        if (!n.is_list() || n.items.size() != 3) r.fail(n, "'range' is [from, to, step]");
+        const double from = fields::read_number(n.items[0], r), to = fields::read_number(n.items[1], r),
+                     step = fields::read_number(n.items[2], r);
+        if (!(step > 0) || to < from) r.fail(n, "'range' needs step > 0 and to >= from");
+        a.range_values.clear();
+        for (double v = from; v <= to + 1e-9 * step; v += step) a.range_values.push_back(v);
+      },
+      [](const AxisDoc&) -> std::optional<Node> { return std::nullopt; });  // written as its values
+}
+
+// an axis's values: a list of numbers (also the whole axis in the short form `name: [1, 2]`)
+void read_values(AxisDoc& a, const Node& n, const Reading& r) {
+  if (!n.is_list()) r.fail(n, "grid axis '" + a.axis.name + "': values must be a list");
+  a.axis.values.clear();
+  for (const auto& x : n.items) a.axis.values.push_back(fields::read_number(x, r));
+}
+
+fields::Row<AxisDoc> values_row() {
+  return fields::custom<AxisDoc>(
+      "values", "", read_values,
+      [](const AxisDoc& a) -> std::optional<Node> {
+        std::vector<Node> xs;
+        for (double v : a.axis.values) xs.push_back(Node::scalar(exact_number(v)));
+        return Node::list(std::move(xs));
+      });
+}
+
+const Table<AxisDoc>& axis_table() {
+  using A = AxisDoc;
+  static const Table<A> t = {
+      texts<A>("set", [](auto& a) -> auto& { return a.axis.set; }),
+      values_row(),
+      range_row(),
+      fields::flag<A>("vector3", [](auto& a) -> auto& { return a.axis.vector3; }),
+      fields::flag<A>("boolean", [](auto& a) -> auto& { return a.axis.boolean; }),
+  };
+  return t;
+}
+
+// grid: {name: [values] | {set, values | range, vector3, boolean}, ...}, axes in file order
+fields::Row<SweepConfig> grid_row() {
+  return fields::custom<SweepConfig>(
+      "grid", "",
+      [](SweepConfig& c, const Node& n, const Reading& r) {
+        if (!n.is_map()) r.fail(n, "'grid' must map axis names to value lists or {set, values}");
+        for (const auto& e : n.entries) {
+          AxisDoc a;
+          a.axis.name = e.key;
+          const fields::Context ctx = r.ctx.child(e.key);
+          if (e.value.is_map()) {
+            fields::read_block(axis_table(), a, e.value, ctx);
+          } else {
+            read_values(a, e.value, Reading{ctx});
+          }
+          a.axis.values.insert(a.axis.values.begin(), a.range_values.begin(), a.range_values.end());
+          if (a.axis.set.empty()) a.axis.set.push_back(a.axis.name);
+          c.grid.push_back(std::move(a.axis));
+        }
+      },
+      [](const SweepConfig& c) -> std::optional<Node> {
+        Node m = Node::map();
+        for (const auto& ax : c.grid) m.add(ax.name, fields::write_block(axis_table(), AxisDoc{ax, {}}, true));
+        return m;
+      });
+}
+
+// fixed: {key.path: value}: each value kept as YAML text (one line), applied to every run
+fields::Row<SweepConfig> fixed_row() {
+  return fields::custom<SweepConfig>(
+      "fixed", "",
+      [](SweepConfig& c, const Node& n, const Reading& r) {
+        if (!n.is_map()) r.fail(n, "'fixed' must map key paths to values");
+        for (const auto& e : n.entries) {
+          Node v = e.value;
+          v.flow = true;
+          v.quoted = false;
+          c.fixed.emplace_back(e.key, twin::to_yaml(v));
+        }
+      },
+      [](const SweepConfig& c) -> std::optional<Node> {
+        if (c.fixed.empty()) return std::nullopt;
+        Node m = Node::map();
+        for (const auto& [k, v] : c.fixed) m.add(k, twin::parse_yaml(v, "fixed." + k));
+        return m;
+      });
+}
+
+const Table<PlotSpec>& plot_table() {
+  using P = PlotSpec;
+  static const Table<P> t = {
+      fields::text<P>("x", &P::x),
+      texts<P>("y", &P::y),
+      fields::text<P>("series", &P::series, false, true),
+      fields::flag<P>("logx", &P::logx),
+      fields::flag<P>("logy", &P::logy),
+  };
+  return t;
+}
+
+// plots: one plot map or a list of them (`plot:` is the same key)
+fields::Row<SweepConfig> plots_row(const char* stem) {
+  return fields::custom<SweepConfig>(
+      stem, "",
+      [](SweepConfig& c, const Node& n, const Reading& r) {
+        const std::vector<Node> one{n};
+        const std::vector<Node>& items = n.is_map() ? one : n.items;
+        if (!n.is_map() && !n.is_list()) r.fail(n, "expected a plot {x, y, ...} or a list of them");
+        for (std::size_t i = 0; i < items.size(); ++i) {
+          const fields::Context ctx{r.ctx.file, r.ctx.path + (n.is_map() ? "" : "[" + std::to_string(i) + "]")};
+          PlotSpec p;
+          const auto given = fields::read_block(plot_table(), p, items[i], ctx);
+          fields::require(plot_table(), given, items[i], ctx, {"x"});
+          c.plots.push_back(std::move(p));
+        }
+      },
+      [](const SweepConfig& c) -> std::optional<Node> {
+        std::vector<Node> xs;
+        for (const auto& p : c.plots) xs.push_back(fields::write_block(plot_table(), p, true));
+        return Node::list(std::move(xs), false);
+      });
+}
+
+const Table<SweepConfig>& sweep_table() {
+  using C = SweepConfig;
+  static const Table<C> t = {
+      fields::text<C>("name", &C::name),
+      fields::text<C>("description", &C::description, false, true),
+      fields::text<C>("runner", &C::runner),
+      fields::custom<C>(
+          "scenario", "", [](C& c, const Node& n, const Reading& r) { c.scenario = fields::read_text(n, r); },
+          [](const C& c) -> std::optional<Node> {
+            if (c.scenario.empty()) return std::nullopt;
+            return Node::scalar(c.scenario.string());
+          }),
+      fields::number<C>("duration", "s", &C::duration_s),
+      fields::integer<C>("monte_carlo", &C::monte_carlo, 1, 1000000),
+      fields::integer<C>("seed", &C::seed, 0, INT64_MAX),
+      grid_row(),
+      fixed_row(),
+      fields::written_if<C>(plots_row("plot"), [](const C&) { return false; }),  // read as plots
+      plots_row("plots"),
+  };
+  return t;
+}
+
+}  // namespace
+
 SweepConfig parse_sweep(const std::string& yaml_text, const std::string& file,
                         const std::filesystem::path& base_dir) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml_text);
-  } catch (const YAML::Exception& e) {
-    throw InputError(file, static_cast<std::size_t>(e.mark.line) + 1, "", "broken YAML: " + e.msg);
-  }
-  if (!root.IsMap()) throw InputError(file, 0, "", "a sweep file is a YAML map (docs/sweep.md)");
+  const Node root = twin::parse_yaml(yaml_text, file);
+  if (!root.is_map()) throw InputError(file, root.line, "", "a sweep file is a YAML map (docs/sweep.md)");
   SweepConfig c;
   c.file = file;
-  static const std::set<std::string> known = {"name",  "description", "runner", "scenario",
-                                              "duration_s", "monte_carlo", "seed", "grid",
-                                              "fixed", "plot", "plots"};
-  for (const auto& kv : root) {
-    const auto key = kv.first.as<std::string>();
-    if (!known.count(key)) {
-      fail(file, kv.first, "unknown key '" + key +
-                               "' (expected name, description, runner, scenario, duration_s, "
-                               "monte_carlo, seed, grid, fixed, plots)");
-    }
-  }
-  c.name = root["name"] ? root["name"].as<std::string>() : std::filesystem::path(file).stem().string();
-  if (root["description"]) c.description = root["description"].as<std::string>();
-  if (root["runner"]) c.runner = root["runner"].as<std::string>();
-  if (root["scenario"]) {
-    const auto s = root["scenario"].as<std::string>();
-    const std::filesystem::path p(s);
-    // a bare word without a suffix is a built-in scenario name
-    c.scenario = (p.has_extension() && p.is_relative()) ? base_dir / p : p;
-  }
-  if (root["duration_s"]) c.duration_s = as_double(file, root["duration_s"], "duration_s");
-  if (root["monte_carlo"]) c.monte_carlo = static_cast<int>(as_double(file, root["monte_carlo"], "monte_carlo"));
-  if (root["seed"]) c.seed = static_cast<std::uint64_t>(as_double(file, root["seed"], "seed"));
-  if (const auto g = root["grid"]) {
-    if (!g.IsMap()) fail(file, g, "'grid' must map axis names to value lists or {set, values}");
-    for (const auto& kv : g) {
-      GridAxis a;
-      a.name = kv.first.as<std::string>();
-      // copy-construct (yaml-cpp's Node::operator= would write into the referenced node)
-      const YAML::Node vals = kv.second.IsMap() ? YAML::Node(kv.second["values"]) : kv.second;
-      if (kv.second.IsMap()) {
-        if (const auto s = kv.second["set"]) {
-          if (s.IsSequence()) {
-            for (const auto& x : s) a.set.push_back(x.as<std::string>());
-          } else {
-            a.set.push_back(s.as<std::string>());
-          }
-        }
-        if (kv.second["vector3"]) a.vector3 = kv.second["vector3"].as<bool>();
-        if (kv.second["boolean"]) a.boolean = kv.second["boolean"].as<bool>();
-        if (const auto r = kv.second["range"]) {  // {range: [from, to, step]}
-          if (!r.IsSequence() || r.size() != 3) fail(file, r, "'range' is [from, to, step]");
-          const double from = as_double(file, r[0], "range"), to = as_double(file, r[1], "range"),
-                       step = as_double(file, r[2], "range");
-          if (!(step > 0) || to < from) fail(file, r, "'range' needs step > 0 and to >= from");
-          for (double v = from; v <= to + 1e-9 * step; v += step) a.values.push_back(v);
-        }
-      }
-      if (vals) {
-        if (!vals.IsSequence()) fail(file, kv.second, "grid axis '" + a.name + "': values must be a list");
-        for (const auto& v : vals) a.values.push_back(as_double(file, v, a.name));
-      }
-      if (a.set.empty()) a.set.push_back(a.name);
-      c.grid.push_back(std::move(a));
-    }
-  }
-  if (const auto f = root["fixed"]) {
-    if (!f.IsMap()) fail(file, f, "'fixed' must map key paths to values");
-    for (const auto& kv : f) {
-      YAML::Emitter e;
-      e << YAML::Flow << kv.second;
-      c.fixed.emplace_back(kv.first.as<std::string>(), e.c_str());
-    }
-  }
-  const YAML::Node given = root["plots"] ? root["plots"] : root["plot"];
-  if (given) {
-    YAML::Node plots(YAML::NodeType::Sequence);
-    if (given.IsMap()) {
-      plots.push_back(given);
-    } else {
-      for (const auto& p : given) plots.push_back(p);
-    }
-    for (const auto& p : plots) {
-      PlotSpec s;
-      if (!p["x"]) fail(file, p, "a plot needs 'x' (a grid axis)");
-      s.x = p["x"].as<std::string>();
-      if (p["y"]) {
-        if (p["y"].IsSequence()) {
-          for (const auto& y : p["y"]) s.y.push_back(y.as<std::string>());
-        } else {
-          s.y.push_back(p["y"].as<std::string>());
-        }
-      }
-      if (p["series"]) s.series = p["series"].as<std::string>();
-      if (p["logx"]) s.logx = p["logx"].as<bool>();
-      if (p["logy"]) s.logy = p["logy"].as<bool>();
-      c.plots.push_back(std::move(s));
-    }
-  }
+  c.name = std::filesystem::path(file).stem().string();
+  fields::read_block(sweep_table(), c, root, fields::Context{file, ""});
+  // a bare word without a suffix is a built-in scenario name; a file is relative to the sweep's
+  if (c.scenario.has_extension() && c.scenario.is_relative()) c.scenario = base_dir / c.scenario;
   with_location("", 0, "", [&] { c.validate(); });  // validate() names the file itself
   return c;
 }
+
+std::string sweep_yaml(const SweepConfig& c) { return twin::to_yaml(fields::write_block(sweep_table(), c)) + "\n"; }
 
 SweepConfig load_sweep(const std::filesystem::path& path) {
   std::ifstream in(path);

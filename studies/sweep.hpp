@@ -58,6 +58,8 @@ SweepConfig load_sweep(const std::filesystem::path& path);
 /// Parses sweep YAML text (`file` names it in messages, `base_dir` resolves `scenario:`).
 SweepConfig parse_sweep(const std::string& yaml_text, const std::string& file,
                         const std::filesystem::path& base_dir);
+/// The sweep as YAML text (the same table as parse_sweep; `range:` axes written as their values).
+std::string sweep_yaml(const SweepConfig& c);
 
 /// One run of the sweep.
 struct RunSpec {

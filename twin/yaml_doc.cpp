@@ -93,8 +93,9 @@ void emit_yaml(YAML::Emitter& out, const fields::Node& n) {
   }
 }
 
-std::string to_yaml(const fields::Node& node) {
+std::string to_yaml(const fields::Node& node, const std::string& comment) {
   YAML::Emitter out;
+  if (!comment.empty()) out << YAML::Comment(comment);
   emit_yaml(out, node);
   return out.c_str();
 }

@@ -20,7 +20,7 @@ fields::Node parse_yaml(const std::string& text, const std::string& file);
 fields::Node load_yaml_file(const std::filesystem::path& path);
 /// Writes a node into an emitter (inside a map value, a sequence, or at the top).
 void emit_yaml(YAML::Emitter& out, const fields::Node& node);
-/// The node as YAML text (no trailing newline).
-std::string to_yaml(const fields::Node& node);
+/// The node as YAML text (no trailing newline), after `comment` as '#' lines when not empty.
+std::string to_yaml(const fields::Node& node, const std::string& comment = "");
 
 }  // namespace driftless::twin

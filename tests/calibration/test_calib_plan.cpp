@@ -175,6 +175,51 @@ TEST(CalibPlan, PlanThatDoesNotMatchTheLogIsRefused) {
   }
 }
 
+TEST(CalibPlan, WrittenInTheFormatOfDocsCalibration) {
+  // GIVEN a plan with a named and a custom orientation
+  RigPlan plan;
+  PlanSegment a;
+  a.name = "XY@-90";
+  a.t_start_s = 2;
+  a.t_end_s = 14;
+  PlanSegment b = a;
+  b.name = "tilted";
+  b.orientation = "custom";
+  b.axis_box = Eigen::Vector3d(0.6, 0, 0.8);
+  b.plat1_deg = b.plat2_deg = 90;
+  b.t_start_s = 20;
+  b.t_end_s = 32;
+  b.first_sign = -1;
+  plan.segments = {a, b};
+  plan.latitude_deg = 52;
+  // THEN the file is this text, byte for byte (axis_box only with custom; latitude when set)
+  EXPECT_EQ(rig_plan_yaml(plan),
+            "# rig plan for driftless calibrate --plan (docs/calibration.md)\n"
+            "format: driftless-rig-plan 1\n"
+            "gyro_full_scale_dps: 250\n"
+            "max_rate_fraction: 0.8\n"
+            "latitude_deg: 52\n"
+            "segments:\n"
+            "  - {name: XY@-90, orientation: XY, plat1_deg: -90, plat2_deg: -90, t_start_s: 2, t_end_s: 14, "
+            "rate_dps: 50, half_period_s: 2, first_sign: 1, settle_s: 0.3}\n"
+            "  - {name: tilted, orientation: custom, axis_box: [0.6, 0, 0.8], plat1_deg: 90, plat2_deg: 90, "
+            "t_start_s: 20, t_end_s: 32, rate_dps: 50, half_period_s: 2, first_sign: -1, settle_s: 0.3}\n");
+  // AND `defaults:` may stand after the segments; a key in another unit converts
+  const RigPlan back = parse_rig_plan(
+      "segments:\n  - {name: a, orientation: YZ, plat1_deg: -90, plat2_deg: -90, t_start_ms: 1500, t_end_s: 20}\n"
+      "defaults: {rate_dps: 40}\n",
+      "d.yaml");
+  ASSERT_EQ(back.segments.size(), 1u);
+  EXPECT_EQ(back.segments[0].rate_dps, 40.0);
+  EXPECT_EQ(back.segments[0].t_start_s, 1.5);
+  EXPECT_EQ(back.segments[0].axis_box, Eigen::Vector3d::UnitX());
+  // AND a missing required key is named with the segment's line
+  const std::string msg = message_of([] {
+    parse_rig_plan("segments:\n  - {name: a, orientation: XY, plat1_deg: -90, t_start_s: 0, t_end_s: 60}\n", "m.yaml");
+  });
+  EXPECT_NE(msg.find("m.yaml:2: segments[0].plat2_deg: missing"), std::string::npos) << msg;
+}
+
 TEST(CalibPlan, BadPlanFilesNameFileAndKey) {
   const auto path = temp_path("bad_plan.yaml");
   std::ofstream(path) << "format: driftless-rig-plan 1\nsegments:\n"
@@ -233,6 +278,17 @@ TEST(CalibFile, BadFilesAreRefusedWithFileAndKey) {
                          "sensor2: {minus90: {M: [[1,0,0],[0,1,0],[0,0,0]]}, plus90: {M: [[1,0,0],[0,1,0],[0,0,1]]}}\n";
   msg = message_of([&] { load_calib(path); });
   EXPECT_NE(msg.find("sensor 2 at -90"), std::string::npos) << msg;
+  // every key is one of the table's: a misspelt one is refused, not ignored
+  std::ofstream(path) << "format: driftless-calib 1\n"
+                         "rig: {source: x, latitude_deg: null, earth_rate_remove: true}\n"
+                         "sensor1: {minus90: {M: [[1,0,0],[0,1,0],[0,0,1]]}, plus90: {M: [[1,0,0],[0,1,0],[0,0,1]]}}\n"
+                         "sensor2: {minus90: {M: [[1,0,0],[0,1,0],[0,0,1]]}, plus90: {M: [[1,0,0],[0,1,0],[0,0,1]]}}\n";
+  msg = message_of([&] { load_calib(path); });
+  EXPECT_NE(msg.find("bad_calib.yaml:2: rig.earth_rate_remove: unknown key"), std::string::npos) << msg;
+  std::ofstream(path) << "format: driftless-calib 1\n"
+                         "sensor1: {minus90: {M: [[1,0,0],[0,1,0],[0,0,1]]}, plus90: {M: [[1,0,0],[0,1,0],[0,0,1]]}}\n";
+  msg = message_of([&] { load_calib(path); });
+  EXPECT_NE(msg.find("sensor2: missing"), std::string::npos) << msg;
 }
 
 }  // namespace

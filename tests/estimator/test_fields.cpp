@@ -2,6 +2,7 @@
 // name file, line and the dotted key; duplicate keys are refused naming both lines.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <sstream>
 
 #include "estimator/fields.hpp"
@@ -181,6 +182,98 @@ TEST(Fields, DuplicateKeysAreRefusedNamingBothLines) {
     EXPECT_NE(std::string(e.what()).find("lines 4 and 6"), std::string::npos) << e.what();
   }
   EXPECT_NO_THROW(check_unique_keys(doc({{"a", num("1")}, {"b", num("2")}}), "x"));
+}
+
+// the row kinds of the calibration files and the sweep: lists of blocks, null numbers, optional
+// rows, rows written only when they apply, required keys
+struct Item {
+  std::string name;
+  double t_s = 0.0;
+};
+struct Doc {
+  std::vector<Item> items;
+  double lat_deg = kNaN;
+  bool has_extra = false;
+  double extra = 0.0;
+  bool custom = false;
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
+  std::vector<std::string> tags;
+};
+
+const Table<Item>& item_table() {
+  static const Table<Item> t = {text<Item>("name", &Item::name), number<Item>("t", "s", &Item::t_s)};
+  return t;
+}
+
+const Table<Doc>& doc_table() {
+  static const Table<Doc> t = {
+      block_list<Doc>("items", &Doc::items, &item_table),
+      number_or_null<Doc>("lat", "deg", &Doc::lat_deg),
+      optional_row(number<Doc>("extra", "", &Doc::extra), &Doc::has_extra),
+      written_if<Doc>(vector<Doc>("axis", "", &Doc::axis), [](const Doc& d) { return d.custom; }),
+      text_list<Doc>("tags", &Doc::tags),
+  };
+  return t;
+}
+
+Node item(const std::string& name, const std::string& t_key, const std::string& t) {
+  Node m = Node::map(true);
+  m.add("name", Node::scalar(name));
+  m.add(t_key, Node::scalar(t));
+  return m;
+}
+
+TEST(Fields, ListsNullsOptionalAndRequiredRows) {
+  // GIVEN a list of blocks (one key in another unit), a null number and a text list
+  Node items = Node::list({item("a", "t_s", "1.5"), item("b", "t_ms", "250")}, false);
+  Node tags = list({"x", "y"});
+  const Node in = doc({{"items", items}, {"lat_deg", Node{}}, {"tags", tags}});
+  Doc d;
+  d.has_extra = false;
+  const auto given = read_block(doc_table(), d, in, Context{"d.yaml", ""});
+  // THEN each item went through its table, units converted; null reads as NaN
+  ASSERT_EQ(d.items.size(), 2u);
+  EXPECT_EQ(d.items[1].name, "b");
+  EXPECT_DOUBLE_EQ(d.items[1].t_s, 0.25);
+  EXPECT_TRUE(std::isnan(d.lat_deg));
+  EXPECT_EQ(d.tags, (std::vector<std::string>{"x", "y"}));
+  EXPECT_FALSE(d.has_extra);
+  EXPECT_NO_THROW(require(doc_table(), given, in, Context{"d.yaml", ""}, {"items", "lat_deg"}));
+  try {
+    require(doc_table(), given, in, Context{"d.yaml", ""}, {"items", "extra"});
+    FAIL() << "a missing required key passed";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.key(), "extra");
+    EXPECT_NE(std::string(e.what()).find("missing"), std::string::npos) << e.what();
+  }
+  // AND an item error names its index
+  Node bad_items = Node::list({item("a", "t_s", "1"), item("b", "t_deg", "2")}, false);
+  try {
+    Doc e;
+    read_block(doc_table(), e, doc({{"items", bad_items}}), Context{"d.yaml", ""});
+    FAIL() << "a time in degrees passed";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.key(), "items[1].t_deg");
+  }
+  // WHEN written: the optional row and the conditional row stay out until they apply; NaN is null
+  Node out = write_block(doc_table(), d);
+  EXPECT_EQ(out.find("extra"), nullptr);
+  EXPECT_EQ(out.find("axis"), nullptr);
+  EXPECT_TRUE(out.find("lat_deg")->is_null());
+  EXPECT_TRUE(out.find("items")->items[0].flow);
+  EXPECT_EQ(out.find("items")->items[1].find("t_s")->text, "0.25");
+  d.has_extra = true;
+  d.custom = true;
+  d.lat_deg = 52.0;
+  out = write_block(doc_table(), d);
+  EXPECT_EQ(out.find("extra")->text, "0");
+  EXPECT_NE(out.find("axis"), nullptr);
+  EXPECT_EQ(out.find("lat_deg")->text, "52");
+  // AND reading an optional row sets its flag
+  Doc f;
+  read_block(doc_table(), f, doc({{"extra", num("3")}}), Context{"d.yaml", ""});
+  EXPECT_TRUE(f.has_extra);
+  EXPECT_EQ(f.extra, 3.0);
 }
 
 TEST(Fields, FlatFormReadsLinesAndRefusesDuplicates) {

@@ -5,6 +5,8 @@
 #  2. no function in the product is over 150 lines;
 #  3. each piece of shared physics is defined once: the old copies do not come back; every file
 #     the program writes goes through the one output helper (estimator/output_file.hpp);
+#     YAML is read and written only through twin/yaml_doc.hpp and the field tables (no block
+#     parsed or emitted by hand with yaml-cpp);
 #  4. the estimator tests have one closed-form generator; the twin-side test logs (tests/diagnose
 #     headers) come from the twin's own sources (FastBox, Simulator), not from a copy of them.
 # Usage: check.sh SOURCE_DIR. Prints every violation with file:line and exits 1 if there is one.
@@ -86,6 +88,7 @@ estimator/fdi_input.cpp|the fault detector's input built from the filter (use es
 twin/truth_delay.cpp twin/truth_delay.hpp|the sensors' sampling offset (model.time_offset_s: use twin::TruthDelay)|time_offset_s \* 
 cli/compare_run.cpp|the options compare and diagnose share (use cli::add_compare_options)|"--(block|threshold|resample)"
 importers/ground_truth.cpp|parsing EuRoC ground-truth stamps (use importers::read_ground_truth: whole ns)|_ns *= *v\[0\]|t_first_ns
+twin/yaml_doc.cpp twin/yaml_doc.hpp|reading or writing YAML by hand (describe the block as a fields::Table, estimator/fields.hpp; twin/yaml_doc.hpp turns text into fields::Node and back)|yaml-cpp/yaml\.h|YAML::|\.as<(double|int|bool|std::string)>
 RULES
 
 # 4. one closed-form generator for the estimator tests (tests/estimator/synth.hpp, Eigen only):

@@ -81,6 +81,48 @@ TEST(Sweep, RejectsBadFilesWithFileAndKey) {
                driftless::InputError);
 }
 
+TEST(Sweep, OneTableReadsAndWritesTheFile) {
+  // GIVEN the demo sweep read
+  const SweepConfig c = parse_sweep(kSweep, "demo.yaml", "/tmp/x");
+  // WHEN written through the same table and read again
+  const std::string text = sweep_yaml(c);
+  const SweepConfig back = parse_sweep(text, "back.yaml", "/elsewhere");
+  // THEN every field comes back (the range as its values, the scenario path as written)
+  EXPECT_EQ(back.name, c.name);
+  EXPECT_EQ(back.runner, c.runner);
+  EXPECT_EQ(back.scenario, c.scenario);
+  EXPECT_EQ(back.duration_s, 60.0);
+  EXPECT_EQ(back.monte_carlo, 3);
+  EXPECT_EQ(back.seed, 7u);
+  ASSERT_EQ(back.grid.size(), 2u);
+  for (std::size_t a = 0; a < 2; ++a) {
+    EXPECT_EQ(back.grid[a].name, c.grid[a].name);
+    EXPECT_EQ(back.grid[a].set, c.grid[a].set);
+    EXPECT_EQ(back.grid[a].values, c.grid[a].values);  // shortest exact numbers: bit for bit
+    EXPECT_EQ(back.grid[a].vector3, c.grid[a].vector3);
+  }
+  EXPECT_EQ(back.fixed, c.fixed);
+  ASSERT_EQ(back.plots.size(), 1u);
+  EXPECT_EQ(back.plots[0].y, c.plots[0].y);
+  EXPECT_TRUE(back.plots[0].logy);
+  EXPECT_FALSE(back.plots[0].logx);
+  // AND a key in another unit of the same quantity converts; one in another quantity is refused
+  EXPECT_EQ(parse_sweep("duration_min: 2\n", "m.yaml", ".").duration_s, 120.0);
+  try {
+    parse_sweep("duration_deg: 2\n", "q.yaml", ".");
+    FAIL() << "a duration in degrees passed";
+  } catch (const driftless::InputError& e) {
+    EXPECT_EQ(e.key(), "duration_deg");
+  }
+  // AND a plot without x names the key and the line
+  try {
+    parse_sweep("grid: {a: [1]}\nplots:\n  - {y: [e]}\n", "p.yaml", ".");
+    FAIL() << "a plot without x passed";
+  } catch (const driftless::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("p.yaml:3: plots[0].x: missing"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Sweep, ExpandsLastAxisFastestWithCommonSeeds) {
   const SweepConfig c = parse_sweep(kSweep, "demo.yaml", ".");
   const auto specs = expand(c);
