@@ -175,12 +175,12 @@ double column_value(const ColumnInputs& in, int s, int j, int col, std::size_t k
     case kG0: case kG1: case kG2: return static_cast<double>(r.f_mps2[s][k][col - kG0]) / kStandardGravityMps2;
     case kMount0: case kMount1: case kMount2:
       return w.cross(Eigen::Vector3d::Unit(col - kMount0))[j] * kDegPerRad * kRadPerDeg;
-    case kTempBias: return in.pred[s].temp_c[k] - in.params[s].temperature.reference_degc;
+    case kTempBias: return in.res.temp_c(s, k) - in.params[s].temperature.reference_degc;
     case kTempScale:
-      return (in.pred[s].temp_c[k] - in.params[s].temperature.reference_degc) * w[j] * kDegPerRad / 100.0;
+      return (in.res.temp_c(s, k) - in.params[s].temperature.reference_degc) * w[j] * kDegPerRad / 100.0;
     case kNonlin2: case kNonlin3: {
       const double fs = in.params[s].saturation.full_scale_dps;
-      const double u = in.pred[s].gyro_dps[k][j] / fs;
+      const double u = in.res.pred_dps(s, j, k) / fs;
       return fs * (col == kNonlin2 ? u * u : u * u * u) / 100.0;
     }
     case kDelay: return -r.dw_radps2(s, k)[j] * kDegPerRad;

@@ -12,6 +12,7 @@
 
 #include "diagnose/compare_model.hpp"
 #include "diagnose/replay.hpp"
+#include "diagnose/residual.hpp"
 #include "twin/sensor/sensor_model.hpp"
 
 namespace driftless::diagnose {
@@ -112,10 +113,11 @@ inline constexpr std::array<double, 5> kFlipBinsS = {0.0, 0.25, 0.5, 1.0, 2.0};
 /// Prior 1-sigma of a platform's rest angle on a stop, deg (servo press differs between boxes).
 inline constexpr double kRestAngleSigmaDeg = 0.01;
 
-/// What a column needs besides the replay: the model's prediction (output and temperature).
+/// What a column needs besides the replay: the model's prediction (output and temperature, from
+/// the residual).
 struct ColumnInputs {
   const Replay& r;
-  const std::array<SensorPrediction, 2>& pred;
+  const Residual& res;
   const std::array<twin::SensorParams, 2>& params;
 };
 /// Value of column `col` for channel (sensor s, axis j) at sample k.

@@ -139,7 +139,7 @@ void correlations(const Replay& r, const Residual& res, const Channels& ch, cons
   }
   sigs.emplace_back("time", [&](std::size_t k) { return r.t_s[k]; });
   for (int s = 0; s < res.sensors; ++s) {
-    sigs.emplace_back(fmt::format("temperature {}", s + 1), [&, s](std::size_t k) { return res.pred[s].temp_c[k]; });
+    sigs.emplace_back(fmt::format("temperature {}", s + 1), [&, s](std::size_t k) { return res.temp_c(s, k); });
     sigs.emplace_back(fmt::format("time since flip {}", s + 1), [&, s](std::size_t k) { return std::min(10.0f, r.since_flip_s[s][k]); });
   }
   std::array<std::vector<double>, 6> rw;

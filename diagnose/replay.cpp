@@ -313,7 +313,7 @@ std::vector<Eigen::Vector3d> specific_force(Raw& raw, Replay& out) {
     f_body[k] = quat(raw.q[k]).conjugate() * (a_enu + g_enu);
     out.f_body_mps2[k] = f_body[k].cast<float>();
   }
-  raw.p = {};  // ref_p is used up
+  raw.p = std::vector<Eigen::Vector3d>();  // ref_p is used up (not "= {}": that keeps the memory)
   if (!out.has_accel && !p_ok) {
     out.notes.push_back("no ref_p and no accel columns: the specific force is gravity alone (vehicle accelerations unknown)");
   }
@@ -337,7 +337,7 @@ PlatformMotion platform_motion(Raw& raw, const ReplayOptions& opt, Replay& out) 
     if (out.has_temp) {
       out.temp_c[s] = std::move(raw.temp[s]);
     } else {
-      out.temp_c[s].assign(n, kNaN), raw.temp[s] = {};
+      out.temp_c[s].assign(n, kNaN), raw.temp[s] = std::vector<double>();
     }
     pm.moving[s].assign(n, 0);
     for (std::size_t k = 0; k < n; ++k) {
@@ -419,7 +419,7 @@ void sensor_truth(Raw& raw, const std::vector<Eigen::Vector3d>& f_body, const Pl
       out.dw_dlat_radps[s][k] = (Rt * (quat(raw.q[k]).conjugate() * dearth_dlat_enu)).cast<float>();
       if (s < out.sensors && !raw.g[s][k].allFinite()) out.usable[k] = 0;
     }
-    raw.a[s] = {};
+    raw.a[s] = std::vector<Eigen::Vector3d>();
     out.gyro_dps[s] = std::move(raw.g[s]);
     out.plat_deg[s] = std::move(raw.plat[s]);
   }
