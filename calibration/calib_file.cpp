@@ -196,9 +196,11 @@ fields::Row<SensorBlock> temperature_row() {
   auto read = row.read;
   row.read = [read](SensorBlock& s, const fields::Node& n, const fields::Reading& r) {
     read(s, n, r);
-    if ((s.temp.tc_sigma_dps_per_degc.array() < 0.0).any())
-      r.ctx.fail(*n.find("bias_tc_sigma_dps_per_degc"), r.ctx.key("bias_tc_sigma_dps_per_degc"),
-                 "a sigma must be >= 0 deg/s per degC");
+    if ((s.temp.tc_sigma_dps_per_degc.array() < 0.0).any()) {
+      // the key may be written in another unit (bias_tc_sigma_dph_per_degc): then point at the block
+      const fields::Node* at = n.find("bias_tc_sigma_dps_per_degc");
+      r.ctx.fail(at != nullptr ? *at : n, r.ctx.key("bias_tc_sigma_dps_per_degc"), "a sigma must be >= 0 deg/s per degC");
+    }
   };
   return fields::optional_row(std::move(row), &SensorBlock::has_temp);
 }
@@ -306,9 +308,10 @@ est::Calibration CalibFile::to_filter_calibration() const {
   return cal;
 }
 
-CalibFile load_calib(const std::filesystem::path& path) {
-  const std::string file = path.string();
-  const fields::Node root = twin::load_yaml_file(path);
+CalibFile load_calib(const std::filesystem::path& path) { return parse_calib(twin::read_yaml_text(path), path.string()); }
+
+CalibFile parse_calib(const std::string& yaml_text, const std::string& file) {
+  const fields::Node root = twin::parse_yaml(yaml_text, file);
   if (!root.is_map()) throw InputError(file, root.line, "", "not a calibration file (expected a YAML map)");
   const fields::Context ctx{file, ""};
   CalibDoc doc;

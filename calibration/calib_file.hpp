@@ -81,5 +81,7 @@ void save_calib(const std::filesystem::path& path, const est::CalibFit& fit,
 /// Reads calib.yaml; throws std::invalid_argument naming file, line and key (missing matrix,
 /// wrong shape, singular M, another format).
 CalibFile load_calib(const std::filesystem::path& path);
+/// Reads calib.yaml from its text (`file` names it in errors); what load_calib does after reading.
+CalibFile parse_calib(const std::string& yaml_text, const std::string& file);
 
 }  // namespace driftless::calib

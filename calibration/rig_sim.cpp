@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <memory>
 #include <sstream>
 #include <stdexcept>
@@ -234,14 +233,6 @@ void true_matrices(const twin::Simulator& sim, const BoxParams& box, const RigTr
 
 // ---- scenario file: a normal scenario plus a `calibration:` block -----------------------------
 
-std::string read_text(const std::filesystem::path& path) {
-  std::ifstream f(path);
-  if (!f) throw InputError(path.string(), 0, "", "cannot open calibration scenario");
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
-
 // the calibration: block, one table (docs/calibration.md)
 const fields::Table<RigParams>& rig_table() {
   using R = RigParams;
@@ -289,7 +280,7 @@ void RigParams::validate() const {
 
 CalibScenario load_calib_scenario(const std::filesystem::path& path) {
   const std::string file = path.string();
-  const std::string text = read_text(path);
+  const std::string text = twin::read_yaml_text(path);
   const fields::Node root = twin::parse_yaml(text, file);
   const fields::Node* block = root.is_map() ? root.find("calibration") : nullptr;
   if (block == nullptr) {

@@ -8,7 +8,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
 #include <mutex>
 #include <set>
 #include <sstream>
@@ -276,11 +275,7 @@ SweepConfig parse_sweep(const std::string& yaml_text, const std::string& file,
 std::string sweep_yaml(const SweepConfig& c) { return twin::to_yaml(fields::write_block(sweep_table(), c)) + "\n"; }
 
 SweepConfig load_sweep(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path.string(), 0, "", "cannot open sweep file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parse_sweep(ss.str(), path.string(), path.parent_path());
+  return parse_sweep(twin::read_yaml_text(path), path.string(), path.parent_path());
 }
 
 std::uint64_t run_seed(std::uint64_t base_seed, int mc) {

@@ -2,9 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <map>
-#include <sstream>
 #include <stdexcept>
 
 #include <fmt/core.h>
@@ -295,11 +293,7 @@ Scenario load_scenario(const std::string& path_or_builtin) {
     for (const auto& n : builtin_scenarios()) names += (names.empty() ? "" : ", ") + n;
     throw InputError(path_or_builtin, 0, "", "no such scenario file (built-in scenarios: " + names + ")");
   }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path.string(), 0, "", "cannot read scenario file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parse_scenario(ss.str(), path.string(), std::filesystem::absolute(path).parent_path());
+  return parse_scenario(read_yaml_text(path), path.string(), std::filesystem::absolute(path).parent_path());
 }
 
 Scenario default_scenario() { return load_scenario("default"); }

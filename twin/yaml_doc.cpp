@@ -57,15 +57,17 @@ fields::Node parse_yaml(const std::string& text, const std::string& file) {
   return n;
 }
 
-fields::Node load_yaml_file(const std::filesystem::path& path) {
+std::string read_yaml_text(const std::filesystem::path& path) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) throw InputError(path.string(), 0, "", "is a directory, expected a YAML file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path.string(), 0, "", "cannot read (no such file or no permission)");
   std::stringstream ss;
   ss << in.rdbuf();
-  return parse_yaml(ss.str(), path.string());
+  return ss.str();
 }
+
+fields::Node load_yaml_file(const std::filesystem::path& path) { return parse_yaml(read_yaml_text(path), path.string()); }
 
 void emit_yaml(YAML::Emitter& out, const fields::Node& n) {
   using K = fields::Node::Kind;

@@ -16,6 +16,8 @@ namespace driftless::twin {
 
 /// Parses YAML text; `file` names it in errors. An empty document gives a null node.
 fields::Node parse_yaml(const std::string& text, const std::string& file);
+/// The text of a YAML file (InputError naming the file when it is a directory or cannot be read).
+std::string read_yaml_text(const std::filesystem::path& path);
 /// Reads and parses a YAML file (InputError when it cannot be read).
 fields::Node load_yaml_file(const std::filesystem::path& path);
 /// Writes a node into an emitter (inside a map value, a sequence, or at the top).

@@ -102,6 +102,21 @@ TEST(CalibSelfcal, ANegativeSigmaIsRefusedWithItsKey) {
   } catch (const std::exception& e) {
     EXPECT_NE(std::string(e.what()).find("sensor2.temperature.bias_tc_sigma_dps_per_degc"), std::string::npos) << e.what();
   }
+  // AND written in deg/h per degC (another unit of the same quantity) it is converted and refused alike
+  std::string text;
+  {
+    std::ifstream in(path);
+    text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  for (std::size_t at; (at = text.find("bias_tc_sigma_dps_per_degc")) != std::string::npos;)
+    text.replace(at, 26, "bias_tc_sigma_dph_per_degc");
+  std::ofstream(path) << text;
+  try {
+    load_calib(path);
+    FAIL() << "accepted in deg/h per degC";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("a sigma must be >= 0"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace
