@@ -10,7 +10,9 @@
 #include <mujoco/mujoco.h>
 
 #include "cli/command.hpp"
+#include "estimator/config.hpp"
 #include "estimator/output_file.hpp"
+#include "estimator/pipeline.hpp"
 #include "report/json.hpp"
 #include "renders/render_job.hpp"
 #include "renders/twin_source.hpp"
@@ -32,7 +34,21 @@ struct RenderArgs {
   int crf = 23;
   bool no_overlay = false;
   bool no_estimate = false;
+  std::string config;    // estimator config YAML (docs/estimator.md)
+  bool selfcal = false;  // the self-calibrating filter
 };
+
+// the filter's configuration as `driftless estimate` reads it (--config, --selfcal)
+est::EstimatorConfig estimator_config(const RenderArgs& a) {
+  est::EstimatorConfig cfg;
+  if (!a.config.empty()) {
+    std::ifstream in(a.config);
+    if (!in) throw std::runtime_error("cannot read --config " + a.config);
+    cfg = est::parse_estimator_config(in, a.config, est::EstimatorConfig{});
+  }
+  if (a.selfcal) cfg.self_calibration = true;
+  return cfg;
+}
 
 using ModelPtr = std::unique_ptr<mjModel, decltype(&mj_deleteModel)>;
 
@@ -52,11 +68,14 @@ void write_sidecar(const RenderArgs& a, const render::RenderParams& p, const ren
       "{{\n  \"format\": \"driftless-video 1\",\n  \"output\": {},\n  \"png_fallback\": {},\n"
       "  \"complete\": {},\n  \"frames\": {},\n  \"width\": {},\n  \"height\": {},\n  \"fps\": {},\n"
       "  \"speed\": {},\n  \"first_frame_s\": {},\n  \"last_frame_s\": {},\n  \"realtime_flip_frames\": {},\n"
-      "  \"camera\": {},\n  \"wall_s\": {:.3f},\n  \"stopped_at_t_s\": {}\n}}\n",
+      "  \"camera\": {},\n  \"wall_s\": {:.3f},\n  \"stopped_at_t_s\": {},\n"
+      "  \"estimator\": {{\"ran\": {}, \"self_calibration\": {}, \"locked_from_t_s\": {}, \"final_sigma_dps\": {}}}\n}}\n",
       json_string(st.output), st.png_fallback, complete, st.frames, p.scene.width_px, p.scene.height_px,
       json_number(p.timeline.fps), json_number(p.timeline.speed), json_number(st.first_frame_s),
       json_number(st.last_frame_s), st.realtime_flip_frames, json_string(p.scene.camera.empty() ? "auto" : p.scene.camera),
-      st.wall_s, complete ? std::string("null") : json_number(st.last_frame_s)));
+      st.wall_s, complete ? std::string("null") : json_number(st.last_frame_s), st.estimator_ran,
+      st.estimator_ran && p.estimator.self_calibration, json_number(st.estimator_locked_from_s),
+      json_number(st.estimator_final_sigma_dps)));
 }
 
 int run_render(const RenderArgs& a) {
@@ -76,6 +95,7 @@ int run_render(const RenderArgs& a) {
   p.out = a.out;
   p.overlay = !a.no_overlay;
   p.run_estimator = !a.no_estimate;
+  if (p.run_estimator) p.estimator = estimator_config(a);
   p.validate();
 
   // the source: a simulation as it runs, or a log replayed in the twin's model (or an MJCF)
@@ -126,6 +146,15 @@ int run_render(const RenderArgs& a) {
              stats.realtime_flip_frames, stats.wall_s,
              stats.wall_s > 0 ? static_cast<double>(stats.frames) / stats.wall_s : 0.0);
   write_sidecar(a, p, stats, !stop_requested().load());
+  if (stats.estimator_ran && std::isnan(stats.estimator_locked_from_s)) {
+    fmt::print(stderr,
+               "driftless render: note: the overlaid DriftLess filter never locked on (the largest sigma of "
+               "its bias correction is {:.3g} deg/s at the end, lock needs < {:g}): its bias charts are "
+               "unconverged and no attitude error is shown. 'driftless estimate' on the log says why; "
+               "uncalibrated MEMS gyros on a moving box (the shipped pan_tilt and vehicle scenarios) need "
+               "--selfcal and a log long enough to lock\n",
+               stats.estimator_final_sigma_dps, est::EstimateRunOptions{}.attitude_start_sigma_dps);
+  }
   if (stop_requested().load()) {
     fmt::print(stderr, "driftless render: stopped early (Ctrl-C); the video ends at t = {:.2f} s\n",
                stats.last_frame_s);
@@ -190,9 +219,19 @@ const bool registered = register_command(60, [](CLI::App& app) {
   cmd->add_option("--crf", a->crf, "x264 quality, 0 (lossless) .. 51 (worst)")
       ->capture_default_str();
   cmd->add_flag("--no-overlay", a->no_overlay, "Draw the scene only (no text, no chart)");
-  cmd->add_flag("--no-estimate", a->no_estimate,
+  CLI::Option* no_estimate = cmd->add_flag("--no-estimate", a->no_estimate,
                 "Chart the residual of eq. (2) instead of running the DriftLess filter for the "
                 "bias chart and the attitude error");
+  cmd->add_option("--config", a->config,
+                  "Estimator config YAML for the overlaid filter, as for driftless estimate "
+                  "(docs/estimator.md; default: the defaults)")
+      ->check(CLI::ExistingFile)
+      ->excludes(no_estimate);
+  cmd->add_flag("--selfcal", a->selfcal,
+                "Run the overlaid filter self-calibrating (g-sensitivity, scale factor, "
+                "misalignment; needs accel columns): the shipped moving-base scenarios use "
+                "uncalibrated MPU6050s, which the default filter does not lock on")
+      ->excludes(no_estimate);
   return [a, cmd] {
     if (a->scenario.empty() && a->log.empty()) {
       throw std::invalid_argument("give --scenario FILE or --log FILE (see driftless render --help)");

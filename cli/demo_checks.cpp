@@ -208,6 +208,14 @@ OutputCheck check_video(const fs::path& video, std::uint64_t min_frames) {
          w == number(at(claim, "width")) && h == number(at(claim, "height"));
   c.detail = fmt::format("decodes to {} frames of {}x{} px (the renderer wrote {}; at least {} expected)", n, w, h,
                          frames, min_frames);
+  // the overlay's filter must have locked, or its attitude chart is empty (video.json "estimator")
+  const Node& est = at(claim, "estimator");
+  if (text(at(est, "ran")) == "true") {
+    const double lock_s = number(at(est, "locked_from_t_s"));
+    c.ok = c.ok && std::isfinite(lock_s);
+    c.detail += std::isfinite(lock_s) ? fmt::format("; its filter locked at t = {:.1f} s", lock_s)
+                                      : "; its filter never locked (no attitude error in the video)";
+  }
   return c;
 }
 

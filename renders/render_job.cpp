@@ -288,6 +288,7 @@ RenderStats render_video(FrameSource& source, const RenderParams& params,
   const auto& info = source.info();
   TelemetryParams tp;
   tp.run_estimator = params.run_estimator;
+  tp.estimator = params.estimator;
   tp.window_s = std::isnan(params.chart_window_s) ? std::max(30.0, 20.0 * params.timeline.speed) : params.chart_window_s;
   tp.settle_s = kSettleS;
   Telemetry telemetry(tp, info.metadata);
@@ -314,6 +315,11 @@ RenderStats render_video(FrameSource& source, const RenderParams& params,
   }
   if (keep_going) planner.finish(emit);
   out.close();
+  if (const est::DriftlessFilter* f = telemetry.filter(); f != nullptr && params.overlay) {
+    stats.estimator_ran = true;
+    stats.estimator_locked_from_s = telemetry.locked_from_s();
+    stats.estimator_final_sigma_dps = f->correction_sigma_dps().maxCoeff();
+  }
   stats.wall_s = now_s() - t_start;
   return stats;
 }

@@ -11,6 +11,7 @@
 
 #include <mujoco/mujoco.h>
 
+#include "estimator/config.hpp"
 #include "estimator/log.hpp"
 #include "renders/pose.hpp"
 #include "renders/scene_renderer.hpp"
@@ -69,6 +70,7 @@ struct RenderParams {
   std::filesystem::path out = "video.mp4";
   bool overlay = true;
   bool run_estimator = true;     // overlay the DriftLess filter's estimate (else the residual)
+  est::EstimatorConfig estimator;  // the filter's configuration
   double chart_window_s = kNaN;  // strip chart width in data s; NaN: max(30, 20 * speed)
 
   /// Throws std::invalid_argument naming the bad option.
@@ -87,6 +89,9 @@ struct RenderStats {
   std::string output;              // the MP4 path or the PNG pattern
   bool png_fallback = false;       // ffmpeg was missing
   std::string gl_renderer;
+  bool estimator_ran = false;      // the DriftLess filter ran for the overlay
+  double estimator_locked_from_s = kNaN;  // its lock (data time, s); NaN: it never locked
+  double estimator_final_sigma_dps = kNaN;  // largest sigma of its bias correction at the end
 };
 
 /// Called after each frame with the frame's data time; return false to stop early (Ctrl-C).

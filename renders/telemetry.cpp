@@ -18,7 +18,7 @@ Telemetry::Telemetry(const TelemetryParams& p, const log::Metadata& meta)
     : p_(p), residual_(meta.hinge1_axis(), meta.hinge2_axis(), p.window_s) {
   p_.validate();
   if (p_.run_estimator) {
-    filter_ = std::make_unique<est::DriftlessFilter>(est::EstimatorConfig{}, est::box_geometry_from_metadata(meta));
+    filter_ = std::make_unique<est::DriftlessFilter>(p_.estimator, est::box_geometry_from_metadata(meta));
     bias1_.emplace(1, p_.window_s);
     bias2_.emplace(2, p_.window_s);
     attitude_chart_.emplace(p_.window_s);
@@ -36,6 +36,9 @@ void Telemetry::push(const Sample& s, double rest_s, OverlayState& st) {
     if (filter_->has_update()) {
       bias1_->push(s.t_s, filter_->bias1_dps(), s.true_bias1_dps);
       bias2_->push(s.t_s, filter_->bias2_dps(), s.true_bias2_dps);
+      if (std::isnan(locked_from_s_) && filter_->correction_sigma_dps().maxCoeff() < lock_sigma_dps_) {
+        locked_from_s_ = s.t_s;
+      }
     }
     // the attitude comparison of docs/estimator.md section 4: from lock on, against ref_q
     attitude_now_.available = attitude_now_.available || s.ref_q_wxyz.allFinite();

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "estimator/attitude_comparison.hpp"
+#include "estimator/config.hpp"
 #include "estimator/pipeline.hpp"
 #include "estimator/filter.hpp"
 #include "estimator/log.hpp"
@@ -17,7 +18,8 @@ namespace driftless::render {
 
 /// What the overlay computes.
 struct TelemetryParams {
-  bool run_estimator = true;   // run the DriftLess filter (general mode, defaults) on the stream
+  bool run_estimator = true;   // run the DriftLess filter on the stream
+  est::EstimatorConfig estimator;  // its configuration (render --config / --selfcal; default: defaults)
   double window_s = 30.0;      // strip chart width, s of data time
   double settle_s = 0.3;       // residual counts this long after both platforms stopped, s
 
@@ -39,6 +41,9 @@ class Telemetry {
   std::vector<const StripChart*> charts() const;
   /// The filter, when it runs (for tests and summaries).
   const est::DriftlessFilter* filter() const { return filter_.get(); }
+  /// Data time at which every sigma of the filter's bias correction first fell below the lock
+  /// level of `driftless estimate` (s; NaN: never, or no filter).
+  double locked_from_s() const { return locked_from_s_; }
 
  private:
   TelemetryParams p_;
@@ -48,6 +53,8 @@ class Telemetry {
   std::optional<AttitudeChart> attitude_chart_;
   std::optional<est::AttitudeComparison> attitude_;  // the comparison `driftless estimate` makes
   AttitudeNow attitude_now_;
+  double lock_sigma_dps_ = est::EstimateRunOptions{}.attitude_start_sigma_dps;
+  double locked_from_s_ = kNaN;
 };
 
 }  // namespace driftless::render

@@ -90,6 +90,15 @@ grep -q "cam_fixed" "$work/err.txt" || fail "bad camera message: $(cat "$work/er
 n=$(ffprobe -v error -count_frames -select_streams v:0 -show_entries stream=nb_read_frames \
     -of default=nw=1:nk=1 "$work/s.mp4")
 [ "$n" = 10 ] || fail "scenario render: $n frames (want 10)"
+# 1 s cannot lock the overlaid filter: the sidecar says so and stderr names the fix
+grep -q '"locked_from_t_s": null' "$work/s.json" || fail "scenario render: lock not in video.json: $(cat "$work/s.json")"
+"$bin" render --scenario static --out "$work/s2.mp4" --width 160 --height 120 --fps 10 --to 1 --selfcal \
+  > /dev/null 2> "$work/s2.err"
+grep -q "never locked on" "$work/s2.err" || fail "render: an unlocked overlay filter is not said: $(cat "$work/s2.err")"
+grep -q '"self_calibration": true' "$work/s2.json" || fail "render --selfcal not in video.json"
+if "$bin" render --scenario static --out "$work/s3.mp4" --selfcal --no-estimate > /dev/null 2>&1; then
+  fail "render: --selfcal with --no-estimate accepted"
+fi
 
 # 6. only `render` maps the GL stack: the program does not need libOSMesa (and its libLLVM) at
 #    start-up; renders/gl_api.cpp loads it when a context is made (step 5 proved that works)
