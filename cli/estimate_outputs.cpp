@@ -197,9 +197,14 @@ void write_estimate_summary(const fs::path& path, const SummaryContext& ctx, con
                        json_number(m(2, 0)), json_number(m(2, 1)), json_number(m(2, 2)));
   };
   add("  \"self_calibration\": {{\"enabled\": {}, \"correction_sigma_dps\": {}, "
-      "\"g_sensitivity_dps_per_g\": [{}, {}], \"g_sensitivity_sigma_dps_per_g\": [{}, {}]}},\n",
+      "\"g_sensitivity_dps_per_g\": [{}, {}], \"g_sensitivity_sigma_dps_per_g\": [{}, {}], "
+      "\"scale_misalign_states\": {}, \"scale_misalign_frac\": [{}, {}], \"scale_misalign_sigma_frac\": [{}, {}]}},\n",
       s.gsens_states ? "true" : "false", json_vec(s.correction_sigma_dps), mat(s.gsens_dps_per_g[0]),
-      mat(s.gsens_dps_per_g[1]), mat(s.gsens_sigma_dps_per_g[0]), mat(s.gsens_sigma_dps_per_g[1]));
+      mat(s.gsens_dps_per_g[1]), mat(s.gsens_sigma_dps_per_g[0]), mat(s.gsens_sigma_dps_per_g[1]),
+      s.scale_states ? "true" : "false", mat(s.scale_misalign_frac[0]), mat(s.scale_misalign_frac[1]),
+      mat(s.scale_misalign_sigma_frac[0]), mat(s.scale_misalign_sigma_frac[1]));
+  add("  \"box_dwells\": {{\"updates\": {}, \"rejected\": {}}},\n", s.counters.box_dwell_updates,
+      s.counters.box_dwell_rejected);
   add("  \"locked_from_t_s\": {}, \"rows_locked\": {},\n", json_number(s.locked_from_t_s), s.samples_locked);
   add("  \"attitude_start_s\": {},\n", json_number(s.attitude_start_s));
   add("  \"attitude_drift_deg_per_h\": {{\"with_driftless\": {}, \"bias_fixed_at_start\": {}, "

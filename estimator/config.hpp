@@ -112,6 +112,18 @@ struct EstimatorConfig {
   // the vertical, which eq. (2) cannot see once g-sensitivity is a state. General mode only.
   bool box_at_rest = false;
   double box_rest_rate_sigma_dps = 1e-4;  // deg/s, how still the box is about the vertical (1 sigma)
+  // self-calibrating mode, a box that moves but pauses now and then (a pan/tilt unit's dwells, a
+  // vehicle at a stop, a static box between flips; not with box_at_rest, which does it already): once
+  // the correction is known to a tenth of box_dwell_rate, every stretch where both platforms rest,
+  // the corrected fused rate stays below box_dwell_rate and the specific force is 1 g (within
+  // 5 %) is a box dwell; at least box_dwell_min long after box_dwell_margin is dropped at each end,
+  // it measures the vertical rate as Omega sin(latitude) (the same row as box_at_rest, variance
+  // with box_rest_rate_sigma). It observes the g-sensitivity both sensors share, which eq. (2)
+  // cannot see on a moving box (docs/estimator.md section 1d). Needs the accel columns.
+  bool box_dwell_updates = true;
+  double box_dwell_rate_dps = 2.0;   // deg/s, |corrected fused rate| below this: the box rests
+  double box_dwell_min_s = 1.0;      // s, shortest dwell used (after the margins)
+  double box_dwell_margin_s = 0.2;   // s, dropped at the start and the end of each dwell
 
   Calibration calibration;  // optional calibrated matrices (issue 4); empty = rotations
 

@@ -84,6 +84,9 @@ void EstimatorConfig::validate() const {
   non_negative(gsens_sigma_dps_per_g, "gsens_sigma_dps_per_g", "deg/s per g");
   non_negative(scale_misalign_sigma_frac, "scale_misalign_sigma_frac", "fraction");
   positive(box_rest_rate_sigma_dps, "box_rest_rate_sigma_dps", "deg/s");
+  positive(box_dwell_rate_dps, "box_dwell_rate_dps", "deg/s");
+  non_negative(box_dwell_min_s, "box_dwell_min_s", "s");
+  non_negative(box_dwell_margin_s, "box_dwell_margin_s", "s");
   if (mode == FilterMode::kPaper && (self_calibration || box_at_rest)) {
     throw std::invalid_argument("estimator config: self_calibration and box_at_rest need mode: general");
   }
@@ -170,6 +173,8 @@ DriftlessFilter::DriftlessFilter(const EstimatorConfig& cfg, const BoxGeometry& 
   if (has_scale_states()) {
     P_.diagonal().segment<18>(kScale1.start).setConstant(cfg_.scale_misalign_sigma_frac * cfg_.scale_misalign_sigma_frac);
   }
+  gate1_ = cfg_.nis_gate_probability < 1.0 ? chi2_quantile(cfg_.nis_gate_probability, 1.0)
+                                           : std::numeric_limits<double>::infinity();
   gate3_ = cfg_.nis_gate_probability < 1.0 ? chi2_quantile(cfg_.nis_gate_probability, 3.0)
                                            : std::numeric_limits<double>::infinity();
   gate6_ = cfg_.nis_gate_probability < 1.0 ? chi2_quantile(cfg_.nis_gate_probability, 6.0)
@@ -187,6 +192,9 @@ void DriftlessFilter::on_source_switch(const BoxGeometry* box) {
   }
   standstill_.restart(box_);
   prev_res_.valid = false;
+  dwell_ = StandstillSegment{};
+  dwell_recent_.clear();
+  dwell_quiet_since_s_ = kNaN;
   last_t_s_ = kNaN;
   // P and x stay; the time base of the prediction restarts with the next sample
   t_filter_s_ = kNaN;
@@ -309,7 +317,7 @@ Vector6d DriftlessFilter::correction_sigma_dps() const {
 
 template <int D>
 bool DriftlessFilter::update(const Eigen::Matrix<double, D, 1>& r, const Eigen::Matrix<double, D, kFullStateDim>& H,
-                             const Eigen::Matrix<double, D, D>& R, UpdateRecord& rec) {
+                             const Eigen::Matrix<double, D, D>& R, UpdateRecord& rec, bool may_relock) {
   // P here is P_k + Q_k (predict_to ran); the recursion of section 2, S^-1 through a Cholesky solve
   const Eigen::Matrix<double, kFullStateDim, D> PHt = P_ * H.transpose();
   const Eigen::Matrix<double, D, D> S = R + H * PHt;
@@ -318,13 +326,14 @@ bool DriftlessFilter::update(const Eigen::Matrix<double, D, 1>& r, const Eigen::
   rec.dim = D;
   rec.innovation_dps.setZero();
   rec.innovation_dps.head(D) = innov;
-  rec.nis_gate = D == 3 ? gate3_ : D == 4 ? gate4_ : gate6_;
+  rec.nis_gate = D == 1 ? gate1_ : D == 3 ? gate3_ : D == 4 ? gate4_ : gate6_;
   if (llt.info() != Eigen::Success) {
     rec.nis = kNaN;
     return false;
   }
   rec.nis = innov.dot(llt.solve(innov));
   if (!(rec.nis <= rec.nis_gate)) {
+    if (!may_relock) return false;
     // an outlier is rejected once or twice; a run of rejections means the state lost lock
     // (a bias step, another sensor after a source switch): widen P by the innovation, re-lock
     ++consecutive_rejections_;
@@ -341,11 +350,13 @@ bool DriftlessFilter::update(const Eigen::Matrix<double, D, 1>& r, const Eigen::
   // W = (P + Q) H^T S^-1
   const Eigen::Matrix<double, kFullStateDim, D> W = llt.solve(PHt.transpose()).transpose();
   x_ += W * innov;
-  const StateMatrix IKH = StateMatrix::Identity() - W * H;
   if (cfg_.covariance_update == CovarianceUpdate::kJoseph) {
-    P_ = IKH * P_ * IKH.transpose() + W * R * W.transpose();
+    // (I - W H) P (I - W H)^T + W R W^T multiplied out, P H^T = PHt: P - W (H P) - (W (H P))^T +
+    // W S W^T, O(n^2 D) instead of the O(n^3) of the two 48 x 48 products
+    const StateMatrix WHP = W * PHt.transpose();
+    P_ += W * S * W.transpose() - WHP - WHP.transpose();
   } else {
-    P_ = IKH * P_;  // as printed
+    P_ = (StateMatrix::Identity() - W * H) * P_;  // as printed
   }
   P_ = (0.5 * (P_ + P_.transpose())).eval();  // eval: no aliasing with the transpose
   for (int i = 0; i < kStateDim; ++i) P_(i, i) = std::max(P_(i, i), cfg_.variance_floor_dps2);
@@ -437,6 +448,8 @@ int DriftlessFilter::use_segment(const StandstillSegment& s) {
   prev_res_ = cur;
   predict_to(s.t_last_s);
   if (result != 0) last_update_.sigma_dps = sigma_dps();
+  // box dwells are used once the correction is known well below the rest threshold
+  if (uses_box_dwells()) dwell_armed_ = correction_sigma_dps().maxCoeff() < 0.1 * cfg_.box_dwell_rate_dps;
   return result;
 }
 
@@ -605,6 +618,8 @@ PushStatus DriftlessFilter::push_corrected(const Sample& s) {
 
   // 3. outputs with the estimate now in force
   fuse_rate(s, st);
+  // 4. a box dwell (box_dwell_updates): its vertical rate is the Earth's
+  if (uses_box_dwells()) track_box_dwell(s);
   return out_.status;
 }
 
@@ -617,14 +632,101 @@ PushStatus DriftlessFilter::finish() {
     const int r = use_segment(standstill_.closed(i));
     if (r != 0) result = r;
   }
+  if (uses_box_dwells()) close_box_dwell(kNaN, kNaN);  // a box still at the end of the stream
   return result > 0 ? PushStatus::kUpdated : result < 0 ? PushStatus::kRejected : PushStatus::kMoving;
 }
 
+// ---------------------------------------------------------------------------------------------
+// box dwells (docs/estimator.md section 1d): the box pauses with both platforms at rest; its
+// vertical rate is then the Earth's, which observes what both sensors share in box axes (their
+// common g-sensitivity along gravity acts like a turn about the vertical: eq. (2) cannot see it)
+
+bool DriftlessFilter::box_quiet(const Sample& s) const {
+  if (!dwell_armed_ || out_.sensors_fused != 2 || !out_.at_rest) return false;
+  if (!(out_.rate_body_dps.norm() < cfg_.box_dwell_rate_dps)) return false;
+  constexpr double kOneGTolerance = 0.05;  // |f| within 5 % of 1 g: no linear acceleration
+  for (const Eigen::Vector3d* a : {&s.accel1_mps2, &s.accel2_mps2}) {
+    if (!a->allFinite() || !(std::fabs(a->norm() / kStandardGravityMps2 - 1.0) < kOneGTolerance)) return false;
+  }
+  return true;
+}
+
+void DriftlessFilter::track_box_dwell(const Sample& s) {
+  const bool quiet = box_quiet(s);
+  const bool moved = finite(dwell_quiet_since_s_) &&
+                     (out_.plat1_deg != dwell_.plat1_deg || out_.plat2_deg != dwell_.plat2_deg);
+  if (!quiet || moved) close_box_dwell(s.temp1_c, s.temp2_c);
+  if (!quiet) return;
+  if (!finite(dwell_quiet_since_s_)) {
+    dwell_quiet_since_s_ = s.t_s;
+    dwell_.plat1_deg = out_.plat1_deg;
+    dwell_.plat2_deg = out_.plat2_deg;
+  }
+  if (s.t_s - dwell_quiet_since_s_ < cfg_.box_dwell_margin_s) return;  // the start margin
+  dwell_recent_.push_back({s.t_s, s.gyro1_dps, s.gyro2_dps, s.accel1_mps2, s.accel2_mps2, s.temp1_c, s.temp2_c});
+  // samples older than the end margin can no longer be spoiled by the motion that ends the dwell
+  while (dwell_recent_.front().t_s < s.t_s - cfg_.box_dwell_margin_s) {
+    const DwellSample& d = dwell_recent_.front();
+    if (dwell_.n == 0) dwell_.t_first_s = d.t_s;
+    dwell_.t_last_s = d.t_s;
+    ++dwell_.n;
+    ++dwell_.n_accel;
+    dwell_.sum_gyro1_dps += d.gyro1_dps;
+    dwell_.sum_gyro2_dps += d.gyro2_dps;
+    dwell_.sum_accel1_mps2 += d.accel1_mps2;
+    dwell_.sum_accel2_mps2 += d.accel2_mps2;
+    if (finite(d.temp1_c) && finite(d.temp2_c)) {
+      ++dwell_.n_temp;
+      dwell_.sum_temp1_c += d.temp1_c;
+      dwell_.sum_temp2_c += d.temp2_c;
+    }
+    dwell_recent_.pop_front();
+  }
+}
+
+// the dwell ends (motion, a platform leaves, the stream ends): used if long enough; the state is
+// then referred to the temperatures given (NaN: kept at the dwell's)
+void DriftlessFilter::close_box_dwell(double temp1_c, double temp2_c) {
+  if (dwell_.n >= 2 && dwell_.span_s() >= cfg_.box_dwell_min_s) {
+    use_box_dwell(dwell_);
+    predict_temperature(temp1_c, temp2_c);
+  }
+  dwell_ = StandstillSegment{};
+  dwell_recent_.clear();
+  dwell_quiet_since_s_ = kNaN;
+}
+
+void DriftlessFilter::use_box_dwell(const StandstillSegment& seg) {
+  const Eigen::Matrix3d M1 = body_from_sensor(1, seg.plat1_deg);
+  const Eigen::Matrix3d M2 = body_from_sensor(2, seg.plat2_deg);
+  const double to_g = 1.0 / (double(seg.n_accel) * kStandardGravityMps2);
+  last_f_g_ = {seg.sum_accel1_mps2 * to_g, seg.sum_accel2_mps2 * to_g};
+  // the box turns at the Earth rate only (0.004 deg/s): E times it stays below 1e-4 deg/s, far under
+  // a dwell's noise, and a rate taken from a bias not yet known would pass its error into E
+  last_w_dps_ = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  if (seg.n_temp > 0) predict_temperature(seg.sum_temp1_c / double(seg.n_temp), seg.sum_temp2_c / double(seg.n_temp));
+  const double t_mid = 0.5 * (seg.t_first_s + seg.t_last_s);
+  predict_to(std::max(t_mid, finite(t_filter_s_) ? t_filter_s_ : t_mid));
+  // one axis of eq. (2)'s R for this segment (rotations: M1 M1^T + M2 M2^T = 2 I), as rest_row expects
+  const double rate_hz = double(seg.n - 1) / seg.span_s();
+  const double var_r = 2.0 * (cfg_.sample_variance_dps2(rate_hz) / double(seg.n) + q_rate_dps2_per_s_ * seg.span_s() / 12.0);
+  Eigen::Matrix<double, 1, kFullStateDim> h;
+  Eigen::Matrix<double, 1, 1> z, var_z;
+  if (!rest_row(seg, M1, M2, var_r, h, z(0), var_z(0))) return;
+  UpdateRecord rec;  // not emitted: the platform updates' record and counts stay theirs
+  const bool ok = update<1>(z, h, var_z, rec, false);
+  ++counters_.box_dwell_updates;
+  if (!ok) ++counters_.box_dwell_rejected;
+  predict_to(std::max(seg.t_last_s, t_filter_s_));
+}
+
+template bool DriftlessFilter::update<1>(const Eigen::Matrix<double, 1, 1>&, const Eigen::Matrix<double, 1, kFullStateDim>&,
+                                         const Eigen::Matrix<double, 1, 1>&, UpdateRecord&, bool);
 template bool DriftlessFilter::update<3>(const Eigen::Matrix<double, 3, 1>&, const Eigen::Matrix<double, 3, kFullStateDim>&,
-                                         const Eigen::Matrix<double, 3, 3>&, UpdateRecord&);
+                                         const Eigen::Matrix<double, 3, 3>&, UpdateRecord&, bool);
 template bool DriftlessFilter::update<4>(const Eigen::Matrix<double, 4, 1>&, const Eigen::Matrix<double, 4, kFullStateDim>&,
-                                         const Eigen::Matrix<double, 4, 4>&, UpdateRecord&);
+                                         const Eigen::Matrix<double, 4, 4>&, UpdateRecord&, bool);
 template bool DriftlessFilter::update<6>(const Eigen::Matrix<double, 6, 1>&, const Eigen::Matrix<double, 6, kFullStateDim>&,
-                                         const Eigen::Matrix<double, 6, 6>&, UpdateRecord&);
+                                         const Eigen::Matrix<double, 6, 6>&, UpdateRecord&, bool);
 
 }  // namespace driftless::est

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdint>
+#include <deque>
 #include <iosfwd>
 #include <string>
 #include <vector>
@@ -110,6 +111,9 @@ struct FilterCounters {
   std::uint64_t schedule_mismatches = 0;  // paper mode: measured positions differ from eq. (5)
   std::uint64_t source_switches = 0;
   std::uint64_t relocks = 0;  // gate re-locks after gate_relock_after consecutive rejections
+  // box-dwell updates of the vertical rate (box_dwell_updates; not in `updates`/`rejected`)
+  std::uint64_t box_dwell_updates = 0;
+  std::uint64_t box_dwell_rejected = 0;
 };
 
 /// The streaming DriftLess filter.
@@ -154,6 +158,9 @@ class DriftlessFilter {
   Eigen::Matrix3d scale_misalign(int sensor) const;
   Eigen::Matrix3d scale_misalign_sigma(int sensor) const;
   bool has_scale_states() const { return cfg_.self_calibration && cfg_.scale_misalign_sigma_frac > 0.0; }
+  /// Box dwells measure the vertical rate (self-calibrating mode, box_dwell_updates, and not
+  /// box_at_rest, whose standstill rows measure the same already)
+  bool uses_box_dwells() const { return cfg_.self_calibration && cfg_.box_dwell_updates && !cfg_.box_at_rest; }
   /// Sigma of the correction the filter applies, o_i = b_i + G_i f_i at the specific force of
   /// the last update (deg/s): what "locked" means. The bias sigma without self-calibration; with
   /// it, b_i alone may stay unobservable (a g-sensitivity along a fixed gravity looks like bias).
@@ -196,12 +203,17 @@ class DriftlessFilter {
   Vector6d bias_at(const Sample& s) const;
   template <int D>
   bool update(const Eigen::Matrix<double, D, 1>& r, const Eigen::Matrix<double, D, kFullStateDim>& H,
-              const Eigen::Matrix<double, D, D>& R, UpdateRecord& rec);
+              const Eigen::Matrix<double, D, D>& R, UpdateRecord& rec, bool may_relock = true);
   void emit_update(const UpdateRecord& rec, bool accepted);
   void fuse_rate(const Sample& s, const StandstillStep& st);
   void scale_rows(const StandstillSegment& seg, const Eigen::Matrix3d& M1, const Eigen::Matrix3d& M2,
                   Residual3& out);
   void skip_paper_step();
+  // box dwells (cfg_.box_dwell_updates, docs/estimator.md section 1d)
+  bool box_quiet(const Sample& s) const;
+  void track_box_dwell(const Sample& s);
+  void close_box_dwell(double temp1_c, double temp2_c);
+  void use_box_dwell(const StandstillSegment& seg);
 
   EstimatorConfig cfg_;
   BoxGeometry box_;
@@ -220,7 +232,18 @@ class DriftlessFilter {
   double last_t_s_ = kNaN;
 
   StandstillDetector standstill_;
-  double gate3_ = 0.0, gate4_ = 0.0, gate6_ = 0.0;
+  // the box dwell in progress: samples older than box_dwell_margin_s in dwell_, the newer ones
+  // (dropped if the dwell ends now) in dwell_recent_; armed once the correction is known
+  struct DwellSample {
+    double t_s;
+    Eigen::Vector3d gyro1_dps, gyro2_dps, accel1_mps2, accel2_mps2;
+    double temp1_c, temp2_c;
+  };
+  StandstillSegment dwell_;
+  std::deque<DwellSample> dwell_recent_;
+  double dwell_quiet_since_s_ = kNaN;
+  bool dwell_armed_ = false;
+  double gate1_ = 0.0, gate3_ = 0.0, gate4_ = 0.0, gate6_ = 0.0;
   // cached M_body_from_sensor of the last angle asked for, per sensor
   mutable std::array<double, 2> cache_deg_{kNaN, kNaN};
   mutable std::array<Eigen::Matrix3d, 2> cache_M_{Eigen::Matrix3d::Identity(), Eigen::Matrix3d::Identity()};

@@ -265,9 +265,12 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
   sum.temp_coef_sigma_dps_per_degc = filter.temp_coef_sigma_dps_per_degc();
   sum.temp_ref_c = filter.temperature_ref_c();
   sum.gsens_states = filter.has_gsens_states();
+  sum.scale_states = filter.has_scale_states();
   for (int i = 0; i < 2; ++i) {
     sum.gsens_dps_per_g[static_cast<std::size_t>(i)] = filter.g_sensitivity_dps_per_g(i + 1);
     sum.gsens_sigma_dps_per_g[static_cast<std::size_t>(i)] = filter.g_sensitivity_sigma_dps_per_g(i + 1);
+    sum.scale_misalign_frac[static_cast<std::size_t>(i)] = filter.scale_misalign(i + 1);
+    sum.scale_misalign_sigma_frac[static_cast<std::size_t>(i)] = filter.scale_misalign_sigma(i + 1);
   }
   sum.correction_sigma_dps = filter.correction_sigma_dps();
   add_attitude_results(att, filter, opt, sum);

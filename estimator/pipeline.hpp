@@ -116,6 +116,11 @@ struct EstimateSummary {
   std::array<Eigen::Matrix3d, 2> gsens_dps_per_g{Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero()};
   std::array<Eigen::Matrix3d, 2> gsens_sigma_dps_per_g{Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero()};
   Vector6d correction_sigma_dps = Vector6d::Constant(kNaN);
+  // ... and its scale-factor and misalignment error E_i (fraction, sensor axes) with each
+  // element's sigma (states with scale_misalign_sigma_frac > 0)
+  bool scale_states = false;
+  std::array<Eigen::Matrix3d, 2> scale_misalign_frac{Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero()};
+  std::array<Eigen::Matrix3d, 2> scale_misalign_sigma_frac{Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero()};
   double t_first_s = kNaN, t_last_s = kNaN;
   bool attitude_available = false;   // the log has ref_q
   double drift_corrected_deg_per_h = kNaN;

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The self-calibrating mode (docs/estimator.md section 1b) on the built-in static scenario (MPU6050
 # defaults, g-sensitivity not calibrated out): without it the estimate fails, exits 1 and names
-# --selfcal; with --selfcal --box-at-rest it locks, rejects nothing and reports G with its sigma.
+# --selfcal; with --selfcal --box-at-rest, or --selfcal alone (box dwells), it locks, rejects nothing
+# and reports G with its sigma.
 # usage: estimate_selfcal.sh <path-to-driftless> <source-dir>
 set -uo pipefail
 bin=$1
@@ -23,7 +24,16 @@ grep -q -- "--selfcal" "$t/plain.err" || fail "defaults: the fix is not named: $
 grep -q '"rejected": 0,' "$t/sc/summary.json" || fail "--selfcal: updates rejected"
 grep -q '"self_calibration": {"enabled": true' "$t/sc/summary.json" || fail "no self_calibration block"
 grep -q '"g_sensitivity_sigma_dps_per_g": \[\[\[' "$t/sc/summary.json" || fail "no G sigma in summary.json"
-# AND without --box-at-rest the lock failure names it
-"$bin" estimate --log "$t/sim/log.csv" --out "$t/free" --selfcal > /dev/null 2> "$t/free.err"
+# AND with --selfcal alone the box dwells between flips (docs/estimator.md section 1d) measure the
+# vertical: ok with --strict, dwell updates reported, none rejected
+"$bin" estimate --log "$t/sim/log.csv" --out "$t/dw" --selfcal --strict > /dev/null 2> "$t/dw.err" ||
+  fail "--selfcal (box dwells): exit $?: $(cat "$t/dw.err")"
+[[ $(verdict "$t/dw") == ok ]] || fail "--selfcal (box dwells): verdict $(verdict "$t/dw")"
+grep -Eq '"box_dwells": \{"updates": [1-9][0-9]*, "rejected": 0\}' "$t/dw/summary.json" ||
+  fail "--selfcal: no box dwell updates: $(grep -o '"box_dwells": {[^}]*}' "$t/dw/summary.json")"
+# AND without box dwells (box_dwell_updates: false) nor --box-at-rest the lock failure names --box-at-rest
+echo "box_dwell_updates: false" > "$t/nodw.yaml"
+"$bin" estimate --log "$t/sim/log.csv" --out "$t/free" --selfcal --config "$t/nodw.yaml" > /dev/null 2> "$t/free.err"
+[[ $? -eq 1 ]] || fail "--selfcal without dwells: expected exit 1"
 grep -q -- "--box-at-rest" "$t/free.err" || fail "--selfcal alone: --box-at-rest not proposed: $(cat "$t/free.err")"
 echo "ok"
