@@ -106,7 +106,7 @@ double saturation_evidence(const Replay& r, const Residual& res, int c, double y
   std::size_t plateau = 0;
   for (std::size_t k = 0; k < res.n; ++k) {
     if (!r.usable[k]) continue;
-    const double v = r.gyro_dps[s][k][j], pv = res.pred[s].gyro_dps[k][j] + bias_dps;
+    const double v = r.gyro_dps[s][k][j], pv = res.pred_dps(s, j, k) + bias_dps;
     if (std::abs(std::abs(v) - ymax) <= tol && std::abs(pv) > ymax + 5.0 * floor_dps) {
       ++plateau;
       dj += std::pow((std::abs(pv) - ymax) / std::max(floor_dps, 1e-3), 2);

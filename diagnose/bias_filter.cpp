@@ -121,51 +121,23 @@ double BiasWhitener::neg2_loglik(const BlockSeries& blocks, const ChannelNoise& 
 }
 
 void BiasWhitener::whiten(std::span<const double> z, std::span<double> out) const {
-  double x0 = 0.0, x1 = 0.0;
-  for (std::size_t j = 0; j < steps_.size(); ++j) {
-    const Step& st = steps_[j];
-    x1 *= st.phi;
-    if (st.s > 0.0) {
-      const double nu = z[j] - x0 - x1;
-      x0 += st.k0 * nu;
-      x1 += st.k1 * nu;
-      out[j] = used_[j] ? nu / std::sqrt(st.s) : 0.0;
-    } else {
-      out[j] = 0.0;
-    }
-  }
+  forward(z, [&](std::size_t j, const Step& st, double nu, double, double) {
+    out[j] = st.s > 0.0 && used_[j] ? nu / std::sqrt(st.s) : 0.0;
+  });
 }
 
 double BiasWhitener::neg2_loglik(std::span<const double> z) const {
-  double x0 = 0.0, x1 = 0.0, acc = 0.0;
-  for (std::size_t j = 0; j < steps_.size(); ++j) {
-    const Step& st = steps_[j];
-    x1 *= st.phi;
-    if (st.s > 0.0) {
-      const double nu = z[j] - x0 - x1;
-      x0 += st.k0 * nu;
-      x1 += st.k1 * nu;
-      if (used_[j]) acc += std::log(st.s) + nu * nu / st.s;
-    }
-  }
+  double acc = 0.0;
+  forward(z, [&](std::size_t j, const Step& st, double nu, double, double) {
+    if (st.s > 0.0 && used_[j]) acc += std::log(st.s) + nu * nu / st.s;
+  });
   return acc;
 }
 
 std::vector<double> BiasWhitener::smooth(std::span<const double> z) const {
   const std::size_t m = steps_.size();
   std::vector<double> xf0(m), xf1(m), out(m);
-  double x0 = 0.0, x1 = 0.0;
-  for (std::size_t j = 0; j < m; ++j) {
-    const Step& st = steps_[j];
-    x1 *= st.phi;
-    if (st.s > 0.0) {
-      const double nu = z[j] - x0 - x1;
-      x0 += st.k0 * nu;
-      x1 += st.k1 * nu;
-    }
-    xf0[j] = x0;
-    xf1[j] = x1;
-  }
+  forward(z, [&](std::size_t j, const Step&, double, double x0, double x1) { xf0[j] = x0, xf1[j] = x1; });
   if (m == 0) return out;
   // Rauch-Tung-Striebel backward pass: C = Pf F^T Pp_next^{-1}
   double s0 = xf0[m - 1], s1 = xf1[m - 1];

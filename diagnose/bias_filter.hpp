@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -57,6 +58,24 @@ class BiasWhitener {
     // RTS smoother: filtered and predicted covariances
     double pf00, pf01, pf11, pp00, pp01, pp11;
   };
+  /// The filter's forward pass over z, the one loop whiten, neg2_loglik and smooth share: after
+  /// block j it calls visit(j, step, nu, x0, x1) with the innovation nu (NaN where the block has
+  /// no data and the state was only predicted) and the filtered states.
+  template <class Visit>
+  void forward(std::span<const double> z, Visit&& visit) const {
+    double x0 = 0.0, x1 = 0.0;
+    for (std::size_t j = 0; j < steps_.size(); ++j) {
+      const Step& st = steps_[j];
+      x1 *= st.phi;
+      double nu = std::numeric_limits<double>::quiet_NaN();
+      if (st.s > 0.0) {
+        nu = z[j] - x0 - x1;
+        x0 += st.k0 * nu;
+        x1 += st.k1 * nu;
+      }
+      visit(j, st, nu, x0, x1);
+    }
+  }
   std::vector<Step> steps_;
   std::vector<std::uint8_t> used_;
   std::size_t n_used_ = 0;

@@ -170,7 +170,7 @@ CompareResult compare(const Replay& r, const CompareModel& model, const CompareO
   out.samples_used = res.samples_used;
   out.block_s = static_cast<double>(res.block_len) / res.fs_hz;
   // 2: per-channel regressors, whitening, white density (a nuisance)
-  const ColumnInputs in{r, res.pred, model.sensor};
+  const ColumnInputs in{r, res, model.sensor};
   Channels ch = build_channels(in, res);
   out.blocks_used = ch[0].m;
   // 3: forward selection of the physical, box, signal-chain and ADC effects; 4: the noise model

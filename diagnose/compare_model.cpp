@@ -171,13 +171,14 @@ SensorPrediction predict_sensor(const Replay& r, int s, const SensorParams& p, c
   // (linear interpolation of the replayed truth)
   const double delay_s = time_offset_s + (d.sample_delay.enabled ? d.sample_delay.delay_s : 0.0);
   const double shift = delay_s * r.sample_rate_hz;
-  auto truth_at = [&](const std::vector<Eigen::Vector3d>& v, std::size_t k) -> Eigen::Vector3d {
-    if (shift == 0.0) return v[k];
+  // a series at the prediction's time (linear between samples), double whatever it is stored as
+  auto truth_at = [&](const auto& v, std::size_t k) -> Eigen::Vector3d {
+    if (shift == 0.0) return v[k].template cast<double>();
     const double x = std::clamp(static_cast<double>(k) - shift, 0.0, static_cast<double>(n - 1));
     const auto i = static_cast<std::size_t>(std::floor(x));
     const double u = x - static_cast<double>(i);
-    if (i + 1 >= n || u == 0.0) return v[i];
-    return (1.0 - u) * v[i] + u * v[i + 1];
+    if (i + 1 >= n || u == 0.0) return v[i].template cast<double>();
+    return (1.0 - u) * v[i].template cast<double>() + u * v[i + 1].template cast<double>();
   };
   Eigen::Vector3d last_w = Eigen::Vector3d::Zero(), last_f(0, 0, kStandardGravityMps2);
   for (std::size_t k = 0; k < n; ++k) {

@@ -102,16 +102,21 @@ std::vector<ColumnUse> on_both(int col) {
 
 const EffectInfo& effect_info(Effect e) { return kEffects[static_cast<std::size_t>(e)]; }
 
-const char* family_name(Family f) {
-  switch (f) {
-    case Family::kPhysical: return "physical";
-    case Family::kBox: return "box";
-    case Family::kSignalChain: return "signal chain";
-    case Family::kAdc: return "ADC";
-    case Family::kNoiseModel: return "noise model";
-  }
-  return "?";
-}
+namespace {
+// each family's machine-readable id (diagnosis.json) and its name in text and HTML
+struct FamilyText {
+  const char* id;
+  const char* name;
+};
+constexpr std::array<FamilyText, 5> kFamilyText = {{{"physical", "physical"},
+                                                    {"box", "box"},
+                                                    {"signal_chain", "signal chain"},
+                                                    {"adc", "ADC"},
+                                                    {"noise_model", "noise model"}}};
+}  // namespace
+
+const char* family_name(Family f) { return kFamilyText[static_cast<std::size_t>(f)].name; }
+const char* family_id(Family f) { return kFamilyText[static_cast<std::size_t>(f)].id; }
 
 const char* param_unit(Param p) { return param_info(p).unit; }
 Effect effect_of(Param p) { return param_info(p).effect; }
@@ -167,15 +172,15 @@ double column_value(const ColumnInputs& in, int s, int j, int col, std::size_t k
     case kScale: return w[j] * kDegPerRad / 100.0;
     case kMisA: return w[other_axes(j)[0]] * kDegPerRad / 100.0;
     case kMisB: return w[other_axes(j)[1]] * kDegPerRad / 100.0;
-    case kG0: case kG1: case kG2: return r.f_mps2[s][k][col - kG0] / kStandardGravityMps2;
+    case kG0: case kG1: case kG2: return static_cast<double>(r.f_mps2[s][k][col - kG0]) / kStandardGravityMps2;
     case kMount0: case kMount1: case kMount2:
       return w.cross(Eigen::Vector3d::Unit(col - kMount0))[j] * kDegPerRad * kRadPerDeg;
-    case kTempBias: return in.pred[s].temp_c[k] - in.params[s].temperature.reference_degc;
+    case kTempBias: return in.res.temp_c(s, k) - in.params[s].temperature.reference_degc;
     case kTempScale:
-      return (in.pred[s].temp_c[k] - in.params[s].temperature.reference_degc) * w[j] * kDegPerRad / 100.0;
+      return (in.res.temp_c(s, k) - in.params[s].temperature.reference_degc) * w[j] * kDegPerRad / 100.0;
     case kNonlin2: case kNonlin3: {
       const double fs = in.params[s].saturation.full_scale_dps;
-      const double u = in.pred[s].gyro_dps[k][j] / fs;
+      const double u = in.res.pred_dps(s, j, k) / fs;
       return fs * (col == kNonlin2 ? u * u : u * u * u) / 100.0;
     }
     case kDelay: return -r.dw_radps2(s, k)[j] * kDegPerRad;
@@ -188,7 +193,7 @@ double column_value(const ColumnInputs& in, int s, int j, int col, std::size_t k
       if (r.rest_side[s][k] != (col == kEndPlus ? 1 : -1)) return 0.0;
       return -r.hinge_axis[s].cross(w)[j] * kDegPerRad * kRadPerDeg;
     }
-    case kLat: return r.dw_dlat_radps[s][k][j] * kDegPerRad * kRadPerDeg;
+    case kLat: return static_cast<double>(r.dw_dlat_radps[s][k][j]) * kDegPerRad * kRadPerDeg;
     default: {  // flip bins
       const auto b = static_cast<std::size_t>(col - kFlip0);
       const double since = r.since_flip_s[s][k];

@@ -12,6 +12,7 @@
 
 #include "diagnose/compare_model.hpp"
 #include "diagnose/replay.hpp"
+#include "diagnose/residual.hpp"
 #include "twin/sensor/sensor_model.hpp"
 
 namespace driftless::diagnose {
@@ -41,7 +42,10 @@ struct EffectInfo {
 };
 const EffectInfo& effect_info(Effect e);
 inline const char* effect_id(Effect e) { return effect_info(e).id; }
+/// The family in text and HTML: "physical", "box", "signal chain", "ADC", "noise model".
 const char* family_name(Family f);
+/// The family in diagnosis.json: physical|box|signal_chain|adc|noise_model.
+const char* family_id(Family f);
 
 /// Which model value a fitted parameter is (the field --apply writes).
 enum class Param : std::uint8_t {
@@ -109,10 +113,11 @@ inline constexpr std::array<double, 5> kFlipBinsS = {0.0, 0.25, 0.5, 1.0, 2.0};
 /// Prior 1-sigma of a platform's rest angle on a stop, deg (servo press differs between boxes).
 inline constexpr double kRestAngleSigmaDeg = 0.01;
 
-/// What a column needs besides the replay: the model's prediction (output and temperature).
+/// What a column needs besides the replay: the model's prediction (output and temperature, from
+/// the residual).
 struct ColumnInputs {
   const Replay& r;
-  const std::array<SensorPrediction, 2>& pred;
+  const Residual& res;
   const std::array<twin::SensorParams, 2>& params;
 };
 /// Value of column `col` for channel (sensor s, axis j) at sample k.

@@ -150,7 +150,7 @@ PerChannel jitter(const Replay& r, const Residual& res, const std::array<double,
   for (int j = 0; j < 3; ++j) {
     const double v0 = std::pow(floor_dps[static_cast<std::size_t>(s * 3 + j)], 2);
     for (std::size_t k = 0; k < res.n; ++k) {
-      const double e = a.e[s * 3 + j][k];
+      const double e = a.e(s * 3 + j, k);
       if (!res.mask[k] || !std::isfinite(e)) continue;
       const double g2 = std::pow(r.dw_radps2(s, k)[j] * kDegPerRad, 2);
       const double var = 2.0 * std::pow(v0 + sj2 * g2, 2) + 1e-30;

@@ -1,6 +1,7 @@
 // Where the model fails: the residual after the selection by regime, by window, and its
 // correlation with the inputs (docs/compare.md section 4).
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -25,11 +26,12 @@ void add_regime(const Replay& r, const AfterFit& a, const std::string& group, co
   const int nc = 3 * r.sensors;  // channels with data
   for (std::size_t k = 0; k < r.size(); ++k) {
     if (!r.usable[k] || !sel(k)) continue;
+    std::array<float, 6> e{};
     bool ok = true;
-    for (int c = 0; c < nc; ++c) ok = ok && std::isfinite(a.e[c][k]);
+    for (int c = 0; c < nc; ++c) e[c] = a.e(c, k), ok = ok && std::isfinite(e[c]);
     if (!ok) continue;
     ++rs.samples;
-    for (int c = 0; c < nc; ++c) s1[c] += a.e[c][k], s2[c] += static_cast<double>(a.e[c][k]) * a.e[c][k];
+    for (int c = 0; c < nc; ++c) s1[c] += e[c], s2[c] += static_cast<double>(e[c]) * e[c];
   }
   if (rs.samples == 0) return;
   rs.mean_dps.fill(kNaN);
@@ -87,7 +89,7 @@ void regimes(const Replay& r, const Residual& res, const AfterFit& a, CompareRes
   add_bands(r, a, "base rate", {0.0, 1.0, 10.0, 30.0, kInf}, "deg/s",
             [&](std::size_t k) { return std::max(0.0, r.w_body_radps[k].norm() * kDegPerRad - we); }, out);
   add_bands(r, a, "acceleration", {0.0, 0.5, 2.0, kInf}, "m/s^2",
-            [&](std::size_t k) { return std::abs(r.f_body_mps2[k].norm() - kStandardGravityMps2); }, out);
+            [&](std::size_t k) { return std::abs(static_cast<double>(r.f_body_mps2[k].norm()) - kStandardGravityMps2); }, out);
   temperature_quartiles(r, res, a, out);
 }
 
@@ -101,10 +103,11 @@ void windows(const Replay& r, const Residual& res, const AfterFit& a, const Comp
     std::size_t cnt = 0;
     for (; k < res.n && r.t_s[k] < w.t0_s + ws; ++k) {
       if (!res.mask[k]) continue;
+      std::array<float, 6> e{};
       bool ok = true;
-      for (int c = 0; c < res.channels(); ++c) ok = ok && std::isfinite(a.e[c][k]);
+      for (int c = 0; c < res.channels(); ++c) e[c] = a.e(c, k), ok = ok && std::isfinite(e[c]);
       if (!ok) continue;
-      for (int c = 0; c < res.channels(); ++c) s2[c] += static_cast<double>(a.e[c][k]) * a.e[c][k];
+      for (int c = 0; c < res.channels(); ++c) s2[c] += static_cast<double>(e[c]) * e[c];
       ++cnt;
     }
     w.t1_s = k < res.n ? r.t_s[k] : r.t_s.back();
@@ -132,11 +135,11 @@ void correlations(const Replay& r, const Residual& res, const Channels& ch, cons
   for (int ax = 0; ax < 3; ++ax) {
     sigs.emplace_back(fmt::format("body rate {}", axis_letter(ax)), [&, ax](std::size_t k) { return r.w_body_radps[k][ax]; });
     sigs.emplace_back(fmt::format("|body rate {}|", axis_letter(ax)), [&, ax](std::size_t k) { return std::abs(r.w_body_radps[k][ax]); });
-    sigs.emplace_back(fmt::format("specific force {}", axis_letter(ax)), [&, ax](std::size_t k) { return r.f_body_mps2[k][ax]; });
+    sigs.emplace_back(fmt::format("specific force {}", axis_letter(ax)), [&, ax](std::size_t k) { return static_cast<double>(r.f_body_mps2[k][ax]); });
   }
   sigs.emplace_back("time", [&](std::size_t k) { return r.t_s[k]; });
   for (int s = 0; s < res.sensors; ++s) {
-    sigs.emplace_back(fmt::format("temperature {}", s + 1), [&, s](std::size_t k) { return res.pred[s].temp_c[k]; });
+    sigs.emplace_back(fmt::format("temperature {}", s + 1), [&, s](std::size_t k) { return res.temp_c(s, k); });
     sigs.emplace_back(fmt::format("time since flip {}", s + 1), [&, s](std::size_t k) { return std::min(10.0f, r.since_flip_s[s][k]); });
   }
   std::array<std::vector<double>, 6> rw;

@@ -292,8 +292,9 @@ void body_rate(Raw& raw, const Eigen::Vector3d& earth_enu, const ReplayOptions& 
   for (std::size_t k = 0; k < std::min(n, M); ++k) out.rough[k] = out.rough[n - 1 - k] = 1;
 }
 
-// specific force in body axes: second differences of ref_p, else gravity only
-void specific_force(Raw& raw, Replay& out) {
+// specific force in body axes: second differences of ref_p, else gravity only (double here: the
+// sensors' series are rotated from it; the Replay keeps a float copy)
+std::vector<Eigen::Vector3d> specific_force(Raw& raw, Replay& out) {
   const std::size_t n = raw.size();
   bool p_ok = out.has_ref_p;
   if (p_ok) {
@@ -301,6 +302,7 @@ void specific_force(Raw& raw, Replay& out) {
     if (!p_ok) out.notes.push_back("ref_p has empty values; accelerations set to zero");
   }
   const Eigen::Vector3d g_enu(0, 0, kStandardGravityMps2);  // f = a - g, g = (0,0,-9.81)
+  std::vector<Eigen::Vector3d> f_body(n);
   out.f_body_mps2.resize(n);
   for (std::size_t k = 0; k < n; ++k) {
     Eigen::Vector3d a_enu = Eigen::Vector3d::Zero();
@@ -308,44 +310,51 @@ void specific_force(Raw& raw, Replay& out) {
       const double h1 = out.t_s[k] - out.t_s[k - 1], h2 = out.t_s[k + 1] - out.t_s[k];
       a_enu = 2.0 * ((raw.p[k + 1] - raw.p[k]) / h2 - (raw.p[k] - raw.p[k - 1]) / h1) / (h1 + h2);
     }
-    out.f_body_mps2[k] = quat(raw.q[k]).conjugate() * (a_enu + g_enu);
+    f_body[k] = quat(raw.q[k]).conjugate() * (a_enu + g_enu);
+    out.f_body_mps2[k] = f_body[k].cast<float>();
   }
-  raw.p = {};  // ref_p is used up
+  raw.p = std::vector<Eigen::Vector3d>();  // ref_p is used up (not "= {}": that keeps the memory)
   if (!out.has_accel && !p_ok) {
     out.notes.push_back("no ref_p and no accel columns: the specific force is gravity alone (vehicle accelerations unknown)");
   }
   if (out.has_accel) out.notes.push_back("the specific force on each sensor is taken from the log's accel columns");
+  return f_body;
 }
 
-// platforms: angle as logged, rate by central differences; unknown angle = moving
-std::array<std::vector<std::uint8_t>, 2> platform_motion(Raw& raw, const ReplayOptions& opt, Replay& out) {
-  const std::size_t n = raw.size();
+// platforms: angle as logged, rate by central differences (NaN unknown); unknown angle = moving
+struct PlatformMotion {
   std::array<std::vector<std::uint8_t>, 2> moving;
+  std::array<std::vector<double>, 2> rate_dps;
+};
+
+PlatformMotion platform_motion(Raw& raw, const ReplayOptions& opt, Replay& out) {
+  const std::size_t n = raw.size();
+  PlatformMotion pm;
   for (int s = 0; s < 2; ++s) {
     const std::vector<double>& plat = raw.plat[s];
-    out.plat_rate_dps[s].resize(n);
+    std::vector<double>& rate = pm.rate_dps[s];
+    rate.resize(n);
     if (out.has_temp) {
       out.temp_c[s] = std::move(raw.temp[s]);
     } else {
-      out.temp_c[s].assign(n, kNaN), raw.temp[s] = {};
+      out.temp_c[s].assign(n, kNaN), raw.temp[s] = std::vector<double>();
     }
-    moving[s].assign(n, 0);
+    pm.moving[s].assign(n, 0);
     for (std::size_t k = 0; k < n; ++k) {
       const std::size_t a = k == 0 ? 0 : k - 1, b = k + 1 < n ? k + 1 : n - 1;
-      out.plat_rate_dps[s][k] = std::isfinite(plat[k]) ? (plat[b] - plat[a]) / (out.t_s[b] - out.t_s[a]) : kNaN;
-      const double r = out.plat_rate_dps[s][k];
-      moving[s][k] = !std::isfinite(r) || std::abs(r) > opt.flip_rate_threshold_dps;
+      rate[k] = std::isfinite(plat[k]) ? (plat[b] - plat[a]) / (out.t_s[b] - out.t_s[a]) : kNaN;
+      pm.moving[s][k] = !std::isfinite(rate[k]) || std::abs(rate[k]) > opt.flip_rate_threshold_dps;
     }
   }
   // flips: a platform turning or unknown; guard a few samples around it
   out.flipping.assign(n, 0);
   const auto guard = static_cast<std::size_t>(std::ceil(opt.flip_guard_s * out.sample_rate_hz));
   for (std::size_t k = 0; k < n; ++k) {
-    if (!(moving[0][k] || moving[1][k])) continue;
+    if (!(pm.moving[0][k] || pm.moving[1][k])) continue;
     const std::size_t a = k >= guard ? k - guard : 0, b = std::min(n - 1, k + guard);
     for (std::size_t i = a; i <= b; ++i) out.flipping[i] = 1;
   }
-  return moving;
+  return pm;
 }
 
 // per platform: time since it last stopped, the direction it went, the side it rests on
@@ -381,32 +390,36 @@ void flip_history(const Raw& raw, const std::array<std::vector<std::uint8_t>, 2>
 }
 
 // each sensor's ideal output (docs/log-format.md): y_i = R_i^T w_body + thetadot_i a_i
-void sensor_truth(Raw& raw, const Eigen::Vector3d& dearth_dlat_enu, Replay& out) {
+void sensor_truth(Raw& raw, const std::vector<Eigen::Vector3d>& f_body, const PlatformMotion& pm,
+                  const Eigen::Vector3d& dearth_dlat_enu, Replay& out) {
   const std::size_t n = raw.size();
   out.usable.assign(n, 1);
+  const Eigen::Vector3f nan3 = Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN());
   for (int s = 0; s < 2; ++s) {
     out.w_radps[s].resize(n);
     out.dw_dlat_radps[s].resize(n);
-    // the log's accel columns are the specific force where they are finite (used in place)
-    std::vector<Eigen::Vector3d> f = out.has_accel ? std::move(raw.a[s]) : std::vector<Eigen::Vector3d>(n);
+    // the log's accel columns are the specific force where they are finite
+    std::vector<Eigen::Vector3f>& f = out.f_mps2[s];
+    f.resize(n);
     const Eigen::Vector3d& axis = out.hinge_axis[s];
     for (std::size_t k = 0; k < n; ++k) {
       const double ang = raw.plat[s][k];
       if (!std::isfinite(ang)) {
         out.w_radps[s][k].setConstant(kNaN);
-        f[k].setConstant(kNaN);
-        out.dw_dlat_radps[s][k].setConstant(kNaN);
+        f[k] = nan3;
+        out.dw_dlat_radps[s][k] = nan3;
         out.usable[k] = 0;
         continue;
       }
       const Eigen::Matrix3d Rt = geo::rot_about_axis_deg(axis, ang).transpose();
-      const double rate = out.plat_rate_dps[s][k];
+      const double rate = pm.rate_dps[s][k];
       out.w_radps[s][k] = Rt * out.w_body_radps[k] + (std::isfinite(rate) ? rate : 0.0) * kRadPerDeg * axis;
-      if (!(out.has_accel && f[k].allFinite())) f[k] = Rt * out.f_body_mps2[k];
-      out.dw_dlat_radps[s][k] = Rt * (quat(raw.q[k]).conjugate() * dearth_dlat_enu);
+      const bool logged = out.has_accel && raw.a[s][k].allFinite();
+      f[k] = (logged ? raw.a[s][k] : Eigen::Vector3d(Rt * f_body[k])).cast<float>();
+      out.dw_dlat_radps[s][k] = (Rt * (quat(raw.q[k]).conjugate() * dearth_dlat_enu)).cast<float>();
       if (s < out.sensors && !raw.g[s][k].allFinite()) out.usable[k] = 0;
     }
-    out.f_mps2[s] = std::move(f);
+    raw.a[s] = std::vector<Eigen::Vector3d>();
     out.gyro_dps[s] = std::move(raw.g[s]);
     out.plat_deg[s] = std::move(raw.plat[s]);
   }
@@ -434,9 +447,10 @@ Replay build(Raw raw, const log::Metadata& meta, std::uint32_t fields, const Rep
   const Eigen::Vector3d earth_enu = geo::earth_rate_enu_radps(lat);
   const Eigen::Vector3d dearth_dlat_enu = geo::earth_rate_enu_dlat_radps_per_rad(lat);
   body_rate(raw, earth_enu, opt, out);
-  specific_force(raw, out);
-  flip_history(raw, platform_motion(raw, opt, out), out);
-  sensor_truth(raw, dearth_dlat_enu, out);
+  const std::vector<Eigen::Vector3d> f_body = specific_force(raw, out);
+  const PlatformMotion pm = platform_motion(raw, opt, out);
+  flip_history(raw, pm.moving, out);
+  sensor_truth(raw, f_body, pm, dearth_dlat_enu, out);
   return out;
 }
 

@@ -43,13 +43,14 @@ struct Replay {
   std::vector<double> t_s;                               // s, log time
   std::array<std::vector<Eigen::Vector3d>, 2> gyro_dps;  // measured, sensor axes, deg/s
   std::array<std::vector<Eigen::Vector3d>, 2> w_radps;   // ideal inertial rate y_i, sensor axes
-  std::array<std::vector<Eigen::Vector3d>, 2> f_mps2;    // specific force, sensor axes
+  // the slowly varying or small series below are stored as float (7 significant digits: 1e-6
+  // m/s^2 of a specific force, 1e-12 rad/s of the latitude sensitivity), half the memory of double
+  std::array<std::vector<Eigen::Vector3f>, 2> f_mps2;    // specific force, sensor axes
   // d(y_i)/d(latitude) per rad of latitude: the Earth-rate part's sensitivity, sensor axes
-  std::array<std::vector<Eigen::Vector3d>, 2> dw_dlat_radps;
+  std::array<std::vector<Eigen::Vector3f>, 2> dw_dlat_radps;
   std::vector<Eigen::Vector3d> w_body_radps;             // box inertial rate, box axes
-  std::vector<Eigen::Vector3d> f_body_mps2;              // box specific force, box axes
+  std::vector<Eigen::Vector3f> f_body_mps2;              // box specific force, box axes
   std::array<std::vector<double>, 2> plat_deg;           // as logged; NaN when unknown
-  std::array<std::vector<double>, 2> plat_rate_dps;      // by central differences; NaN unknown
   std::array<std::vector<double>, 2> temp_c;             // logged die temperature, NaN if absent
   std::vector<std::uint8_t> usable;    // gyro finite and the truth is known
   std::vector<std::uint8_t> flipping;  // a platform moves, or its angle is unknown

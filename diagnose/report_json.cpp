@@ -27,7 +27,7 @@ void params_json(std::ostringstream& o, const char* key, const std::vector<Fitte
 
 void candidate_json(std::ostringstream& o, const Candidate& c) {
   const EffectInfo& info = effect_info(c.effect);
-  o << "{\"effect\": " << q(info.id) << ", \"family\": " << q(family_name(info.family)) << ", \"step\": " << c.step
+  o << "{\"effect\": " << q(info.id) << ", \"family\": " << q(family_id(info.family)) << ", \"step\": " << c.step
     << ", \"sensor\": " << q(sensor_text(c)) << ", \"axis\": " << q(axis_text(c))
     << ", \"writable\": " << (info.writable ? "true" : "false") << ", \"testable\": " << (c.testable ? "true" : "false")
     << ", \"absurd\": " << (c.absurd ? "true" : "false") << ", \"evidence\": " << n(c.evidence)

@@ -26,6 +26,16 @@ std::string n(double v) { return report::json_number(v); }
 // bins (the cloud the points would make), with the bin's mean smoothed bias
 constexpr std::size_t kPlotBuckets = 1500;
 
+// writes DIR/NAME (before gnuplot reads it), a line or none per item as `line` makes it
+template <class Items, class Line>
+std::filesystem::path write_dat(const std::filesystem::path& dir, const char* name, const Items& items, Line&& line) {
+  std::ostringstream d;
+  for (const auto& item : items) line(d, item);
+  const auto dat = dir / name;
+  io::write_file(dat, d.str());
+  return dat;
+}
+
 struct PlotRow {
   double t_s;
   std::array<double, 6> lo_dps, hi_dps, bias_dps;  // lo = hi = the block mean when not binned
@@ -94,16 +104,11 @@ Plot residual_plot(const CompareResult& r, const std::filesystem::path& dir) {
 }
 
 Plot windows_plot(const CompareResult& r, const std::filesystem::path& dir) {
-  const auto dat = dir / "windows.dat";
-  {
-    std::ostringstream d;
-    for (const auto& w : r.windows) {
-      d << fmt::format("{:.3f}", 0.5 * (w.t0_s + w.t1_s));
-      for (int c = 0; c < 6; ++c) d << ' ' << n(w.rms_dps[c]) << ' ' << n(r.channels[c].noise_floor_dps);
-      d << '\n';
-    }
-    io::write_file(dat, d.str());  // before gnuplot reads it
-  }
+  const auto dat = write_dat(dir, "windows.dat", r.windows, [&](std::ostringstream& d, const WindowSummary& w) {
+    d << fmt::format("{:.3f}", 0.5 * (w.t0_s + w.t1_s));
+    for (int c = 0; c < 6; ++c) d << ' ' << n(w.rms_dps[c]) << ' ' << n(r.channels[c].noise_floor_dps);
+    d << '\n';
+  });
   std::string s = "set termoption noenhanced\nset xlabel 't (s)'\nset ylabel 'rms (deg/s)'\nset yrange [0:*]\nset key outside right\n"
                   "set title 'windowed residual rms after the selected effects (dashed: the model noise floor)'\nplot ";
   const int nc = 3 * r.sensors;
@@ -155,17 +160,12 @@ Plot allan_plot(const CompareResult& r, const std::filesystem::path& dir) {
 
 // bars from zero: the residual rms after the selected effects by regime
 Plot regimes_plot(const CompareResult& r, const std::filesystem::path& dir) {
-  const auto dat = dir / "regimes.dat";
-  {
-    std::ostringstream d;
-    for (const auto& g : r.regimes) {
-      if (g.group == "flip" && g.name == "during flips") continue;  // no truth there: in the table only
-      d << '"' << g.group << ": " << g.name << '"';
-      for (int c = 0; c < 6; ++c) d << ' ' << n(g.rms_dps[c]);
-      d << '\n';
-    }
-    io::write_file(dat, d.str());  // before gnuplot reads it
-  }
+  const auto dat = write_dat(dir, "regimes.dat", r.regimes, [&](std::ostringstream& d, const RegimeSummary& g) {
+    if (g.group == "flip" && g.name == "during flips") return;  // no truth there: in the table only
+    d << '"' << g.group << ": " << g.name << '"';
+    for (int c = 0; c < 6; ++c) d << ' ' << n(g.rms_dps[c]);
+    d << '\n';
+  });
   std::string s = "set termoption noenhanced\nset style data histograms\nset style histogram clustered gap 1\n"
                   "set style fill solid 0.8\n"
                   "set yrange [0:*]\nset xtics rotate by -30\nset ylabel 'rms (deg/s)'\nset key outside right\n"

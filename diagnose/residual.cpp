@@ -87,13 +87,23 @@ Residual make_residual(const Replay& r, const CompareModel& model, double block_
   // platforms resting on stops: the model's stop errors plus the servo's press into the stop
   // (the MuJoCo box settled on them); logs with an encoder read the true angle instead
   const Eigen::Matrix2d settled = r.encoder_readback ? Eigen::Matrix2d::Zero() : settled_stop_offsets_deg(model.box);
+  res.replay = &r;
   for (int s = 0; s < 2; ++s) {
-    res.pred[s] = predict_sensor(r, s, model.sensor[s], model.box, model.time_offset_s, settled);
+    SensorPrediction& p = res.pred[s];
+    p = predict_sensor(r, s, model.sensor[s], model.box, model.time_offset_s, settled);
+    for (int j = 0; j < 3; ++j) {
+      std::vector<float>& e = res.e_f[static_cast<std::size_t>(s * 3 + j)];
+      e.resize(res.n);
+      for (std::size_t k = 0; k < res.n; ++k) e[k] = static_cast<float>(r.gyro_dps[s][k][j] - p.gyro_dps[k][j]);
+    }
+    p.gyro_dps = std::vector<Eigen::Vector3d>();  // (not "= {}": that clears and keeps the memory)
+    // the log's temperature where it has one everywhere: read from the replay, not copied
+    const bool all_logged = p.temp_from_log && std::all_of(r.temp_c[s].begin(), r.temp_c[s].end(), [](double t) { return std::isfinite(t); });
+    if (all_logged) p.temp_c = std::vector<double>();
   }
   if (!r.has_temp) res.notes.push_back("the log has no temperature columns: the model's temperature curve is used");
   res.mask.resize(res.n);
   for (std::size_t k = 0; k < res.n; ++k) res.mask[k] = r.usable[k] && !r.flipping[k] && !r.rough[k];
-  res.replay = &r;
   for (int s = 0; s < res.sensors; ++s) {
     const std::size_t cnt = mask_hinge_bursts(r, s, res);
     if (cnt == 0) continue;
@@ -111,8 +121,8 @@ Residual make_residual(const Replay& r, const CompareModel& model, double block_
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
   for (int s = 0; s < res.sensors; ++s) {
     for (std::size_t k = 0; k < res.n; k += 10) {
-      lo = std::min(lo, res.pred[s].temp_c[k]);
-      hi = std::max(hi, res.pred[s].temp_c[k]);
+      lo = std::min(lo, res.temp_c(s, k));
+      hi = std::max(hi, res.temp_c(s, k));
     }
   }
   res.temp_span_c = hi - lo;

@@ -20,13 +20,22 @@ struct Residual {
   double fs_hz = 0.0;           // sample rate of the replay
   std::size_t block_len = 1;    // samples per block
   std::size_t blocks = 0;       // number of blocks
-  std::array<SensorPrediction, 2> pred;       // noise-free prediction and temperature per sensor
-  /// measured - predicted of channel c (sensor c / 3, axis c % 3) at sample k, deg/s; NaN where
-  /// unusable. Formed when asked from the replay it was made from (which must outlive it): a
-  /// stored copy was 17 MB for a 1 h log at 100 Hz
-  double e_dps(int c, std::size_t k) const {
-    const int s = c / 3, j = c % 3;
-    return replay->usable[k] ? replay->gyro_dps[s][k][j] - pred[s].gyro_dps[k][j] : kNaN;
+  // the model's temperature per sensor (the prediction's output is dropped once e_f is formed;
+  // its temperature too when it is the log's, read from the replay instead)
+  std::array<SensorPrediction, 2> pred;
+  /// measured - predicted per channel (sensor c / 3, axis c % 3), deg/s, as float: 7 significant
+  /// digits of a residual of the noise's size, half of what the double prediction took
+  std::array<std::vector<float>, 6> e_f;
+  /// measured - predicted of channel c at sample k, deg/s; NaN where unusable. The replay it was
+  /// made from must outlive it
+  double e_dps(int c, std::size_t k) const { return replay->usable[k] ? static_cast<double>(e_f[c][k]) : kNaN; }
+  /// The model's noise-free output of sensor s, axis j at sample k (measured - e_f), deg/s.
+  double pred_dps(int s, int j, std::size_t k) const {
+    return replay->gyro_dps[s][k][j] - static_cast<double>(e_f[s * 3 + j][k]);
+  }
+  /// The temperature the model runs at for sensor s at sample k, degC.
+  double temp_c(int s, std::size_t k) const {
+    return pred[s].temp_c.empty() ? replay->temp_c[s][k] : pred[s].temp_c[k];
   }
   /// The whole series of channel c (e_dps(c, k) for every k), deg/s.
   std::vector<double> e_series(int c) const;

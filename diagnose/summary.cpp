@@ -117,17 +117,27 @@ void whiteness(const ChannelData& c, const Residual& res, const std::vector<doub
 
 }  // namespace
 
+double AfterFit::bias_at(int c, std::size_t k) const {
+  const std::vector<double>& bias = this->bias[static_cast<std::size_t>(c)];
+  const std::size_t L = block_len, b = k / L;
+  const double u = (static_cast<double>(k % L) + 0.5) / static_cast<double>(L) - 0.5;
+  double bv = bias[b];
+  if (u > 0 && b + 1 < bias.size()) bv += (bias[b + 1] - bias[b]) * u;
+  if (u < 0 && b > 0) bv += (bias[b] - bias[b - 1]) * u;
+  return bv;
+}
+
 AfterFit residual_after(const Channels& ch, const ColumnInputs& in, const Residual& res, const FitSpec& spec,
                         const FitResult& fit, AfterDetail detail) {
   AfterFit a;
-  const std::size_t L = res.block_len;
+  a.block_len = res.block_len;
   const bool keep = detail == AfterDetail::kSamples;
   for (int c = 0; c < 6; ++c) {
     const ChannelData& C = ch[c];
     if (!C.present) {  // sensor 2 of a single-sensor log: NaN throughout
       a.z[c].assign(res.blocks, kNaN);
       a.bias[c].assign(res.blocks, kNaN);
-      if (keep) a.e_drift[c].assign(res.n, std::numeric_limits<float>::quiet_NaN()), a.e[c] = a.e_drift[c];
+      if (keep) a.e_drift[c].assign(res.n, std::numeric_limits<float>::quiet_NaN());
       continue;
     }
     const Eigen::VectorXd coef = channel_coefficients(C, c, spec, fit);
@@ -136,8 +146,7 @@ AfterFit residual_after(const Channels& ch, const ColumnInputs& in, const Residu
     for (std::size_t b = 0; b < res.blocks; ++b)
       if (!res.block_series.count[b]) a.z[c][b] = kNaN;
     if (detail == AfterDetail::kBlocks) continue;
-    if (keep) a.e_drift[c].resize(res.n), a.e[c].resize(res.n);
-    const auto& bias = a.bias[c];
+    if (keep) a.e_drift[c].resize(res.n);
     RunningMeanRms stats;
     for (std::size_t k = 0; k < res.n; ++k) {
       double v = res.e_dps(c, k);
@@ -145,15 +154,8 @@ AfterFit residual_after(const Channels& ch, const ColumnInputs& in, const Residu
         for (int i = 0; i < static_cast<int>(C.cols.size()); ++i)
           if (coef[i] != 0.0) v -= column_value(in, C.s, C.j, C.cols[i], k) * coef[i];
       }
-      // bias per sample: linear interpolation between block centres
-      const double u = (static_cast<double>(k % L) + 0.5) / static_cast<double>(L) - 0.5;
-      const std::size_t b = k / L;
-      double bv = bias[b];
-      if (u > 0 && b + 1 < res.blocks) bv += (bias[b + 1] - bias[b]) * u;
-      if (u < 0 && b > 0) bv += (bias[b] - bias[b - 1]) * u;
-      const auto e = static_cast<float>(v - bv);
-      if (res.mask[k]) stats.add(e);
-      if (keep) a.e_drift[c][k] = static_cast<float>(v), a.e[c][k] = e;
+      if (res.mask[k]) stats.add(static_cast<float>(v - a.bias_at(c, k)));
+      if (keep) a.e_drift[c][k] = static_cast<float>(v);
     }
     std::tie(a.mean_dps[c], a.rms_dps[c]) = stats.mean_rms();
   }

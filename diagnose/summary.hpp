@@ -16,12 +16,19 @@ struct AfterFit {
   std::array<std::vector<double>, 6> z;       // block means
   std::array<std::vector<double>, 6> bias;    // smoothed bias per block (RTS)
   std::array<std::vector<float>, 6> e_drift;  // per sample, bias drift kept (NaN unusable); kSamples only
-  std::array<std::vector<float>, 6> e;        // per sample, smoothed bias removed too; kSamples only
+  std::size_t block_len = 1;                  // samples per block of z and bias
+  /// The smoothed bias of channel c at sample k: linear between block centres, deg/s.
+  double bias_at(int c, std::size_t k) const;
+  /// Per sample, the smoothed bias removed too (e_drift - bias_at), deg/s; kSamples only. Formed
+  /// when asked: a stored float copy was 8.6 MB for a 1 h log at 100 Hz
+  float e(int c, std::size_t k) const {
+    return static_cast<float>(e_drift[static_cast<std::size_t>(c)][k] - bias_at(c, k));
+  }
   // mean and rms of `e` over the fit samples, deg/s (kStats and kSamples)
   std::array<double, 6> mean_dps{}, rms_dps{};
 };
 /// How much of the per-sample residual residual_after keeps: block means only; the per-sample
-/// statistics (mean, rms) without the series (a 1 h log's two float series are 17 MB); or both.
+/// statistics (mean, rms) without the series (a 1 h log's float series is 8.6 MB); or both.
 enum class AfterDetail { kBlocks, kStats, kSamples };
 /// Computes the residual after `spec` / `fit` (an empty spec: the nuisance-only residual).
 AfterFit residual_after(const Channels& ch, const ColumnInputs& in, const Residual& res, const FitSpec& spec,

@@ -16,7 +16,10 @@
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
+#include <map>
 #include <random>
+#include <string>
+#include <utility>
 
 #include "tests/diagnose/independent_logs.hpp"
 
@@ -118,6 +121,7 @@ bool only_signal_chain(const CompareResult& r) {
 
 TEST(IndependentLogs, PlantedPhysicalEffectIsFoundFirst) {
   int ok = 0, first_overall = 0, applied_ok = 0, applied = 0;
+  std::map<std::string, std::pair<int, int>> per_effect;  // effect id: (found first, planted)
   const int seeds = sweep_seeds(12);
   for (int seed = 1; seed <= seeds; ++seed) {
     std::mt19937 g(static_cast<unsigned>(seed) * 104729u);
@@ -128,8 +132,11 @@ TEST(IndependentLogs, PlantedPhysicalEffectIsFoundFirst) {
     const auto log = indep::generate(src, "plant");
     const CompareResult r = indep::diagnose_log(log);
     std::string why;
-    if (found_first(r, p, &why)) ++ok;
-    else std::printf("MISS %s: %s\n  %s\n", indep::describe(src).c_str(), why.c_str(), r.statement.c_str());
+    const bool found = found_first(r, p, &why);
+    ok += found;
+    auto& tally = per_effect[effect_id(p.effect)];
+    tally.first += found, ++tally.second;
+    if (!found) std::printf("MISS %s: %s\n  %s\n", indep::describe(src).c_str(), why.c_str(), r.statement.c_str());
     if (!r.selected.empty() && r.selected.front().effect == p.effect) ++first_overall;
     if (seed % 3 == 0) {  // the loop on every third seed: apply, compare again
       ++applied;
@@ -141,6 +148,7 @@ TEST(IndependentLogs, PlantedPhysicalEffectIsFoundFirst) {
   }
   std::printf("planted physical effect found first among physical effects within 20 %%: %d / %d (first overall: %d); "
               "after --apply consistent: %d / %d\n", ok, seeds, first_overall, applied_ok, applied);
+  for (const auto& [id, t] : per_effect) std::printf("  %s: %d / %d\n", id.c_str(), t.first, t.second);
   EXPECT_GE(ok, at_least(0.8, seeds));
   EXPECT_GE(applied_ok, at_least(0.6, applied));
 }

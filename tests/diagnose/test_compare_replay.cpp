@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <regex>
 #include <sstream>
 #include <string>
 
@@ -94,6 +95,14 @@ TEST(CompareReport, JsonIsDeterministicAndHoldsTheContract) {
                           "\"family\"", "\"sensor\"", "\"axis\"", "\"params\"", "\"explained_fraction\"", "\"evidence\"",
                           "\"evidence_threshold\"", "\"residual_rms_dps\"", "\"before\"", "\"after_selected\""})
     EXPECT_NE(a.find(key), std::string::npos) << key;
+  // AND every family is one of the machine-readable ids docs/compare.md lists
+  const std::regex family_re("\"family\": \"([^\"]*)\"");
+  int families = 0;
+  for (auto it = std::sregex_iterator(a.begin(), a.end(), family_re); it != std::sregex_iterator(); ++it, ++families) {
+    const std::string id = (*it)[1];
+    EXPECT_TRUE(id == "physical" || id == "box" || id == "signal_chain" || id == "adc" || id == "noise_model") << id;
+  }
+  EXPECT_GT(families, 5);
 }
 
 TEST(CompareReplay, RateKinksAreMarkedRoughAndLinearRateIsExact) {
