@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include <Eigen/Cholesky>
@@ -175,11 +176,23 @@ void add_attitude_results(const AttitudeComparison& att, const DriftlessFilter& 
   sum.drift_net_raw_deg_per_h = drift.net_raw_deg_per_h;
   sum.drift_net_fixed_deg_per_h = drift.net_fixed_deg_per_h;
   if (att.points() < 2 && sum.attitude_available && !att.started() && sum.rows > 0) {
-    sum.warnings.push_back(
-        "no attitude comparison: the filter never locked on (every bias sigma below " +
-        std::to_string(opt.attitude_start_sigma_dps) + " deg/s; the largest is " +
-        std::to_string(filter.sigma_dps().maxCoeff()) +
-        " deg/s); an attitude start sigma of 0 compares from the log's start");
+    // the lock level is the one filter_locked applies: the sigma of the correction b + G f + ...
+    char text[320];
+    if (std::isfinite(sum.locked_from_t_s)) {
+      std::snprintf(text, sizeof text,
+                    "no attitude comparison: the filter locked on only at t = %.6g s, too close to the end "
+                    "of the log to compare; a longer log, or an attitude start sigma of 0 to compare "
+                    "from the log's start",
+                    sum.locked_from_t_s);
+    } else {
+      std::snprintf(text, sizeof text,
+                    "no attitude comparison: the filter never locked on (lock: every sigma of the bias "
+                    "correction below %.3g deg/s; the largest is %.3g deg/s at the end); an attitude start "
+                    "sigma of 0 compares from the log's start",
+                    opt.attitude_start_sigma_dps,
+                    filter.has_update() ? filter.correction_sigma_dps().maxCoeff() : filter.sigma_dps().maxCoeff());
+    }
+    sum.warnings.emplace_back(text);
   }
 }
 

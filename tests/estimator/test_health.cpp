@@ -300,6 +300,16 @@ TEST(HealthTest, ALockAtTheEndOfTheLogIsDegradedNotOk) {
                                  [](const HealthFinding& f) { return f.cause == HealthCause::kLateLock; });
   EXPECT_DOUBLE_EQ(late->value, cut.lock_t_s);
   EXPECT_DOUBLE_EQ(late->suggested, double(cut.nis_updates));
+  // GIVEN the log cut one sample after its lock THEN the missing attitude comparison says the lock
+  // came too late, not that it never came
+  p.duration_s = full.lock_t_s + 1.5 / p.rate_hz;
+  const EstimateSummary end = run_synth(p, "late_lock_end.csv", cfg);
+  ASSERT_TRUE(end.attitude_available);
+  ASSERT_TRUE(end.health.locked);
+  const bool said = std::any_of(end.warnings.begin(), end.warnings.end(), [](const std::string& w) {
+    return w.find("locked on only at t =") != std::string::npos;
+  });
+  EXPECT_TRUE(said) << (end.warnings.empty() ? std::string("no warning") : end.warnings.front());
 }
 
 }  // namespace
