@@ -36,7 +36,7 @@ void Telemetry::push(const Sample& s, double rest_s, OverlayState& st) {
     if (filter_->has_update()) {
       bias1_->push(s.t_s, filter_->bias1_dps(), s.true_bias1_dps);
       bias2_->push(s.t_s, filter_->bias2_dps(), s.true_bias2_dps);
-      if (std::isnan(locked_from_s_) && filter_->correction_sigma_dps().maxCoeff() < lock_sigma_dps_) {
+      if (std::isnan(locked_from_s_) && est::filter_locked(*filter_, lock_sigma_dps_)) {
         locked_from_s_ = s.t_s;
       }
     }
