@@ -3,7 +3,9 @@
 // docs/compare.md sections 1-2.
 #pragma once
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -58,5 +60,23 @@ Residual make_residual(const Replay& r, const CompareModel& model, double block_
 
 /// Block means of a per-sample series over the residual's blocks (masked samples only).
 std::vector<double> block_series_of(const Residual& res, const std::vector<double>& x);
+
+/// Block means of x(k) over the samples the fits use (bmask; NaN skipped) into `out`: the same
+/// sums in the same order as block_series_of() of the series, without a per-sample copy of it.
+template <class X>
+void block_means_of(const Residual& res, X&& x, std::vector<double>& out) {
+  out.resize(res.blocks);
+  for (std::size_t b = 0; b < res.blocks; ++b) {
+    double acc = 0.0;
+    int cnt = 0;
+    const std::size_t a = b * res.block_len, e = std::min(res.n, a + res.block_len);
+    for (std::size_t k = a; k < e; ++k) {
+      if (!res.bmask[k]) continue;
+      const double v = x(k);
+      if (std::isfinite(v)) acc += v, ++cnt;
+    }
+    out[b] = cnt > 0 ? acc / cnt : 0.0;
+  }
+}
 
 }  // namespace driftless::diagnose
