@@ -87,7 +87,7 @@ void regimes(const Replay& r, const Residual& res, const AfterFit& a, CompareRes
   }, out);
   const double we = kEarthRateRadps * kDegPerRad;
   add_bands(r, a, "base rate", {0.0, 1.0, 10.0, 30.0, kInf}, "deg/s",
-            [&](std::size_t k) { return std::max(0.0, static_cast<double>(r.w_body_radps[k].norm()) * kDegPerRad - we); }, out);
+            [&](std::size_t k) { return std::max(0.0, r.w_body_radps[k].norm() * kDegPerRad - we); }, out);
   add_bands(r, a, "acceleration", {0.0, 0.5, 2.0, kInf}, "m/s^2",
             [&](std::size_t k) { return std::abs(static_cast<double>(r.f_body_mps2[k].norm()) - kStandardGravityMps2); }, out);
   temperature_quartiles(r, res, a, out);
@@ -133,8 +133,8 @@ void correlations(const Replay& r, const Residual& res, const Channels& ch, cons
                   const CompareOptions& opt, CompareResult& out) {
   std::vector<std::pair<std::string, std::function<double(std::size_t)>>> sigs;
   for (int ax = 0; ax < 3; ++ax) {
-    sigs.emplace_back(fmt::format("body rate {}", axis_letter(ax)), [&, ax](std::size_t k) { return static_cast<double>(r.w_body_radps[k][ax]); });
-    sigs.emplace_back(fmt::format("|body rate {}|", axis_letter(ax)), [&, ax](std::size_t k) { return std::abs(static_cast<double>(r.w_body_radps[k][ax])); });
+    sigs.emplace_back(fmt::format("body rate {}", axis_letter(ax)), [&, ax](std::size_t k) { return r.w_body_radps[k][ax]; });
+    sigs.emplace_back(fmt::format("|body rate {}|", axis_letter(ax)), [&, ax](std::size_t k) { return std::abs(r.w_body_radps[k][ax]); });
     sigs.emplace_back(fmt::format("specific force {}", axis_letter(ax)), [&, ax](std::size_t k) { return static_cast<double>(r.f_body_mps2[k][ax]); });
   }
   sigs.emplace_back("time", [&](std::size_t k) { return r.t_s[k]; });

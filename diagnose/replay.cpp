@@ -269,9 +269,7 @@ void mark_kinks(const std::vector<double>& d2, std::size_t fir_half, const Repla
 // included (rotation vectors of interval increments lose the coning term: a false 0.02 % scale
 // on a 1.5 Hz two-axis wobble at 100 Hz). Near the ends, central differences. The Earth rate is
 // added in body axes; the transport rate (v/R) is neglected.
-// Returns the body rate (rad/s, body axes) in double for the sensors' series; the Replay keeps a
-// float copy.
-std::vector<Eigen::Vector3d> body_rate(Raw& raw, const Eigen::Vector3d& earth_enu, const ReplayOptions& opt, Replay& out) {
+void body_rate(Raw& raw, const Eigen::Vector3d& earth_enu, const ReplayOptions& opt, Replay& out) {
   const std::size_t n = raw.size();
   out.t_s = std::move(raw.t);
   // one hemisphere: q and -q are one rotation (in place: every later use rotates with q, which
@@ -281,7 +279,6 @@ std::vector<Eigen::Vector3d> body_rate(Raw& raw, const Eigen::Vector3d& earth_en
     if (q[k].dot(q[k - 1]) < 0) q[k] = -q[k];
   const std::vector<double> d = central_differentiator();
   const auto M = d.size();
-  std::vector<Eigen::Vector3d> w_body(n);
   out.w_body_radps.resize(n);
   for (std::size_t k = 0; k < n; ++k) {
     Eigen::Vector4d dq = Eigen::Vector4d::Zero();
@@ -295,8 +292,7 @@ std::vector<Eigen::Vector3d> body_rate(Raw& raw, const Eigen::Vector3d& earth_en
     }
     const Eigen::Quaterniond qk(q[k][0], q[k][1], q[k][2], q[k][3]), dqk(dq[0], dq[1], dq[2], dq[3]);
     const Eigen::Vector3d w_eb = 2.0 * (qk.conjugate() * dqk).vec();
-    w_body[k] = w_eb + qk.conjugate() * earth_enu;
-    out.w_body_radps[k] = w_body[k].cast<float>();
+    out.w_body_radps[k] = w_eb + qk.conjugate() * earth_enu;
   }
   // kinks from the second differences of the interval mean rates (three kept at a time)
   std::vector<double> d2(n, 0.0);
@@ -314,7 +310,6 @@ std::vector<Eigen::Vector3d> body_rate(Raw& raw, const Eigen::Vector3d& earth_en
   mark_kinks(d2, M, opt, out);
   // the first and last M samples have no full differentiator stencil: left out like a kink
   for (std::size_t k = 0; k < std::min(n, M); ++k) out.rough[k] = out.rough[n - 1 - k] = 1;
-  return w_body;
 }
 
 // specific force in body axes: second differences of ref_p, else gravity only (double here: the
@@ -415,7 +410,7 @@ void flip_history(const Raw& raw, const std::array<std::vector<std::uint8_t>, 2>
 }
 
 // each sensor's ideal output (docs/log-format.md): y_i = R_i^T w_body + thetadot_i a_i
-void sensor_truth(Raw& raw, const std::vector<Eigen::Vector3d>& w_body, const std::vector<Eigen::Vector3d>& f_body, const PlatformMotion& pm,
+void sensor_truth(Raw& raw, const std::vector<Eigen::Vector3d>& f_body, const PlatformMotion& pm,
                   const Eigen::Vector3d& dearth_dlat_enu, Replay& out) {
   const std::size_t n = raw.size();
   out.usable.assign(n, 1);
@@ -438,7 +433,7 @@ void sensor_truth(Raw& raw, const std::vector<Eigen::Vector3d>& w_body, const st
       }
       const Eigen::Matrix3d Rt = geo::rot_about_axis_deg(axis, ang).transpose();
       const double rate = pm.rate_dps[s][k];
-      out.w_radps[s][k] = Rt * w_body[k] + (std::isfinite(rate) ? rate : 0.0) * kRadPerDeg * axis;
+      out.w_radps[s][k] = Rt * out.w_body_radps[k] + (std::isfinite(rate) ? rate : 0.0) * kRadPerDeg * axis;
       const bool logged = out.has_accel && raw.a[s][k].allFinite();
       f[k] = (logged ? raw.a[s][k] : Eigen::Vector3d(Rt * f_body[k])).cast<float>();
       out.dw_dlat_radps[s][k] = (Rt * (quat(raw.q[k]).conjugate() * dearth_dlat_enu)).cast<float>();
@@ -471,11 +466,11 @@ Replay build(Raw raw, const log::Metadata& meta, std::uint32_t fields, const Rep
   check_attitude(raw, opt, out);
   const Eigen::Vector3d earth_enu = geo::earth_rate_enu_radps(lat);
   const Eigen::Vector3d dearth_dlat_enu = geo::earth_rate_enu_dlat_radps_per_rad(lat);
-  const std::vector<Eigen::Vector3d> w_body = body_rate(raw, earth_enu, opt, out);
+  body_rate(raw, earth_enu, opt, out);
   const std::vector<Eigen::Vector3d> f_body = specific_force(raw, out);
   const PlatformMotion pm = platform_motion(raw, opt, out);
   flip_history(raw, pm.moving, out);
-  sensor_truth(raw, w_body, f_body, pm, dearth_dlat_enu, out);
+  sensor_truth(raw, f_body, pm, dearth_dlat_enu, out);
   return out;
 }
 

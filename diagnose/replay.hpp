@@ -48,8 +48,7 @@ struct Replay {
   std::array<std::vector<Eigen::Vector3f>, 2> f_mps2;    // specific force, sensor axes
   // d(y_i)/d(latitude) per rad of latitude: the Earth-rate part's sensitivity, sensor axes
   std::array<std::vector<Eigen::Vector3f>, 2> dw_dlat_radps;
-  std::vector<Eigen::Vector3f> w_body_radps;             // box inertial rate, box axes (float:
-                                                         // the rate bands and correlations use it)
+  std::vector<Eigen::Vector3d> w_body_radps;             // box inertial rate, box axes
   std::vector<Eigen::Vector3f> f_body_mps2;              // box specific force, box axes
   std::array<std::vector<double>, 2> plat_deg;           // as logged; NaN when unknown
   std::array<std::vector<double>, 2> temp_c;             // logged die temperature, NaN if absent

@@ -39,8 +39,6 @@ struct Residual {
   double temp_c(int s, std::size_t k) const {
     return pred[s].temp_c.empty() ? replay->temp_c[s][k] : pred[s].temp_c[k];
   }
-  /// The whole series of channel c (e_dps(c, k) for every k), deg/s.
-  std::vector<double> e_series(int c) const;
   const Replay* replay = nullptr;             // the replay the residual was made from
   std::vector<std::uint8_t> mask;   // sample enters the fits (usable, at rest, rebuilt, no burst)
   std::vector<std::uint8_t> bmask;  // ... and its block has enough data
@@ -58,11 +56,8 @@ struct Residual {
 /// Throws std::runtime_error when fewer than 50 samples remain.
 Residual make_residual(const Replay& r, const CompareModel& model, double block_s);
 
-/// Block means of a per-sample series over the residual's blocks (masked samples only).
-std::vector<double> block_series_of(const Residual& res, const std::vector<double>& x);
-
 /// Block means of x(k) over the samples the fits use (bmask; NaN skipped) into `out`: the same
-/// sums in the same order as block_series_of() of the series, without a per-sample copy of it.
+/// sums in the same order as block_means() of the series, without a per-sample copy of it.
 template <class X>
 void block_means_of(const Residual& res, X&& x, std::vector<double>& out) {
   out.resize(res.blocks);
