@@ -29,10 +29,10 @@ file(MAKE_DIRECTORY ${DRIFTLESS_TEST_TMPDIR})
 function(driftless_add_test name)
   cmake_parse_arguments(ARG "" "" "SOURCES;LIBS;LABELS" ${ARGN})
   add_executable(${name} ${ARG_SOURCES})
-  target_link_libraries(${name} PRIVATE ${ARG_LIBS} GTest::gtest GTest::gtest_main driftless::flags)
-  target_compile_definitions(${name} PRIVATE
-    DRIFTLESS_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
-    DRIFTLESS_BINARY_DIR="${PROJECT_BINARY_DIR}")
+  # the checkout and build folders come from driftless_test_dirs at run time, not from compile
+  # definitions: test objects hold no path, and ccache shares them between clones (tests/test_dirs.hpp)
+  target_link_libraries(${name} PRIVATE ${ARG_LIBS} driftless_test_dirs GTest::gtest GTest::gtest_main
+                        driftless::flags)
   set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR}/tests)
   # GoogleTest, Eigen and the standard library parsed once for every test (tests/CMakeLists.txt)
   target_precompile_headers(${name} REUSE_FROM driftless_test_pch)
@@ -44,8 +44,15 @@ function(driftless_add_test name)
   endif()
   # TMPDIR inside the build tree: two build trees (a second clone, the sanitizer build) running
   # their suites at once never share a temporary file
+  # COST: the statistical claims (label 'slow', 2-30 s each) start before everything else, as ctest
+  # -j does with timings it measured itself (a fresh clone has none); the cli tests come next (cost
+  # 10, tests/cli/CMakeLists.txt) and the many short unit tests fill the end of the pass
+  set(cost 0)
+  if("${ARG_LABELS}" STREQUAL "slow")
+    set(cost 20)
+  endif()
   gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60
-    PROPERTIES LABELS "${ARG_LABELS}" ENVIRONMENT "TMPDIR=${DRIFTLESS_TEST_TMPDIR}"
+    PROPERTIES LABELS "${ARG_LABELS}" ENVIRONMENT "TMPDIR=${DRIFTLESS_TEST_TMPDIR}" COST ${cost}
     WORKING_DIRECTORY ${PROJECT_BINARY_DIR})
 endfunction()
 
