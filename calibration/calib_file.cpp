@@ -59,12 +59,20 @@ struct TempBlock {
   double final_temp_degc = kNaN;
 };
 
+// sensorN.scale_misalignment: y = (I + E) M^-1 w + ..., E and its 1-sigma per element (fraction)
+struct EBlock {
+  Mat3 E_frac = Mat3::Zero();
+  Mat3 E_sigma_frac = Mat3::Zero();
+};
+
 struct SensorBlock {
   std::array<PositionBlock, 2> pos;  // [minus90, plus90]
   bool has_errors = false;
   est::CalibErrors errors;           // informational; readers ignore it
   bool has_g = false;
   GBlock g;
+  bool has_e = false;
+  EBlock e;
   bool has_temp = false;
   TempBlock temp;
 };
@@ -189,6 +197,46 @@ const Table<TempBlock>& temp_table() {
   return t;
 }
 
+// the g-sensitivity block: G and its 1-sigma, which cannot be negative (the filter's prior)
+fields::Row<SensorBlock> g_row() {
+  fields::Row<SensorBlock> row = fields::block<SensorBlock>("g_sensitivity", &SensorBlock::g, &g_table, {"G_dps_per_g"});
+  auto read = row.read;
+  row.read = [read](SensorBlock& s, const fields::Node& n, const fields::Reading& r) {
+    read(s, n, r);
+    if ((s.g.G_sigma.array() < 0.0).any() || !s.g.G_sigma.allFinite()) {
+      const fields::Node* at = n.find("G_sigma");
+      r.ctx.fail(at != nullptr ? *at : n, r.ctx.key("G_sigma"), "a sigma must be >= 0 deg/s per g");
+    }
+  };
+  return fields::optional_row(std::move(row), &SensorBlock::has_g);
+}
+
+const Table<EBlock>& e_table() {
+  using E = EBlock;
+  static const Table<E> t = {
+      fields::matrix3<E>("E", "frac", &E::E_frac, false),
+      fields::matrix3<E>("E_sigma", "frac", &E::E_sigma_frac, false),
+  };
+  return t;
+}
+
+// the scale/misalignment block: E and its 1-sigma (>= 0), each element below 0.5 (50 %)
+fields::Row<SensorBlock> scale_row() {
+  fields::Row<SensorBlock> row =
+      fields::block<SensorBlock>("scale_misalignment", &SensorBlock::e, &e_table, {"E_frac", "E_sigma_frac"});
+  auto read = row.read;
+  row.read = [read](SensorBlock& s, const fields::Node& n, const fields::Reading& r) {
+    read(s, n, r);
+    const auto fail = [&](const char* key, const char* what) {
+      const fields::Node* at = n.find(key);
+      r.ctx.fail(at != nullptr ? *at : n, r.ctx.key(key), what);
+    };
+    if ((s.e.E_sigma_frac.array() < 0.0).any()) fail("E_sigma_frac", "a sigma must be >= 0 (fraction)");
+    if (!(s.e.E_frac.cwiseAbs().maxCoeff() < 0.5)) fail("E_frac", "each element must be below 0.5 (50 %) in size");
+  };
+  return fields::optional_row(std::move(row), &SensorBlock::has_e);
+}
+
 // the temperature block: both coefficients and their 1-sigma, which cannot be negative
 fields::Row<SensorBlock> temperature_row() {
   fields::Row<SensorBlock> row = fields::block<SensorBlock>("temperature", &SensorBlock::temp, &temp_table,
@@ -211,7 +259,8 @@ const Table<SensorBlock>& sensor_table() {
       fields::block<S>("minus90", [](auto& s) -> auto& { return s.pos[0]; }, &position_table, {"M"}),
       fields::block<S>("plus90", [](auto& s) -> auto& { return s.pos[1]; }, &position_table, {"M"}),
       fields::optional_row(fields::block<S>("errors", &S::errors, &errors_table), &S::has_errors),
-      fields::optional_row(fields::block<S>("g_sensitivity", &S::g, &g_table, {"G_dps_per_g"}), &S::has_g),
+      g_row(),
+      scale_row(),
       temperature_row(),
   };
   return t;
@@ -290,18 +339,38 @@ void save_selfcal_calib(const std::filesystem::path& path, const SelfCalibration
     s.has_g = true;
     s.g.G_dps_per_g = sc.G_dps_per_g[i];
     s.g.G_sigma = sc.G_sigma[i];
+    s.has_e = sc.scale_states;
+    s.e = EBlock{sc.E_frac[i], sc.E_sigma_frac[i]};
     s.has_temp = sc.temp_states;
     s.temp = TempBlock{sc.temp_coef_dps_per_degc[i], sc.temp_coef_sigma_dps_per_degc[i], sc.temp_ref_c[i]};
   }
   write_doc(path, doc,
             "driftless estimate --selfcal output (docs/calibration.md). Convention as driftless calibrate's:\n"
-            "y_i = M^-1 w_box + b_i + G_i f_i + k_i (T_i - T_ref); M here are the nominal rotations (not\n"
-            "calibrated). Units: deg/s, deg, deg/s per g, deg/s per degC, degC.");
+            "y_i = (I + E_i) M^-1 w_box + b_i + G_i f_i + k_i (T_i - T_ref); M here are the nominal rotations\n"
+            "(not calibrated), E_i the scale/misalignment error. Units: deg/s, deg, deg/s per g, fraction,\n"
+            "deg/s per degC, degC.");
+}
+
+est::CalibMatrices CalibFile::matrices_with_scale() const {
+  est::CalibMatrices m = M;
+  if (!has_scale_misalign) return m;
+  for (int i = 0; i < 2; ++i) {
+    const Mat3 inv = (Mat3::Identity() + E_frac[static_cast<std::size_t>(i)]).inverse();
+    for (int p = 0; p < 2; ++p) m.M(i, p) = m.M(i, p) * inv;
+  }
+  return m;
 }
 
 est::Calibration CalibFile::to_filter_calibration() const {
   est::Calibration cal = matrices_nominal ? est::Calibration{} : est::to_filter_calibration(M);
-  if (has_g_sensitivity) cal.G_dps_per_g = G_dps_per_g;
+  if (has_g_sensitivity) {
+    cal.G_dps_per_g = G_dps_per_g;
+    cal.has_g_sigma = true;
+    cal.G_sigma_dps_per_g = G_sigma_dps_per_g;
+  }
+  cal.has_scale_misalign = has_scale_misalign;
+  cal.E_frac = E_frac;
+  cal.E_sigma_frac = E_sigma_frac;
   cal.has_temp_coef = has_temp_coef;
   cal.temp_coef_dps_per_degc = temp_coef_dps_per_degc;
   cal.temp_coef_sigma_dps_per_degc = temp_coef_sigma_dps_per_degc;
@@ -337,6 +406,10 @@ CalibFile parse_calib(const std::string& yaml_text, const std::string& file) {
     }
     c.has_g_sensitivity = c.has_g_sensitivity || s.has_g;
     c.G_dps_per_g[i] = s.g.G_dps_per_g;
+    c.G_sigma_dps_per_g[i] = s.g.G_sigma;
+    c.has_scale_misalign = c.has_scale_misalign || s.has_e;
+    c.E_frac[i] = s.e.E_frac;
+    c.E_sigma_frac[i] = s.e.E_sigma_frac;
     c.has_temp_coef = c.has_temp_coef || s.has_temp;
     c.temp_coef_dps_per_degc[i] = s.temp.tc_dps_per_degc;
     c.temp_coef_sigma_dps_per_degc[i] = s.temp.tc_sigma_dps_per_degc;

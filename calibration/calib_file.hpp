@@ -44,6 +44,12 @@ struct CalibFile {
   /// g-sensitivity per sensor (sensorN.g_sensitivity.G_dps_per_g, deg/s per g), when fitted
   bool has_g_sensitivity = false;
   std::array<Eigen::Matrix3d, 2> G_dps_per_g{Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero()};
+  std::array<Eigen::Matrix3d, 2> G_sigma_dps_per_g{Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero()};  // 1-sigma
+  /// scale-factor and misalignment error per sensor (sensorN.scale_misalignment, fraction, sensor
+  /// axes: y = (I + E) M^-1 w + ...) with each element's 1-sigma; a self-calibration writes it
+  bool has_scale_misalign = false;
+  std::array<Eigen::Matrix3d, 2> E_frac{Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero()};
+  std::array<Eigen::Matrix3d, 2> E_sigma_frac{Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero()};
   /// `matrices: nominal`: M are the nominal rotations Rot(hinge, +-90), not calibrated (a
   /// self-calibration's file); the twin prior then leaves scale, misalignment and mounting alone
   bool matrices_nominal = false;
@@ -51,12 +57,14 @@ struct CalibFile {
   bool has_temp_coef = false;
   std::array<Eigen::Vector3d, 2> temp_coef_dps_per_degc{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
   std::array<Eigen::Vector3d, 2> temp_coef_sigma_dps_per_degc{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
-  /// what the estimator uses: M, G and the temperature coefficients
+  /// M as the twin should plant it: the file's M with E folded in, M (I + E)^-1 (M alone without E)
+  est::CalibMatrices matrices_with_scale() const;
+  /// what the estimator uses: M, G, E (each with its sigma) and the temperature coefficients
   est::Calibration to_filter_calibration() const;
 };
 
-/// What `driftless estimate --selfcal --calib-out` writes: the g-sensitivity and temperature
-/// coefficients the filter estimated, each with its 1-sigma; M stays nominal.
+/// What `driftless estimate --selfcal --calib-out` writes: the g-sensitivity, scale/misalignment
+/// and temperature coefficients the filter estimated, each with its 1-sigma; M stays nominal.
 struct SelfCalibration {
   std::string source;  // "estimate --selfcal on FILE"
   double latitude_deg = driftless::kNaN;
@@ -65,6 +73,9 @@ struct SelfCalibration {
   Eigen::Vector3d hinge2_axis = Eigen::Vector3d::UnitX();
   std::array<Eigen::Matrix3d, 2> G_dps_per_g{Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero()};
   std::array<Eigen::Matrix3d, 2> G_sigma{Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero()};
+  bool scale_states = false;  // E below was estimated (scale_misalign_sigma_frac > 0)
+  std::array<Eigen::Matrix3d, 2> E_frac{Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero()};
+  std::array<Eigen::Matrix3d, 2> E_sigma_frac{Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero()};
   bool temp_states = false;  // the temperature coefficients below were states
   std::array<Eigen::Vector3d, 2> temp_coef_dps_per_degc{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
   std::array<Eigen::Vector3d, 2> temp_coef_sigma_dps_per_degc{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};

@@ -158,11 +158,13 @@ std::string model_prior_yaml(const CalibFile& c) {
   m.box.hinge1_axis = c.hinge1_axis;
   m.box.hinge2_axis = c.hinge2_axis;
   m.box.has_stops = !c.matrices_nominal;
+  // a self-calibration's E (nominal M) plants its scale factor, misalignment and mounting too
+  const est::CalibMatrices M = c.matrices_with_scale();
   for (std::size_t i = 0; i < 2; ++i) {
     PriorEffects& e = m.effects[i];
-    e.s = sensor_prior(c.M, static_cast<int>(i), i == 0 ? c.hinge1_axis : c.hinge2_axis);
+    e.s = sensor_prior(M, static_cast<int>(i), i == 0 ? c.hinge1_axis : c.hinge2_axis);
     m.box.stop_error_deg[i] = e.s.stop_error_deg;
-    e.matrices = !c.matrices_nominal;
+    e.matrices = !c.matrices_nominal || c.has_scale_misalign;
     e.has_g = c.has_g_sensitivity;
     e.G_dps_per_g = c.G_dps_per_g[i];
     e.has_temp = c.has_temp_coef;

@@ -58,6 +58,9 @@ void write_selfcal_files(const EstimateArgs& a, const log::Metadata& meta, const
   sc.hinge2_axis = meta.hinge2_axis();
   sc.G_dps_per_g = s.gsens_dps_per_g;
   sc.G_sigma = s.gsens_sigma_dps_per_g;
+  sc.scale_states = s.scale_states;
+  sc.E_frac = s.scale_misalign_frac;
+  sc.E_sigma_frac = s.scale_misalign_sigma_frac;
   sc.temp_states = s.temp_states;
   for (int i = 0; i < 2; ++i) {
     const auto iu = static_cast<std::size_t>(i);
@@ -66,8 +69,8 @@ void write_selfcal_files(const EstimateArgs& a, const log::Metadata& meta, const
   }
   sc.temp_ref_c = s.temp_ref_c;
   calib::save_selfcal_calib(a.calib_out, sc);
-  fmt::print("  wrote {} (g-sensitivity{} with 1-sigma; M nominal)\n", a.calib_out,
-             sc.temp_states ? " and bias temperature coefficients" : "");
+  fmt::print("  wrote {} (g-sensitivity{}{} with 1-sigma; M nominal)\n", a.calib_out,
+             sc.scale_states ? ", scale/misalignment" : "", sc.temp_states ? " and bias temperature coefficients" : "");
   if (a.prior_out.empty()) return;
   io::write_file(a.prior_out, calib::model_prior_yaml(calib::load_calib(a.calib_out)));
   fmt::print("  wrote {} (model prior for the twin)\n", a.prior_out);
@@ -139,8 +142,10 @@ int run_estimate_cmd(const EstimateArgs& a) {
           meta.hinge1_axis().y(), meta.hinge1_axis().z(), meta.hinge2_axis().x(), meta.hinge2_axis().y(),
           meta.hinge2_axis().z()));
     }
-    // M (unless nominal); y <- y - G f / g with the log's accelerometer columns (samples without
-    // them stay as they are); the temperature states start at the calibrated coefficients
+    // M (unless nominal); G and E: with --selfcal the prior of their states (value and sigma),
+    // else fixed corrections (y <- y - G f / g with the log's accelerometer columns, samples
+    // without them stay as they are; M (I + E)^-1 for M); the temperature states start at the
+    // calibrated coefficients
     cfg.calibration = c.to_filter_calibration();
   }
   cfg.validate();
@@ -252,15 +257,16 @@ const bool registered = register_command(30, [](CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--calib", a->calib,
                   "Calibration file (calib.yaml) from 'driftless calibrate' (the matrices M per sensor and "
-                  "end stop replace the hinge rotations; its G, deg/s per g, is subtracted) or from "
-                  "'estimate --selfcal --calib-out' (G, and the temperature states start at its "
-                  "coefficients, deg/s per degC); docs/calibration.md")
+                  "end stop replace the hinge rotations) or from 'estimate --selfcal --calib-out'. Its G "
+                  "(deg/s per g) and scale/misalignment E (fraction): with --selfcal the start value and "
+                  "1-sigma of their states, else fixed corrections; the temperature states start at its "
+                  "coefficients (deg/s per degC); docs/calibration.md")
       ->check(CLI::ExistingFile);
   auto* calib_out = cmd->add_option(
       "--calib-out", a->calib_out,
-      "With --selfcal: write the estimated g-sensitivity (deg/s per g) and bias temperature "
-      "coefficients (deg/s per degC), each with its 1-sigma, as calib.yaml for --calib on the next "
-      "log of the same sensors (M stays nominal); docs/calibration.md");
+      "With --selfcal: write the estimated g-sensitivity (deg/s per g), scale/misalignment "
+      "(fraction) and bias temperature coefficients (deg/s per degC), each with its 1-sigma, as "
+      "calib.yaml for --calib on the next log of the same sensors (M stays nominal); docs/calibration.md");
   cmd->add_option("--prior-out", a->prior_out,
                   "With --calib-out: the same as a twin model-config file (a scenario's model: block; "
                   "compare/diagnose/render --model)")

@@ -51,6 +51,17 @@ struct Calibration {
   bool has_temp_coef = false;
   std::array<Eigen::Vector3d, 2> temp_coef_dps_per_degc{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
   std::array<Eigen::Vector3d, 2> temp_coef_sigma_dps_per_degc{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  /// the 1-sigma of each G element (deg/s per g), when the file gives it. With self-calibration's
+  /// g-sensitivity states on, G and G_sigma are their prior (start value and P0), not a fixed
+  /// correction (docs/estimator.md section 1e)
+  bool has_g_sigma = false;
+  std::array<Eigen::Matrix3d, 2> G_sigma_dps_per_g{Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero()};
+  /// scale-factor and misalignment error per sensor (fraction, sensor axes: y_i = (I + E_i) w_i + ...)
+  /// and the 1-sigma of each element, e.g. from a self-calibration's calib.yaml. With the scale
+  /// states on they are their prior; else push() removes them, y <- (I + E_i)^-1 y
+  bool has_scale_misalign = false;
+  std::array<Eigen::Matrix3d, 2> E_frac{Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero()};
+  std::array<Eigen::Matrix3d, 2> E_sigma_frac{Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero()};
   bool empty() const { return sensor1.empty() && sensor2.empty(); }
   bool has_g_sensitivity() const { return !G_dps_per_g[0].isZero(0.0) || !G_dps_per_g[1].isZero(0.0); }
   /// Throws std::invalid_argument when a matrix is singular or not finite.

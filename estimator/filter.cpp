@@ -34,6 +34,18 @@ void Calibration::validate() const {
       throw std::invalid_argument("calibration: sensor " + std::to_string(i + 1) +
                                   " has a non-finite temperature coefficient or a negative sigma (deg/s per degC)");
   }
+  for (int i = 0; i < 2; ++i) {
+    const auto iu = static_cast<std::size_t>(i);
+    const std::string who = "calibration: sensor " + std::to_string(i + 1);
+    if (has_g_sigma && (!G_sigma_dps_per_g[iu].allFinite() || (G_sigma_dps_per_g[iu].array() < 0.0).any()))
+      throw std::invalid_argument(who + " has a non-finite or negative g-sensitivity sigma (deg/s per g)");
+    if (!has_scale_misalign) continue;
+    if (!E_frac[iu].allFinite() || !E_sigma_frac[iu].allFinite() || (E_sigma_frac[iu].array() < 0.0).any())
+      throw std::invalid_argument(who + " has a non-finite scale/misalignment entry or a negative sigma (fraction)");
+    // (I + E) must be invertible and near I: an E this large is not a scale error but another axis order
+    if (!(E_frac[iu].cwiseAbs().maxCoeff() < 0.5))
+      throw std::invalid_argument(who + " has a scale/misalignment element of 0.5 (50 %) or more: not a small error");
+  }
   auto check = [&](const std::vector<CalibratedPosition>& list, int sensor) {
     for (const auto& p : list) {
       if (!finite(p.plat_deg) || !p.M_body_from_sensor.allFinite()) {
@@ -173,6 +185,7 @@ DriftlessFilter::DriftlessFilter(const EstimatorConfig& cfg, const BoxGeometry& 
   if (has_scale_states()) {
     P_.diagonal().segment<18>(kScale1.start).setConstant(cfg_.scale_misalign_sigma_frac * cfg_.scale_misalign_sigma_frac);
   }
+  use_calibration_prior();
   gate1_ = cfg_.nis_gate_probability < 1.0 ? chi2_quantile(cfg_.nis_gate_probability, 1.0)
                                            : std::numeric_limits<double>::infinity();
   gate3_ = cfg_.nis_gate_probability < 1.0 ? chi2_quantile(cfg_.nis_gate_probability, 3.0)
@@ -181,6 +194,28 @@ DriftlessFilter::DriftlessFilter(const EstimatorConfig& cfg, const BoxGeometry& 
                                            : std::numeric_limits<double>::infinity();
   gate4_ = cfg_.nis_gate_probability < 1.0 ? chi2_quantile(cfg_.nis_gate_probability, 4.0)
                                            : std::numeric_limits<double>::infinity();
+}
+
+// --calib (docs/estimator.md section 1e): a sensor error the filter has states for starts at the
+// file's value with the file's sigma (a diagonal prior: the file holds no correlations); one it has
+// no states for is a fixed correction: G f subtracted in push(), (I + E)^-1 folded into M
+void DriftlessFilter::use_calibration_prior() {
+  const Calibration& cal = cfg_.calibration;
+  fixed_g_ = cal.has_g_sensitivity() && !has_gsens_states();
+  fixed_e_ = cal.has_scale_misalign && !has_scale_states();
+  const auto start = [this](Eigen::Index o, const Eigen::Matrix3d& value, const Eigen::Matrix3d* sigma) {
+    Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(x_.data() + o) = value;
+    if (sigma == nullptr) return;
+    const Eigen::Matrix<double, 3, 3, Eigen::RowMajor> var = sigma->cwiseAbs2();
+    P_.diagonal().segment<9>(o) = Eigen::Map<const Eigen::Matrix<double, 9, 1>>(var.data());
+  };
+  for (int i = 0; i < 2; ++i) {
+    const auto iu = static_cast<std::size_t>(i);
+    if (has_gsens_states()) start(kGSens1.start + 9 * i, cal.G_dps_per_g[iu], cal.has_g_sigma ? &cal.G_sigma_dps_per_g[iu] : nullptr);
+    if (has_scale_states() && cal.has_scale_misalign) start(kScale1.start + 9 * i, cal.E_frac[iu], &cal.E_sigma_frac[iu]);
+    fixed_E_inv_[iu] = fixed_e_ ? Eigen::Matrix3d((Eigen::Matrix3d::Identity() + cal.E_frac[iu]).inverse())
+                                : Eigen::Matrix3d::Identity();
+  }
 }
 
 void DriftlessFilter::on_source_switch(const BoxGeometry* box) {
@@ -214,6 +249,8 @@ Eigen::Matrix3d DriftlessFilter::body_from_sensor(int sensor, double plat_deg) c
       M = p.M_body_from_sensor;
     }
   }
+  // a fixed scale/misalignment from --calib: y = (I + E) M^-1 w + ..., so M (I + E)^-1 replaces M
+  if (fixed_e_) M = M * fixed_E_inv_[i];
   cache_deg_[i] = plat_deg;
   cache_M_[i] = M;
   return M;
@@ -564,8 +601,8 @@ void DriftlessFilter::fuse_rate(const Sample& s, const StandstillStep& st) {
 }
 
 PushStatus DriftlessFilter::push(const Sample& s) {
-  // calibrated g-sensitivity: y <- y - G f / g with the sample's own specific force
-  if (cfg_.calibration.has_g_sensitivity()) {
+  // calibrated g-sensitivity without its states: y <- y - G f / g with the sample's own specific force
+  if (fixed_g_) {
     Sample c = s;
     if (s.accel1_mps2.allFinite()) c.gyro1_dps -= cfg_.calibration.G_dps_per_g[0] * (s.accel1_mps2 / kStandardGravityMps2);
     if (s.accel2_mps2.allFinite()) c.gyro2_dps -= cfg_.calibration.G_dps_per_g[1] * (s.accel2_mps2 / kStandardGravityMps2);

@@ -192,6 +192,7 @@ class DriftlessFilter {
     Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
     int pattern = 0;  // position index 0..3 of eq. (5)'s sequence
   };
+  void use_calibration_prior();
   PushStatus push_corrected(const Sample& s);
   int use_segment(const StandstillSegment& seg);
   void residual_rows(const StandstillSegment& seg, const Eigen::Matrix3d& M1, const Eigen::Matrix3d& M2,
@@ -218,6 +219,9 @@ class DriftlessFilter {
   EstimatorConfig cfg_;
   BoxGeometry box_;
   double q_rate_dps2_per_s_ = 0.0;
+  // --calib terms without states of their own: fixed corrections (use_calibration_prior)
+  bool fixed_g_ = false, fixed_e_ = false;
+  std::array<Eigen::Matrix3d, 2> fixed_E_inv_{Eigen::Matrix3d::Identity(), Eigen::Matrix3d::Identity()};
 
   StateVector x_ = StateVector::Zero();
   Vector6d fixed_bias_ = Vector6d::Zero();  // deg/s, for rate_body_fixed_dps only

@@ -51,7 +51,7 @@ EOF
   --prior-out "$t/prior.yaml" > "$t/sc.out" 2> "$t/sc.err" || fail "selfcal: exit $?: $(cat "$t/sc.out" "$t/sc.err")"
 # THEN calib.yaml holds G with its sigma, the temperature coefficients, nominal matrices
 for key in "format: driftless-calib 1" "method: selfcal" "matrices: nominal" G_dps_per_g G_sigma \
-           bias_tc_dps_per_degc bias_tc_sigma_dps_per_degc; do
+           scale_misalignment E_frac E_sigma_frac bias_tc_dps_per_degc bias_tc_sigma_dps_per_degc; do
   grep -q "$key" "$t/calib.yaml" || fail "calib.yaml lacks '$key'"
 done
 # AND the G it holds is the planted one where the flips observe it: sensor 2's y column (platform 2
@@ -83,6 +83,28 @@ rc=$?
 [[ $rc -eq 0 ]] || fail "second log with --calib: exit $rc: $(cat "$t/cal.out" "$t/cal.err")"
 jq -e '.health.locked and .health.rejected_fraction < 0.05 and .self_calibration.enabled == false' \
   "$t/cal/summary.json" > /dev/null || fail "second log with --calib: $(jq -c .health "$t/cal/summary.json")"
+
+# AND with --calib calib.yaml --selfcal the G and E states start at the file (docs/estimator.md 1e):
+# the second run's sigma of every G and E element is at most the file's (it only learns more), its
+# sensor 2 G y column stays within 4 sigma of the planted one, and it exits 0
+"$bin" estimate --log "$t/b/log.csv" --out "$t/calsc" --calib "$t/calib.yaml" --selfcal --box-at-rest \
+  > "$t/calsc.out" 2> "$t/calsc.err" || fail "second log with --calib --selfcal: exit $?: $(cat "$t/calsc.out" "$t/calsc.err")"
+python3 - "$t/calsc/summary.json" "$t/sc/summary.json" <<'EOF' || fail "--calib --selfcal: sigma grew or G lost"
+import json, sys
+b, a = (json.load(open(p))["self_calibration"] for p in sys.argv[1:3])
+ok = True
+for key in ("g_sensitivity_sigma_dps_per_g", "scale_misalign_sigma_frac"):
+    for i in range(2):
+        for r in range(3):
+            for c in range(3):
+                if b[key][i][r][c] > a[key][i][r][c] * (1 + 1e-9) + 1e-15:
+                    print(f"{key} sensor {i+1} [{r}][{c}]: {b[key][i][r][c]} > {a[key][i][r][c]}"); ok = False
+G, S = b["g_sensitivity_dps_per_g"][1], b["g_sensitivity_sigma_dps_per_g"][1]
+for r, want in enumerate([0.03, -0.03, -0.06]):
+    print(f"second run: sensor 2 G[{r}][y] {G[r][1]:.4f} sigma {S[r][1]:.4f} (first {a['g_sensitivity_sigma_dps_per_g'][1][r][1]:.4f}, planted {want})")
+    ok = ok and abs(G[r][1] - want) < 4 * S[r][1] and S[r][1] < a["g_sensitivity_sigma_dps_per_g"][1][r][1]
+sys.exit(0 if ok else 1)
+EOF
 
 # AND the twin accepts the model prior (a scenario whose model: block is the prior): the run plants
 # the self-calibrated G of sensor 2
