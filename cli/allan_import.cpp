@@ -1,6 +1,7 @@
 // `driftless allan` on recordings the importers read: into memory, or streamed into octave
 // accumulators with the channels shared between two threads.
 #include <algorithm>
+#include <exception>
 #include <functional>
 #include <thread>
 
@@ -132,6 +133,34 @@ Loaded load_imported(const InputArgs& a) {
 
 namespace {
 
+// a block read ahead, with the rows that start a new gap-free piece
+struct Staged {
+  importers::ImuBlock block;
+  std::vector<std::size_t> gaps;
+  bool full = false;
+};
+
+// runs `side` on a new thread and `here` on this one; rethrows the first failure after both ended
+template <class F, class G>
+void both(F&& side, G&& here) {
+  std::exception_ptr side_error, here_error;
+  std::thread t([&] {
+    try {
+      side();
+    } catch (...) {
+      side_error = std::current_exception();
+    }
+  });
+  try {
+    here();
+  } catch (...) {
+    here_error = std::current_exception();
+  }
+  t.join();
+  if (side_error) std::rethrow_exception(side_error);
+  if (here_error) std::rethrow_exception(here_error);
+}
+
 // one channel's accumulators (one per deviation), fed the finite runs between breaks
 struct ChannelSink {
   std::vector<est::StreamingOctaveDeviation> acc;
@@ -183,22 +212,27 @@ Streamed stream_octaves(const InputArgs& a, const std::vector<est::Deviation>& d
     }
   }
   importers::StampMonitor mon;
-  importers::ImuBlock b;
-  b.bare_untimed = true;
+  // the next block is read (and its stamps checked) on its own thread while this one and a helper
+  // feed the accumulators with the current block: reading and summing overlap
+  Staged cur, next;
+  cur.block.bare_untimed = next.block.bare_untimed = true;
   bool first = true;
-  while (reader->read(b, kBlockRows)) {
-    if (first && reader->info().has_time) mon.learn(b.t_s);
+  auto read_into = [&](Staged& st) {
+    st.full = reader->read(st.block, kBlockRows);
+    if (st.full && first && reader->info().has_time) mon.learn(st.block.t_s);
     first = false;
-    const auto gaps = gap_rows(b, mon, reader->info().has_time, a.gaps_ignore);
+    st.gaps = st.full ? gap_rows(st.block, mon, reader->info().has_time, a.gaps_ignore) : std::vector<std::size_t>{};
+  };
+  read_into(cur);
+  while (cur.full) {
     // the channels split between this thread and one more
     auto work = [&](std::size_t from, std::size_t step) {
       for (std::size_t c = from; c < map.size(); c += step) {
-        if (map[c] >= 0) sinks[static_cast<std::size_t>(map[c])].feed(b.values[c], gaps, a.gaps_ignore);
+        if (map[c] >= 0) sinks[static_cast<std::size_t>(map[c])].feed(cur.block.values[c], cur.gaps, a.gaps_ignore);
       }
     };
-    std::thread helper(work, 1, 2);
-    work(0, 2);
-    helper.join();
+    both([&] { read_into(next); }, [&] { both([&] { work(1, 2); }, [&] { work(0, 2); }); });
+    std::swap(cur, next);
   }
   std::size_t nan = 0;
   for (const auto& s : sinks) nan += s.nan;

@@ -17,6 +17,7 @@
 #include "cli/estimate_outputs.hpp"
 #include "estimator/calibration.hpp"
 #include "estimator/pipeline.hpp"
+#include "estimator/smoother.hpp"
 #include "estimator/tune.hpp"
 #include "calibration/calib_file.hpp"
 #include "calibration/prior.hpp"
@@ -37,6 +38,7 @@ struct EstimateArgs {
   std::string prior_out;  // with --calib-out: the same as a twin model prior
   bool plot = false;
   bool corrected = false;  // write corrected.csv (--corrected)
+  bool smooth = false;     // corrected.csv from the fixed-interval smoother (--smooth)
   bool selfcal = false;   // self-calibrating mode: g-sensitivity states (docs/estimator.md section 1b)
   bool box_at_rest = false;  // the box stands still on the Earth: the vertical Earth rate is a measurement
   bool strict = false;    // exit 1 on a degraded health verdict too (failed always exits 1)
@@ -74,6 +76,19 @@ void write_selfcal_files(const EstimateArgs& a, const log::Metadata& meta, const
   if (a.prior_out.empty()) return;
   io::write_file(a.prior_out, calib::model_prior_yaml(calib::load_calib(a.calib_out)));
   fmt::print("  wrote {} (model prior for the twin)\n", a.prior_out);
+}
+
+// --smooth: the backward pass over the updates, then the log again with the smoothed correction
+// into corrected.csv (docs/estimator.md section 6.3). Every row is marked locked when the forward
+// filter locked at all: the smoothed correction at any time uses the whole log
+void write_smoothed(const EstimateArgs& a, const log::ReaderOptions& read_opt, const est::EstimatorConfig& cfg,
+                    est::FixedIntervalSmoother& sm, EstimateFiles& files, const est::EstimateSummary& s) {
+  sm.smooth();
+  log::LogReader again(a.log, read_opt);
+  const bool locked = std::isfinite(s.locked_from_t_s);
+  est::smoothed_outputs(
+      cfg, est::box_geometry_from_metadata(again.metadata()), [&again](Sample& x) { return again.next(x); }, sm,
+      [&](const Sample& x, const est::SampleOutput& o) { files.on_smoothed_sample(x, o, locked); });
 }
 
 // --tune auto: a first pass over the log measures N and K (docs/estimator.md section 6.2)
@@ -171,12 +186,17 @@ int run_estimate_cmd(const EstimateArgs& a) {
   EstimateFilesOptions file_opt;
   file_opt.truth = truth;
   file_opt.corrected = a.corrected;
+  file_opt.smoothed = a.smooth;
   file_opt.keep_series = a.plot;
   file_opt.t_end_s = reader.metadata().get_number("duration_s", kNaN);
   EstimateFiles files(dir, file_opt);
   est::EstimateRunOptions run_opt;
   run_opt.attitude_start_sigma_dps = a.attitude_start_sigma_dps;
+  std::unique_ptr<est::FixedIntervalSmoother> smoother;
+  if (a.smooth) smoother = std::make_unique<est::FixedIntervalSmoother>(cfg.q_dps2_per_s());
+  run_opt.update_observer = smoother.get();
   const auto summary = est::run_estimate(reader, cfg, &files, run_opt, &stop_polled);
+  if (smoother && !stop_requested().load()) write_smoothed(a, read_opt, cfg, *smoother, files, summary);
   files.commit();
   const bool interrupted = stop_requested().load();
 
@@ -271,10 +291,16 @@ const bool registered = register_command(30, [](CLI::App& app) {
                   "With --calib-out: the same as a twin model-config file (a scenario's model: block; "
                   "compare/diagnose/render --model)")
       ->needs(calib_out);
-  cmd->add_flag("--corrected", a->corrected,
+  auto* corrected = cmd->add_flag("--corrected", a->corrected,
                 "Also write corrected.csv: the corrected gyro and fused rates per log row (deg/s), about "
                 "110 bytes a row (0.6 GB for a 14 h log at 100 Hz); the bias estimates are in estimate.csv "
                 "either way");
+  cmd->add_flag("--smooth", a->smooth,
+                "With --corrected: corrected.csv from the offline fixed-interval (Rauch-Tung-Striebel) "
+                "smoother over the whole log: the correction (deg/s) at every row uses the updates before "
+                "and after it, so it has no steps between updates; a second pass over the log, rows marked "
+                "smoothed = 1; docs/estimator.md section 6.3")
+      ->needs(corrected);
   cmd->add_flag("--plot", a->plot,
                 "Also write Fig. 4 (bias vs truth, deg/s), Fig. 5 (Allan deviation, deg/s vs s) and "
                 "Fig. 9 (attitude error, deg vs s) as PNG + SVG with their gnuplot scripts");

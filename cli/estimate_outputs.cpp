@@ -65,7 +65,8 @@ void format_corrected(io::OutputFile& f, const std::vector<EstimateFiles::Correc
     }
     out.push_back(',');
     out.append(est::to_string(r.status));
-    out.append(r.locked ? ",1\n" : ",0\n");
+    out.append(r.locked ? ",1" : ",0");
+    out.append(r.smoothed ? ",1\n" : "\n");
     f.maybe_drain();
   }
 }
@@ -95,7 +96,8 @@ EstimateFiles::EstimateFiles(const fs::path& dir, const EstimateFilesOptions& op
     : opt_(opt), estimate_(dir / "estimate.csv"), attitude_(dir / "attitude.csv"), progress_("estimate") {
   if (opt_.corrected) {
     corrected_.emplace(dir / "corrected.csv");
-    corrected_->write(kCorrectedHeader);
+    corrected_->write(kCorrectedHeader.substr(0, kCorrectedHeader.size() - 1));
+    corrected_->write(opt_.smoothed ? ",smoothed\n" : "\n");
     corrected_writer_ = std::make_unique<io::BackgroundWriter<CorrectedRow>>(
         [this](const std::vector<CorrectedRow>& rows) { format_corrected(*corrected_, rows); });
   }
@@ -110,11 +112,18 @@ EstimateFiles::EstimateFiles(const fs::path& dir, const EstimateFilesOptions& op
 // the writer thread stops before the file it writes is discarded
 EstimateFiles::~EstimateFiles() { corrected_writer_.reset(); }
 
+void EstimateFiles::on_smoothed_sample(const Sample& s, const est::SampleOutput& o, bool locked) {
+  if (!corrected_writer_) return;
+  corrected_writer_->push(CorrectedRow{{s.t_s, o.y1c_dps[0], o.y1c_dps[1], o.y1c_dps[2], o.y2c_dps[0], o.y2c_dps[1],
+                                        o.y2c_dps[2], o.rate_body_dps[0], o.rate_body_dps[1], o.rate_body_dps[2]},
+                                       o.status, locked, true});
+}
+
 void EstimateFiles::on_sample(const Sample& s, const est::SampleOutput& o, bool locked) {
-  if (corrected_writer_) {
+  if (corrected_writer_ && !opt_.smoothed) {
     CorrectedRow r{{s.t_s, o.y1c_dps[0], o.y1c_dps[1], o.y1c_dps[2], o.y2c_dps[0], o.y2c_dps[1], o.y2c_dps[2],
                     o.rate_body_dps[0], o.rate_body_dps[1], o.rate_body_dps[2]},
-                   o.status, locked};
+                   o.status, locked, false};
     corrected_writer_->push(r);
   }
   if (opt_.keep_series) series_.add(s, o);

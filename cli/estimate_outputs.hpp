@@ -22,6 +22,7 @@ namespace driftless::cli {
 struct EstimateFilesOptions {
   bool truth = false;         // estimate.csv gets the true_bias columns
   bool corrected = false;     // write corrected.csv (--corrected)
+  bool smoothed = false;      // its rows come from --smooth's second pass (on_smoothed_sample), marked smoothed = 1
   bool keep_series = false;   // collect the Fig. 5 series (--plot)
   double t_end_s = kNaN;      // s, for the progress display (the log's duration_s)
 };
@@ -35,6 +36,8 @@ class EstimateFiles : public est::EstimateSink {
   void on_sample(const Sample& s, const est::SampleOutput& o, bool locked) override;
   void on_update(const est::UpdateRecord& r, const est::Matrix6d& P, const Sample& s, bool locked) override;
   void on_attitude(const est::AttitudePoint& p) override;
+  /// A corrected.csv row of --smooth's second pass (smoothed = 1; `locked` as in on_sample).
+  void on_smoothed_sample(const Sample& s, const est::SampleOutput& o, bool locked);
 
   /// Writes what is left and renames the files into place (throws io::OutputError "<file>: <reason>").
   void commit();
@@ -46,6 +49,7 @@ class EstimateFiles : public est::EstimateSink {
     double v[10];
     est::PushStatus status;
     bool locked;
+    bool smoothed;  // a --smooth row: the column smoothed = 1 follows
   };
 
  private:

@@ -36,88 +36,146 @@ double block_dt(const BlockSeries& b, std::size_t j) { return j == 0 ? 0.0 : b.t
 
 }  // namespace
 
-BiasWhitener::BiasWhitener(const BlockSeries& blocks, const ChannelNoise& noise) {
+// the filter's covariance recursion over the blocks, the one loop every user shares (the same
+// operations in the same order, so the same bits whichever user): after block j it calls
+// visit(j, g) with the step's gains and covariances. exp() runs once per distinct interval and the
+// measurement variance once per distinct sample count (the noise-model searches run this
+// thousands of times on 36 000 blocks)
+template <class Visit>
+void BiasWhitener::recursion(const BlockSeries& blocks, const ChannelNoise& noise, Visit&& visit) {
   noise.validate();
-  const std::size_t m = blocks.t_s.size();
-  steps_.resize(m);
-  used_.assign(m, 0);
   const Process pr(blocks, noise);
   double p00 = noise.turn_on_sigma_dps * noise.turn_on_sigma_dps, p01 = 0.0, p11 = pr.gm_var;
+  double last_dt = std::numeric_limits<double>::quiet_NaN(), phi = 1.0, q_gm = 0.0;
+  std::uint16_t last_count = 0;
+  double r = 0.0;
   bool first = true;
-  for (std::size_t j = 0; j < m; ++j) {
-    Step& st = steps_[j];
+  Step st{};
+  for (std::size_t j = 0; j < blocks.t_s.size(); ++j) {
     const double dt = block_dt(blocks, j);
-    st.phi = std::exp(-dt / pr.gm_tau_s);
+    if (dt != last_dt) last_dt = dt, phi = std::exp(-dt / pr.gm_tau_s), q_gm = pr.gm_var * (1.0 - phi * phi);
+    st.phi = phi;
     st.q_rw = pr.rrw_var * dt;
-    st.q_gm = pr.gm_var * (1.0 - st.phi * st.phi);
+    st.q_gm = q_gm;
     // predict
     st.pp00 = p00 + st.q_rw;
-    st.pp01 = st.phi * p01;
-    st.pp11 = st.phi * st.phi * p11 + st.q_gm;
-    if (blocks.count[j] > 0) {
-      const double r = pr.white_var_rate / blocks.count[j];
+    st.pp01 = phi * p01;
+    st.pp11 = phi * phi * p11 + q_gm;
+    const std::uint16_t count = blocks.count[j];
+    bool used = false;
+    if (count > 0) {
+      if (count != last_count) last_count = count, r = pr.white_var_rate / count;
       st.s = st.pp00 + 2 * st.pp01 + st.pp11 + r;
       st.k0 = (st.pp00 + st.pp01) / st.s;
       st.k1 = (st.pp01 + st.pp11) / st.s;
       p00 = st.pp00 - st.k0 * st.k0 * st.s;
       p01 = st.pp01 - st.k0 * st.k1 * st.s;
       p11 = st.pp11 - st.k1 * st.k1 * st.s;
-      // the first observed block only fixes the turn-on bias (diffuse prior)
-      if (!first) {
-        used_[j] = 1;
-        ++n_used_;
-      }
+      used = !first;  // the first observed block only fixes the turn-on bias (diffuse prior)
       first = false;
     } else {
       st.s = 0.0;
       st.k0 = st.k1 = 0.0;
-      p00 = st.pp00;
-      p01 = st.pp01;
-      p11 = st.pp11;
+      p00 = st.pp00, p01 = st.pp01, p11 = st.pp11;
     }
-    st.pf00 = p00;
-    st.pf01 = p01;
-    st.pf11 = p11;
+    st.pf00 = p00, st.pf01 = p01, st.pf11 = p11;
+    visit(j, st, used);
   }
-  final_sigma_ = std::sqrt(std::max(0.0, p00));
 }
 
-// the constructor's recursion and neg2_loglik(z) fused, keeping nothing per block: the same
-// operations in the same order (the same bits); exp() once per distinct interval and the
-// measurement variance once per distinct sample count, because the noise-model searches call
-// this thousands of times on 36 000 blocks
-double BiasWhitener::neg2_loglik(const BlockSeries& blocks, const ChannelNoise& noise, std::span<const double> z) {
-  noise.validate();
-  const Process pr(blocks, noise);
-  double p00 = noise.turn_on_sigma_dps * noise.turn_on_sigma_dps, p01 = 0.0, p11 = pr.gm_var;
-  double x0 = 0.0, x1 = 0.0, acc = 0.0;
-  double last_dt = std::numeric_limits<double>::quiet_NaN(), phi = 1.0, q_gm = 0.0;
-  std::uint16_t last_count = 0;
-  double r = 0.0;
-  bool first = true;
-  for (std::size_t j = 0; j < blocks.t_s.size(); ++j) {
-    const double dt = block_dt(blocks, j);
-    if (dt != last_dt) last_dt = dt, phi = std::exp(-dt / pr.gm_tau_s), q_gm = pr.gm_var * (1.0 - phi * phi);
-    const double pp00 = p00 + pr.rrw_var * dt, pp01 = phi * p01, pp11 = phi * phi * p11 + q_gm;
-    x1 *= phi;
-    const std::uint16_t count = blocks.count[j];
-    if (count == 0) {
-      p00 = pp00, p01 = pp01, p11 = pp11;
-      continue;
+BiasWhitener::BiasWhitener(const BlockSeries& blocks, const ChannelNoise& noise) {
+  const std::size_t m = blocks.t_s.size();
+  steps_.resize(m);
+  used_.assign(m, 0);
+  recursion(blocks, noise, [&](std::size_t j, const Step& st, bool used) {
+    steps_[j] = st;
+    used_[j] = used;
+    n_used_ += used;
+  });
+  final_sigma_ = m > 0 ? std::sqrt(std::max(0.0, steps_.back().pf00)) : std::sqrt(noise.turn_on_sigma_dps * noise.turn_on_sigma_dps);
+}
+
+// -2 log-likelihood of the innovations: sum of nu^2/s plus the log-determinant, summed as the log
+// of products of up to 8 innovation variances (one log per 8 blocks instead of per block: the
+// searches evaluate it a thousand times on 36 000 blocks); 8 variances within 1e-30..1e30 stay
+// far inside double's range, a variance outside it is logged alone
+class Neg2LogLik {
+ public:
+  void add(double nu, double s) {
+    quad_ += nu * nu / s;
+    if (!(s > 1e-30 && s < 1e30)) {
+      logdet_ += std::log(s);
+      return;
     }
-    if (count != last_count) last_count = count, r = pr.white_var_rate / count;
-    const double s = pp00 + 2 * pp01 + pp11 + r;
-    const double k0 = (pp00 + pp01) / s, k1 = (pp01 + pp11) / s;
-    p00 = pp00 - k0 * k0 * s;
-    p01 = pp01 - k0 * k1 * s;
-    p11 = pp11 - k1 * k1 * s;
-    const double nu = z[j] - x0 - x1;
-    x0 += k0 * nu;
-    x1 += k1 * nu;
-    if (!first) acc += std::log(s) + nu * nu / s;
-    first = false;
+    prod_ *= s;
+    if (++in_prod_ == 8) logdet_ += std::log(prod_), prod_ = 1.0, in_prod_ = 0;
   }
-  return acc;
+  double value() const { return logdet_ + std::log(prod_) + quad_; }
+
+ private:
+  double quad_ = 0.0, logdet_ = 0.0, prod_ = 1.0;
+  int in_prod_ = 0;
+};
+
+// the recursion and neg2_loglik(z) fused, keeping nothing per block (the same bits as the member)
+double BiasWhitener::neg2_loglik(const BlockSeries& blocks, const ChannelNoise& noise, std::span<const double> z) {
+  double x0 = 0.0, x1 = 0.0;
+  Neg2LogLik acc;
+  recursion(blocks, noise, [&](std::size_t j, const Step& st, bool used) {
+    x1 *= st.phi;
+    if (!(st.s > 0.0)) return;
+    const double nu = z[j] - x0 - x1;
+    x0 += st.k0 * nu;
+    x1 += st.k1 * nu;
+    if (used) acc.add(nu, st.s);
+  });
+  return acc.value();
+}
+
+// whiten() of every column and of z at once, block by block, summing the rows' outer products in
+// chunks: no per-block gains and no whitened copy of the columns (they were 10 MB per call an hour)
+template <class Matrix>
+WhitenedGram BiasWhitener::whitened_gram_of(const BlockSeries& blocks, const ChannelNoise& noise,
+                                            const Matrix& cols, std::span<const double> z) {
+  const Eigen::Index P = cols.cols(), n = P + 1;
+  constexpr Eigen::Index kChunk = 256;
+  WhitenedGram out;
+  out.gram = Eigen::MatrixXd::Zero(n, n);
+  Eigen::MatrixXd rows(n, kChunk);  // one whitened block per column
+  Eigen::VectorXd x0 = Eigen::VectorXd::Zero(n), x1 = Eigen::VectorXd::Zero(n);
+  Eigen::Index filled = 0;
+  auto flush = [&] {
+    out.gram.noalias() += rows.leftCols(filled) * rows.leftCols(filled).transpose();
+    filled = 0;
+  };
+  recursion(blocks, noise, [&](std::size_t j, const Step& st, bool used) {
+    x1 *= st.phi;
+    if (!(st.s > 0.0)) return;
+    const double sq = std::sqrt(st.s);
+    const auto b = static_cast<Eigen::Index>(j);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const double v = i < P ? static_cast<double>(cols(b, i)) : z[j];
+      const double nu = v - x0[i] - x1[i];
+      x0[i] += st.k0 * nu;
+      x1[i] += st.k1 * nu;
+      if (used) rows(i, filled) = nu / sq;
+    }
+    if (!used) return;
+    ++out.used;
+    if (++filled == kChunk) flush();
+  });
+  flush();
+  return out;
+}
+
+WhitenedGram BiasWhitener::whitened_gram(const BlockSeries& blocks, const ChannelNoise& noise,
+                                         const Eigen::MatrixXf& cols, std::span<const double> z) {
+  return whitened_gram_of(blocks, noise, cols, z);
+}
+
+WhitenedGram BiasWhitener::whitened_gram(const BlockSeries& blocks, const ChannelNoise& noise,
+                                         const Eigen::MatrixXd& cols, std::span<const double> z) {
+  return whitened_gram_of(blocks, noise, cols, z);
 }
 
 void BiasWhitener::whiten(std::span<const double> z, std::span<double> out) const {
@@ -127,11 +185,11 @@ void BiasWhitener::whiten(std::span<const double> z, std::span<double> out) cons
 }
 
 double BiasWhitener::neg2_loglik(std::span<const double> z) const {
-  double acc = 0.0;
+  Neg2LogLik acc;
   forward(z, [&](std::size_t j, const Step& st, double nu, double, double) {
-    if (st.s > 0.0 && used_[j]) acc += std::log(st.s) + nu * nu / st.s;
+    if (st.s > 0.0 && used_[j]) acc.add(nu, st.s);
   });
-  return acc;
+  return acc.value();
 }
 
 std::vector<double> BiasWhitener::smooth(std::span<const double> z) const {

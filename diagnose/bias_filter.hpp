@@ -10,6 +10,8 @@
 #include <span>
 #include <vector>
 
+#include <Eigen/Core>
+
 namespace driftless::diagnose {
 
 /// Noise model of one channel. Units: deg/s, s.
@@ -30,6 +32,12 @@ struct BlockSeries {
   double sample_rate_hz = 100.0;     // Hz, of the samples inside the blocks
 };
 
+/// The whitened Gram matrix of columns [X, z] and how many blocks entered it.
+struct WhitenedGram {
+  Eigen::MatrixXd gram;   // (P+1) x (P+1): whitened [X z]' [X z]
+  std::size_t used = 0;   // blocks that enter fits (used_count())
+};
+
 /// Precomputed gains of the whitening filter for one noise model and block layout.
 class BiasWhitener {
  public:
@@ -41,6 +49,12 @@ class BiasWhitener {
   /// The same -2 log-likelihood in one pass that keeps no gains: for the noise-model searches,
   /// which evaluate many noise models once each (no per-block storage, identical arithmetic).
   static double neg2_loglik(const BlockSeries& blocks, const ChannelNoise& noise, std::span<const double> z);
+  /// The Gram matrix of whiten() applied to every column of `cols` (blocks x P) and to `z`, in
+  /// one pass that keeps nothing per block (the rebuild after every noise-model change).
+  static WhitenedGram whitened_gram(const BlockSeries& blocks, const ChannelNoise& noise,
+                                    const Eigen::MatrixXf& cols, std::span<const double> z);
+  static WhitenedGram whitened_gram(const BlockSeries& blocks, const ChannelNoise& noise,
+                                    const Eigen::MatrixXd& cols, std::span<const double> z);
   /// Smoothed bias (RTS) given z: the nuisance estimate, deg/s, per block.
   std::vector<double> smooth(std::span<const double> z) const;
   /// Which blocks enter fits (data present, not the diffuse first one).
@@ -58,6 +72,13 @@ class BiasWhitener {
     // RTS smoother: filtered and predicted covariances
     double pf00, pf01, pf11, pp00, pp01, pp11;
   };
+  /// The covariance recursion over the blocks, shared by the constructor and the one-pass
+  /// functions: calls visit(j, step, used) after block j.
+  template <class Visit>
+  static void recursion(const BlockSeries& blocks, const ChannelNoise& noise, Visit&& visit);
+  template <class Matrix>
+  static WhitenedGram whitened_gram_of(const BlockSeries& blocks, const ChannelNoise& noise,
+                                       const Matrix& cols, std::span<const double> z);
   /// The filter's forward pass over z, the one loop whiten, neg2_loglik and smooth share: after
   /// block j it calls visit(j, step, nu, x0, x1) with the innovation nu (NaN where the block has
   /// no data and the state was only predicted) and the filtered states.

@@ -143,18 +143,9 @@ namespace {
 
 // whitened Gram of [cols..., z] and the null (nuisance-only) fit's variance and objective
 void rebuild_gram(ChannelData& c, const BlockSeries& blocks) {
-  const int P = static_cast<int>(c.cols.size());
-  const std::size_t mb = c.z.size();
-  const BiasWhitener W(blocks, c.noise);
-  c.m = W.used_count();
-  Eigen::MatrixXd A(static_cast<Eigen::Index>(mb), P + 1);
-  std::vector<double> col(mb), w(mb);
-  for (int i = 0; i <= P; ++i) {
-    for (std::size_t b = 0; b < mb; ++b) col[b] = i < P ? c.block_cols(static_cast<Eigen::Index>(b), i) : c.z[b];
-    W.whiten(col, w);
-    for (std::size_t b = 0; b < mb; ++b) A(static_cast<Eigen::Index>(b), i) = w[b];
-  }
-  c.gram = A.transpose() * A;
+  WhitenedGram g = BiasWhitener::whitened_gram(blocks, c.noise, c.block_cols, c.z);
+  c.m = g.used;
+  c.gram = std::move(g.gram);
   c.sigma2 = 1.0;
   const double j = partial_out(c, {}).J;
   c.sigma2 = std::max(1e-6, j / static_cast<double>(std::max<std::size_t>(c.m, 1)));
@@ -165,13 +156,12 @@ namespace {
 
 // block means of every excited column of channel (s, j)
 void fill_columns(const ColumnInputs& in, const Residual& res, ChannelData& c) {
-  const std::size_t n = res.n, mb = res.blocks;
-  std::vector<double> tmp(n), bm(mb);
+  const std::size_t mb = res.blocks;
+  std::vector<double> bm;
   std::vector<std::vector<double>> kept;
   for (int col = 0; col < kNumCols; ++col) {
     if ((col == kTempBias || col == kTempScale) && res.temp_span_c < 0.2) continue;
-    for (std::size_t k = 0; k < n; ++k) tmp[k] = res.bmask[k] ? column_value(in, c.s, c.j, col, k) : 0.0;
-    block_means(tmp, res.bmask, res.block_len, bm);
+    block_means_of(res, [&](std::size_t k) { return column_value(in, c.s, c.j, col, k); }, bm);
     double ss = 0.0;
     for (std::size_t b = 0; b < mb; ++b) ss += res.block_series.count[b] ? bm[b] * bm[b] : 0.0;
     if (ss < 1e-20) continue;  // not excited by this log
@@ -266,7 +256,7 @@ Channels build_channels(const ColumnInputs& in, const Residual& res) {
       C.gram = Eigen::MatrixXd::Zero(1, 1);
       return;
     }
-    C.z = block_series_of(res, res.e_series(c));
+    block_means_of(res, [&](std::size_t k) { return res.e_dps(c, k); }, C.z);
     fill_columns(in, res, C);
     // noise model: the model's bias processes; the white density is a nuisance, fitted
     C.noise.white_dps_rthz = p.white_noise.enabled ? std::max(1e-6, p.white_noise.density_dps_rthz[C.j]) : 1e-6;

@@ -142,30 +142,32 @@ void correlations(const Replay& r, const Residual& res, const Channels& ch, cons
     sigs.emplace_back(fmt::format("temperature {}", s + 1), [&, s](std::size_t k) { return res.temp_c(s, k); });
     sigs.emplace_back(fmt::format("time since flip {}", s + 1), [&, s](std::size_t k) { return std::min(10.0f, r.since_flip_s[s][k]); });
   }
-  std::array<std::vector<double>, 6> rw;
+  // the block means of every signal as columns; per channel the whitened Gram of [signals,
+  // residual] holds every sum the correlations need (sxx, sxy on its last column, syy)
+  const auto S = static_cast<Eigen::Index>(sigs.size());
+  Eigen::MatrixXd X(static_cast<Eigen::Index>(res.blocks), S);
+  std::vector<double> sb;
+  for (Eigen::Index i = 0; i < S; ++i) {
+    block_means_of(res, sigs[static_cast<std::size_t>(i)].second, sb);
+    X.col(i) = Eigen::Map<const Eigen::VectorXd>(sb.data(), static_cast<Eigen::Index>(sb.size()));
+  }
+  std::array<Eigen::MatrixXd, 6> gram;
   for (int c = 0; c < res.channels(); ++c) {
     std::vector<double> z = a.z[c];
     for (double& v : z) v = std::isfinite(v) ? v : 0.0;
-    rw[c].resize(res.blocks);
-    BiasWhitener(res.block_series, ch[c].noise).whiten(z, rw[c]);
+    gram[static_cast<std::size_t>(c)] = BiasWhitener::whitened_gram(res.block_series, ch[c].noise, X, z).gram;
   }
-  std::vector<double> tmp(res.n), sw(res.blocks);
-  for (const auto& [name, f] : sigs) {
-    for (std::size_t k = 0; k < res.n; ++k) tmp[k] = res.bmask[k] ? f(k) : 0.0;
-    const std::vector<double> sb = block_series_of(res, tmp);
+  for (Eigen::Index i = 0; i < S; ++i) {
     for (int c = 0; c < res.channels(); ++c) {
-      const BiasWhitener W(res.block_series, ch[c].noise);
-      W.whiten(sb, sw);
-      double sxy = 0, sxx = 0, syy = 0;
-      for (std::size_t b = 0; b < res.blocks; ++b) {
-        if (!W.used()[b]) continue;
-        sxy += sw[b] * rw[c][b], sxx += sw[b] * sw[b], syy += rw[c][b] * rw[c][b];
-      }
+      const Eigen::MatrixXd& g = gram[static_cast<std::size_t>(c)];
+      const double sxy = g(i, S), sxx = g(i, i), syy = g(S, S);
       if (sxx <= 1e-300 || syy <= 0) continue;
       const double rho = sxy / std::sqrt(sxx * syy);
       const double z = rho * std::sqrt(static_cast<double>(ch[c].m));
       // significant and material: a long log makes a negligible correlation significant
-      if (std::abs(z) > opt.correlation_z && rho * rho >= opt.min_effect_fraction) out.correlations.push_back({name, c, rho, z});
+      if (std::abs(z) > opt.correlation_z && rho * rho >= opt.min_effect_fraction) {
+        out.correlations.push_back({sigs[static_cast<std::size_t>(i)].first, c, rho, z});
+      }
     }
   }
   std::sort(out.correlations.begin(), out.correlations.end(),

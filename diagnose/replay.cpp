@@ -32,11 +32,25 @@ struct Raw {
     if (with_a) a[0].push_back(s.accel1_mps2), a[1].push_back(s.accel2_mps2);
     ++n;
   }
-  // gives back what the vectors' growth reserved, one column at a time
+  // room for `rows` rows, so the columns do not grow by doubling (each doubling copies the column
+  // and leaves the old one as freed heap: 38 MB of an hour's replay were such holes)
+  void reserve(std::size_t rows) {
+    t.reserve(rows);
+    for (int s = 0; s < 2; ++s) {
+      g[s].reserve(rows), plat[s].reserve(rows), temp[s].reserve(rows);
+      if (with_a) a[s].reserve(rows);
+    }
+    q.reserve(rows);
+    if (with_p) p.reserve(rows);
+  }
+  // gives back what the vectors' growth reserved beyond 1 %, one column at a time
   void shrink() {
-    for (auto* v : {&t, &plat[0], &plat[1], &temp[0], &temp[1]}) v->shrink_to_fit();
-    for (auto* v : {&g[0], &g[1], &a[0], &a[1], &p}) v->shrink_to_fit();
-    q.shrink_to_fit();
+    auto fit = [](auto& v) {
+      if (v.capacity() > v.size() + v.size() / 100 + 64) v.shrink_to_fit();
+    };
+    for (auto* v : {&t, &plat[0], &plat[1], &temp[0], &temp[1]}) fit(*v);
+    for (auto* v : {&g[0], &g[1], &a[0], &a[1], &p}) fit(*v);
+    fit(q);
   }
   std::size_t n = 0;
   bool with_p = false, with_a = false;
@@ -224,13 +238,11 @@ Eigen::Quaterniond quat(const Eigen::Vector4d& q) { return Eigen::Quaterniond(q[
 // no stencil rebuilds the rate near it. It shows as an isolated spike of the second difference
 // of the interval means; continuous vibration raises them everywhere and is not a kink (the FIR
 // rebuilds it)
-void mark_kinks(const std::vector<Eigen::Vector3d>& mean_rate, std::size_t fir_half, const ReplayOptions& opt, Replay& out) {
+// (d2: per sample the largest axis of the second difference of the interval mean rates, rad/s)
+void mark_kinks(const std::vector<double>& d2, std::size_t fir_half, const ReplayOptions& opt, Replay& out) {
   const std::size_t n = out.size();
   const double limit = opt.replay_error_limit_dps * kRadPerDeg;
-  std::vector<double> d2(n, 0.0), csum(n + 1, 0.0);
-  for (std::size_t k = 1; k + 1 < mean_rate.size(); ++k) {
-    d2[k] = (mean_rate[k + 1] - 2.0 * mean_rate[k] + mean_rate[k - 1]).cwiseAbs().maxCoeff();
-  }
+  std::vector<double> csum(n + 1, 0.0);
   for (std::size_t k = 0; k < n; ++k) csum[k + 1] = csum[k] + d2[k];
   const auto half = static_cast<std::size_t>(std::max(5.0, std::round(0.5 * out.sample_rate_hz)));
   const auto spread = static_cast<std::size_t>(std::ceil(opt.rough_guard_s * out.sample_rate_hz)) + fir_half;
@@ -260,11 +272,11 @@ void mark_kinks(const std::vector<Eigen::Vector3d>& mean_rate, std::size_t fir_h
 void body_rate(Raw& raw, const Eigen::Vector3d& earth_enu, const ReplayOptions& opt, Replay& out) {
   const std::size_t n = raw.size();
   out.t_s = std::move(raw.t);
-  std::vector<Eigen::Vector4d> q(n);
-  for (std::size_t k = 0; k < n; ++k) {
-    q[k] = raw.q[k];
-    if (k > 0 && q[k].dot(q[k - 1]) < 0) q[k] = -q[k];  // one hemisphere: q and -q are one rotation
-  }
+  // one hemisphere: q and -q are one rotation (in place: every later use rotates with q, which
+  // gives the same bits for -q, or takes the shortest rotation vector)
+  std::vector<Eigen::Vector4d>& q = raw.q;
+  for (std::size_t k = 1; k < n; ++k)
+    if (q[k].dot(q[k - 1]) < 0) q[k] = -q[k];
   const std::vector<double> d = central_differentiator();
   const auto M = d.size();
   out.w_body_radps.resize(n);
@@ -282,12 +294,20 @@ void body_rate(Raw& raw, const Eigen::Vector3d& earth_enu, const ReplayOptions& 
     const Eigen::Vector3d w_eb = 2.0 * (qk.conjugate() * dqk).vec();
     out.w_body_radps[k] = w_eb + qk.conjugate() * earth_enu;
   }
-  // kinks from the interval mean rates (their second differences)
-  std::vector<Eigen::Vector3d> mean_rate(n - 1);
-  for (std::size_t k = 0; k + 1 < n; ++k) {
-    mean_rate[k] = geo::rotvec_rad(quat(raw.q[k]).conjugate() * quat(raw.q[k + 1])) / (out.t_s[k + 1] - out.t_s[k]);
+  // kinks from the second differences of the interval mean rates (three kept at a time)
+  std::vector<double> d2(n, 0.0);
+  auto mean_rate = [&](std::size_t k) {
+    return Eigen::Vector3d(geo::rotvec_rad(quat(q[k]).conjugate() * quat(q[k + 1])) / (out.t_s[k + 1] - out.t_s[k]));
+  };
+  if (n >= 3) {
+    Eigen::Vector3d m0 = mean_rate(0), m1 = mean_rate(1);
+    for (std::size_t k = 1; k + 2 < n; ++k) {
+      const Eigen::Vector3d m2 = mean_rate(k + 1);
+      d2[k] = (m2 - 2.0 * m1 + m0).cwiseAbs().maxCoeff();
+      m0 = m1, m1 = m2;
+    }
   }
-  mark_kinks(mean_rate, M, opt, out);
+  mark_kinks(d2, M, opt, out);
   // the first and last M samples have no full differentiator stencil: left out like a kink
   for (std::size_t k = 0; k < std::min(n, M); ++k) out.rough[k] = out.rough[n - 1 - k] = 1;
 }
@@ -454,6 +474,17 @@ Replay build(Raw raw, const log::Metadata& meta, std::uint32_t fields, const Rep
   return out;
 }
 
+// the rows a log's metadata announce (duration_s x sample_rate_hz + 1), at most what the file's
+// size can hold (a row has at least 40 characters); 0 when it does not say
+std::size_t expected_rows(const log::Metadata& meta, const std::filesystem::path& path) {
+  const double fs = meta.sample_rate_hz(), dur = meta.get_number("duration_s", kNaN);
+  if (!(fs > 0) || !(dur > 0) || !std::isfinite(fs * dur)) return 0;
+  std::error_code ec;
+  const auto bytes = std::filesystem::file_size(path, ec);
+  if (ec) return 0;
+  return static_cast<std::size_t>(std::min(fs * dur + 1.0, static_cast<double>(bytes / 40)));
+}
+
 }  // namespace
 
 Eigen::Vector3d Replay::dw_radps2(int s, std::size_t k) const {
@@ -495,6 +526,7 @@ Replay replay_log(const std::filesystem::path& path, const ReplayOptions& opt) {
   ro.fields = kFieldAccel | kFieldTemp | kFieldRefQ | kFieldRefP;  // the truth columns are never read here
   log::LogReader reader(path, ro);
   Raw raw(reader.fields());
+  raw.reserve(expected_rows(reader.metadata(), path));
   Sample s;
   while (reader.next(s)) raw.push(s);
   raw.shrink();

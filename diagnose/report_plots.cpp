@@ -9,6 +9,7 @@
 
 #include <fmt/core.h>
 
+#include "diagnose/parallel.hpp"
 #include "diagnose/report_plots.hpp"
 #include "diagnose/report_text.hpp"
 #include "estimator/output_file.hpp"
@@ -179,7 +180,15 @@ Plot regimes_plot(const CompareResult& r, const std::filesystem::path& dir) {
 
 std::vector<Plot> draw_plots(const CompareResult& r, const std::filesystem::path& plot_dir) {
   std::filesystem::create_directories(plot_dir);
-  return {residual_plot(r, plot_dir), windows_plot(r, plot_dir), allan_plot(r, plot_dir), regimes_plot(r, plot_dir)};
+  // each figure is its own data file, script and gnuplot process: they are drawn side by side
+  // on the machine's cores (0.1 s of gnuplot each), in this order in the report
+  using Draw = Plot (*)(const CompareResult&, const std::filesystem::path&);
+  static constexpr std::array<Draw, 4> kDraw = {residual_plot, windows_plot, allan_plot, regimes_plot};
+  std::vector<Plot> plots(kDraw.size());
+  for_each_index(static_cast<int>(kDraw.size()), [&](int i) {
+    plots[static_cast<std::size_t>(i)] = kDraw[static_cast<std::size_t>(i)](r, plot_dir);
+  });
+  return plots;
 }
 
 }  // namespace driftless::diagnose

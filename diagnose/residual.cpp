@@ -129,16 +129,4 @@ Residual make_residual(const Replay& r, const CompareModel& model, double block_
   return res;
 }
 
-std::vector<double> Residual::e_series(int c) const {
-  std::vector<double> e(n);
-  for (std::size_t k = 0; k < n; ++k) e[k] = e_dps(c, k);
-  return e;
-}
-
-std::vector<double> block_series_of(const Residual& res, const std::vector<double>& x) {
-  std::vector<double> out(res.blocks);
-  block_means(x, res.bmask, res.block_len, out);
-  return out;
-}
-
 }  // namespace driftless::diagnose

@@ -3,7 +3,9 @@
 // docs/compare.md sections 1-2.
 #pragma once
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -37,8 +39,6 @@ struct Residual {
   double temp_c(int s, std::size_t k) const {
     return pred[s].temp_c.empty() ? replay->temp_c[s][k] : pred[s].temp_c[k];
   }
-  /// The whole series of channel c (e_dps(c, k) for every k), deg/s.
-  std::vector<double> e_series(int c) const;
   const Replay* replay = nullptr;             // the replay the residual was made from
   std::vector<std::uint8_t> mask;   // sample enters the fits (usable, at rest, rebuilt, no burst)
   std::vector<std::uint8_t> bmask;  // ... and its block has enough data
@@ -56,7 +56,22 @@ struct Residual {
 /// Throws std::runtime_error when fewer than 50 samples remain.
 Residual make_residual(const Replay& r, const CompareModel& model, double block_s);
 
-/// Block means of a per-sample series over the residual's blocks (masked samples only).
-std::vector<double> block_series_of(const Residual& res, const std::vector<double>& x);
+/// Block means of x(k) over the samples the fits use (bmask; NaN skipped) into `out`: the same
+/// sums in the same order as block_means() of the series, without a per-sample copy of it.
+template <class X>
+void block_means_of(const Residual& res, X&& x, std::vector<double>& out) {
+  out.resize(res.blocks);
+  for (std::size_t b = 0; b < res.blocks; ++b) {
+    double acc = 0.0;
+    int cnt = 0;
+    const std::size_t a = b * res.block_len, e = std::min(res.n, a + res.block_len);
+    for (std::size_t k = a; k < e; ++k) {
+      if (!res.bmask[k]) continue;
+      const double v = x(k);
+      if (std::isfinite(v)) acc += v, ++cnt;
+    }
+    out[b] = cnt > 0 ? acc / cnt : 0.0;
+  }
+}
 
 }  // namespace driftless::diagnose

@@ -278,12 +278,16 @@ Eval Selector::evaluate(const ParamRef& x, const Terms& S, double base) const {
   return e;
 }
 
+// the candidates are independent given the selection (each fit reads the channels only): they
+// are evaluated on the machine's cores, each into its own slot (the same result on any count)
 std::vector<Eval> Selector::evaluate_all(const Terms& S, double base) const {
-  std::vector<Eval> out;
-  for (const ParamRef& x : universe_) {
-    if (contains(S, x)) continue;
-    out.push_back(evaluate(x, S, base));
-  }
+  std::vector<ParamRef> todo;
+  for (const ParamRef& x : universe_)
+    if (!contains(S, x)) todo.push_back(x);
+  std::vector<Eval> out(todo.size());
+  for_each_index(static_cast<int>(todo.size()), [&](int i) {
+    out[static_cast<std::size_t>(i)] = evaluate(todo[static_cast<std::size_t>(i)], S, base);
+  });
   return out;
 }
 

@@ -8,6 +8,7 @@
 
 #include <fmt/core.h>
 
+#include "diagnose/parallel.hpp"
 #include "estimator/sample.hpp"
 #include "estimator/stats.hpp"
 
@@ -132,20 +133,21 @@ AfterFit residual_after(const Channels& ch, const ColumnInputs& in, const Residu
   AfterFit a;
   a.block_len = res.block_len;
   const bool keep = detail == AfterDetail::kSamples;
-  for (int c = 0; c < 6; ++c) {
+  // the channels are independent: on the machine's cores, each into its own slots
+  for_each_index(6, [&](int c) {
     const ChannelData& C = ch[c];
     if (!C.present) {  // sensor 2 of a single-sensor log: NaN throughout
       a.z[c].assign(res.blocks, kNaN);
       a.bias[c].assign(res.blocks, kNaN);
       if (keep) a.e_drift[c].assign(res.n, std::numeric_limits<float>::quiet_NaN());
-      continue;
+      return;
     }
     const Eigen::VectorXd coef = channel_coefficients(C, c, spec, fit);
     a.z[c] = block_residual(C, coef);
     a.bias[c] = BiasWhitener(res.block_series, C.noise).smooth(a.z[c]);
     for (std::size_t b = 0; b < res.blocks; ++b)
       if (!res.block_series.count[b]) a.z[c][b] = kNaN;
-    if (detail == AfterDetail::kBlocks) continue;
+    if (detail == AfterDetail::kBlocks) return;
     if (keep) a.e_drift[c].resize(res.n);
     RunningMeanRms stats;
     for (std::size_t k = 0; k < res.n; ++k) {
@@ -158,7 +160,7 @@ AfterFit residual_after(const Channels& ch, const ColumnInputs& in, const Residu
       if (keep) a.e_drift[c][k] = static_cast<float>(v);
     }
     std::tie(a.mean_dps[c], a.rms_dps[c]) = stats.mean_rms();
-  }
+  });
   return a;
 }
 

@@ -35,6 +35,7 @@ void StreamingOptions::validate() const {
 StreamingOctaveDeviation::StreamingOctaveDeviation(const StreamingOptions& opt)
     : opt_(opt), span_(span_in_m(opt.deviation)), exact_log2_(log2_exact(opt.exact_up_to_m)) {
   opt_.validate();
+  levels_.reserve(kMaxLevels);  // a level's scratch is read by the next one: no reallocation moves it
 }
 
 void StreamingOctaveDeviation::push(std::span<const double> rate) {
@@ -46,17 +47,24 @@ void StreamingOctaveDeviation::push(std::span<const double> rate) {
     offset_ = s / static_cast<double>(k);
     have_offset_ = true;
   }
-  scratch_.clear();
-  scratch_.reserve(rate.size() + 1);
-  if (seg_samples_ == 0) scratch_.push_back(0.0);  // S[0] of a new segment
+  // the phase written where it goes, the finiteness checked once per call (the sum's order is kept)
+  const std::size_t lead = seg_samples_ == 0 ? 1 : 0;  // S[0] of a new segment
+  scratch_.resize(rate.size() + lead);
+  double* out = scratch_.data() + lead;
+  if (lead == 1) scratch_[0] = 0.0;
+  bool finite = true;
+  double phase = phase_;
   for (std::size_t i = 0; i < rate.size(); ++i) {
-    if (!std::isfinite(rate[i])) {
-      throw std::invalid_argument("allan: sample " + std::to_string(samples_ + i) +
-                                  " is not a finite number (break the segment at gaps instead)");
-    }
-    phase_ += rate[i] - offset_;
-    scratch_.push_back(phase_);
+    finite &= std::isfinite(rate[i]);
+    phase += rate[i] - offset_;
+    out[i] = phase;
   }
+  if (!finite) {
+    const auto bad = std::find_if(rate.begin(), rate.end(), [](double v) { return !std::isfinite(v); });
+    throw std::invalid_argument("allan: sample " + std::to_string(samples_ + static_cast<std::size_t>(bad - rate.begin())) +
+                                " is not a finite number (break the segment at gaps instead)");
+  }
+  phase_ = phase;
   seg_samples_ += rate.size();
   samples_ += rate.size();
   append(0, scratch_.data(), scratch_.size());
@@ -71,9 +79,10 @@ void StreamingOctaveDeviation::append(std::size_t j, const double* v, std::size_
   L.count += n;
   for (std::size_t i = 0; i < n && L.id.size() < kMaxIdClusters + 1; ++i) L.id.push_back(v[i]);
   accumulate(j, old_end);
-  // the next level: every other value (global index even), i.e. the phase at stride 2^(j+1)
-  std::vector<double> half;
-  half.reserve(n / 2 + 1);
+  // the next level: every other value (global index even), i.e. the phase at stride 2^(j+1);
+  // the level's own scratch (kept: a fresh array each block is a fresh set of pages to fault in)
+  std::vector<double>& half = L.half;
+  half.clear();
   for (std::size_t g = old_end + (old_end % 2); g < L.count; g += 2) half.push_back(L.buf[g - L.base]);
   // keep what the longest difference still needs
   const std::size_t keep = span_ * opt_.exact_up_to_m;

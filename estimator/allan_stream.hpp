@@ -44,6 +44,7 @@ class StreamingOctaveDeviation {
     std::size_t count = 0;       // values produced in this segment
     std::vector<double> id;      // the first values of this segment (noise identification)
     std::vector<double> id_best; // the longest such run over the segments so far
+    std::vector<double> half;    // scratch: this block's values handed to the next level
   };
   void append(std::size_t j, const double* v, std::size_t n);
   void accumulate(std::size_t j, std::size_t old_end);

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <stdexcept>
+#include <utility>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Geometry>
@@ -287,14 +289,17 @@ void DriftlessFilter::predict_temperature(double temp1_c, double temp2_c) {
   P_.topLeftCorner<6, 6>() += D * Pkk * D;
 }
 
-Vector6d DriftlessFilter::bias_at(const Sample& s) const {
-  Vector6d b = x_.head<kStateDim>();
-  if (!has_temp_states()) return b;
-  const std::array<double, 2> temp{s.temp1_c, s.temp2_c};
-  for (std::size_t i = 0; i < 2; ++i) {
-    if (!finite(temp[i]) || !finite(temp_ref_c_[i])) continue;
-    const Eigen::Index o = 3 * static_cast<Eigen::Index>(i);
-    b.segment<3>(o) += (temp[i] - temp_ref_c_[i]) * x_.segment<3>(kTempCoef1.start + o);
+// the correction o_i = b_i + k_i (T_i - T_ref_i) + G_i f_i that state `x` (bias referred to
+// `temp_ref`) applies to sample s: the filter's own state, or a smoothed one (set_output_state)
+Vector6d DriftlessFilter::bias_at(const Sample& s, const StateVector& x, const std::array<double, 2>& temp_ref) const {
+  Vector6d b = x.head<kStateDim>();
+  if (has_temp_states()) {
+    const std::array<double, 2> temp{s.temp1_c, s.temp2_c};
+    for (std::size_t i = 0; i < 2; ++i) {
+      if (!finite(temp[i]) || !finite(temp_ref[i])) continue;
+      const Eigen::Index o = 3 * static_cast<Eigen::Index>(i);
+      b.segment<3>(o) += (temp[i] - temp_ref[i]) * x.segment<3>(kTempCoef1.start + o);
+    }
   }
   if (has_gsens_states()) {
     // self-calibration: the sample's own specific force, else the last update's
@@ -302,7 +307,8 @@ Vector6d DriftlessFilter::bias_at(const Sample& s) const {
     for (int i = 0; i < 2; ++i) {
       const std::size_t u = static_cast<std::size_t>(i);
       const Eigen::Vector3d f = acc[u]->allFinite() ? Eigen::Vector3d(*acc[u] / kStandardGravityMps2) : last_f_g_[u];
-      if (f.allFinite()) b.segment<3>(3 * i) += g_sensitivity_dps_per_g(i + 1) * f;
+      const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> G(x.data() + kGSens1.start + 9 * i);
+      if (f.allFinite()) b.segment<3>(3 * i) += G * f;
     }
   }
   return b;
@@ -384,6 +390,9 @@ bool DriftlessFilter::update(const Eigen::Matrix<double, D, 1>& r, const Eigen::
     return update<D>(r, H, R, rec);
   }
   consecutive_rejections_ = 0;
+  // an offline smoother keeps the state before the gain (the prediction) and after it
+  std::unique_ptr<std::pair<StateVector, StateMatrix>> prior;
+  if (observer_ != nullptr) prior = std::make_unique<std::pair<StateVector, StateMatrix>>(x_, P_);
   // W = (P + Q) H^T S^-1
   const Eigen::Matrix<double, kFullStateDim, D> W = llt.solve(PHt.transpose()).transpose();
   x_ += W * innov;
@@ -397,6 +406,7 @@ bool DriftlessFilter::update(const Eigen::Matrix<double, D, 1>& r, const Eigen::
   }
   P_ = (0.5 * (P_ + P_.transpose())).eval();  // eval: no aliasing with the transpose
   for (int i = 0; i < kStateDim; ++i) P_(i, i) = std::max(P_(i, i), cfg_.variance_floor_dps2);
+  if (observer_ != nullptr) observer_->on_accepted_update({t_filter_s_, temp_ref_c_, &prior->first, &prior->second, &x_, &P_});
   return true;
 }
 
@@ -563,13 +573,16 @@ bool DriftlessFilter::rest_row(const StandstillSegment& s, const Eigen::Matrix3d
 
 void DriftlessFilter::fuse_rate(const Sample& s, const StandstillStep& st) {
   // between updates the correction follows the sample's temperature (b + k dT)
-  const Vector6d b = bias_at(s);
+  // the filter's state, or the smoothed one of set_output_state()
+  const StateVector& x = output_x_ != nullptr ? *output_x_ : x_;
+  const Vector6d b = bias_at(s, x, output_x_ != nullptr ? *output_temp_ref_ : temp_ref_c_);
   out_.y1c_dps = s.gyro1_dps - b.segment<3>(kBias1.start);
   out_.y2c_dps = s.gyro2_dps - b.segment<3>(kBias2.start);
   if (has_scale_states()) {
     // w_i = (I + E_i)^-1 (y_i - o_i) = (I - E_i) (y_i - o_i) to first order in E
-    out_.y1c_dps -= scale_misalign(1) * out_.y1c_dps;
-    out_.y2c_dps -= scale_misalign(2) * out_.y2c_dps;
+    using RowMajor3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
+    out_.y1c_dps -= Eigen::Map<const RowMajor3>(x.data() + kScale1.start) * out_.y1c_dps;
+    out_.y2c_dps -= Eigen::Map<const RowMajor3>(x.data() + kScale2.start) * out_.y2c_dps;
   }
   out_.plat1_deg = st.plat1_deg;
   out_.plat2_deg = st.plat2_deg;

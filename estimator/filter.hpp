@@ -116,6 +116,24 @@ struct FilterCounters {
   std::uint64_t box_dwell_rejected = 0;
 };
 
+/// What an accepted update changed (for an offline smoother: estimator/smoother.hpp). The pointers
+/// are valid during the call only.
+struct UpdateSnapshot {
+  double t_s = kNaN;                             // s, the time x and P refer to
+  std::array<double, 2> temp_ref_c{kNaN, kNaN};  // degC, the temperatures the bias refers to
+  const StateVector* x_prior = nullptr;          // before the gain (predicted; a re-lock's widening in)
+  const StateMatrix* P_prior = nullptr;
+  const StateVector* x_post = nullptr;           // after it
+  const StateMatrix* P_post = nullptr;
+};
+
+/// Told of every accepted update (set_update_observer).
+class UpdateObserver {
+ public:
+  virtual ~UpdateObserver() = default;
+  virtual void on_accepted_update(const UpdateSnapshot& u) = 0;
+};
+
 /// The streaming DriftLess filter.
 class DriftlessFilter {
  public:
@@ -137,6 +155,15 @@ class DriftlessFilter {
   /// whose gyros were calibrated once and never again would use. Zero until set; the filter's
   /// own state is not touched.
   void set_fixed_bias_dps(const Vector6d& b) { fixed_bias_ = b; }
+  /// Every accepted update is handed to `o` (nullptr: none); for the offline smoother.
+  void set_update_observer(UpdateObserver* o) { observer_ = o; }
+  /// The corrected outputs of the following push() calls use state `x` (bias referred to
+  /// `temp_ref_c`) instead of the filter's own (nullptr: its own); both must outlive those calls.
+  /// The filter itself still updates as always (--smooth's second pass).
+  void set_output_state(const StateVector* x, const std::array<double, 2>* temp_ref_c) {
+    output_x_ = x;
+    output_temp_ref_ = temp_ref_c;
+  }
 
   /// Bias estimate [b1; b2], deg/s (b_i in sensor-i axes), at the temperatures of the last
   /// update (temperature_ref_c()).
@@ -201,7 +228,7 @@ class DriftlessFilter {
                 double var_dps2, Eigen::Matrix<double, 1, kFullStateDim>& h, double& z, double& var_z) const;
   void predict_to(double t_s);
   void predict_temperature(double temp1_c, double temp2_c);
-  Vector6d bias_at(const Sample& s) const;
+  Vector6d bias_at(const Sample& s, const StateVector& x, const std::array<double, 2>& temp_ref) const;
   template <int D>
   bool update(const Eigen::Matrix<double, D, 1>& r, const Eigen::Matrix<double, D, kFullStateDim>& H,
               const Eigen::Matrix<double, D, D>& R, UpdateRecord& rec, bool may_relock = true);
@@ -221,6 +248,9 @@ class DriftlessFilter {
   double q_rate_dps2_per_s_ = 0.0;
   // --calib terms without states of their own: fixed corrections (use_calibration_prior)
   bool fixed_g_ = false, fixed_e_ = false;
+  UpdateObserver* observer_ = nullptr;
+  const StateVector* output_x_ = nullptr;
+  const std::array<double, 2>* output_temp_ref_ = nullptr;
   std::array<Eigen::Matrix3d, 2> fixed_E_inv_{Eigen::Matrix3d::Identity(), Eigen::Matrix3d::Identity()};
 
   StateVector x_ = StateVector::Zero();

@@ -217,6 +217,7 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
                          const EstimateRunOptions& opt, bool (*should_stop)()) {
   EstimateSummary sum;
   DriftlessFilter filter(cfg, box_geometry_from_metadata(meta));
+  filter.set_update_observer(opt.update_observer);
   add_stream_warnings(meta, sum);
   const bool have_truth = (fields & kFieldTrueBias) != 0;
   sum.attitude_available = (fields & kFieldRefQ) != 0;

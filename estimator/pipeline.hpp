@@ -55,6 +55,7 @@ struct EstimateRunOptions {
   bool realign_at_eval_start = false;
   double nees_band_probability = 0.95;  // two-sided chi-square band for the NEES statistics
   HealthLimits health;                  // limits of the health verdict (docs/estimator.md section 6.1)
+  UpdateObserver* update_observer = nullptr;  // told of every accepted update (--smooth's smoother)
 };
 
 /// Statistics against the log's truth (filled when the log has true_bias columns).

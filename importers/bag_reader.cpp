@@ -46,7 +46,6 @@ class BagReader : public ImuReader {
   double rate_scale_ = kDegPerRad;
   bool receive_time_ = false;
   std::unique_ptr<BagScan> scan_;  // the direct path (bag_records.hpp), when it gives View's messages
-  std::vector<BagImu> msgs_;
 };
 
 std::string BagReader::choose_topic(const std::vector<BagConnection>& conns, const ImportOptions& opt) {
@@ -148,29 +147,40 @@ BagReader::BagReader(const std::filesystem::path& path, const ImportOptions& opt
   for (int k = 0; k < 3; ++k) info_.channels.push_back({std::string("linear_acceleration.") + "xyz"[k], Quantity::kAccel, k});
 }
 
+// the messages converted where the scan decoded them, into the block's arrays as they are (sized
+// once: no zero-filling of what is written next)
 bool BagReader::read_direct(ImuBlock& out, std::size_t max_rows) {
+  out.values.resize(6);
+  const std::size_t room = static_cast<std::size_t>(std::min<std::uint64_t>(max_rows, info_.rows_estimate - index_));
+  out.t_s.resize(room);
+  out.loc.resize(room);
+  for (auto& v : out.values) v.resize(room);
+  std::size_t n = 0;
   try {
-    scan_->next(msgs_, max_rows);
+    const BagImu* got = nullptr;
+    for (std::size_t k; n < room && (k = scan_->take(room - n, got)) > 0;) {
+      for (const BagImu* m = got; m != got + k; ++m) {
+        out.t_s[n] = seconds_since(receive_time_ ? m->receive_ns : m->stamp_ns, info_.epoch_s);
+        for (std::size_t j = 0; j < 3; ++j) {
+          out.values[j][n] = m->w[j] * rate_scale_;
+          out.values[3 + j][n] = m->a[j];
+        }
+        out.loc[n++] = ++index_;
+      }
+    }
   } catch (const std::runtime_error& e) {
     throw ImportError(where(index_ + 1) + ": cannot read (" + e.what() + ")");
   }
-  for (auto& v : out.values) v.reserve(msgs_.size());
-  for (const BagImu& m : msgs_) {
-    ++index_;
-    out.t_s.push_back(seconds_since(receive_time_ ? m.receive_ns : m.stamp_ns, info_.epoch_s));
-    for (int k = 0; k < 3; ++k) {
-      out.values[static_cast<std::size_t>(k)].push_back(m.w[k] * rate_scale_);
-      out.values[static_cast<std::size_t>(3 + k)].push_back(m.a[k]);
-    }
-    out.loc.push_back(index_);
-  }
-  return out.rows() > 0;
+  out.t_s.resize(n);
+  out.loc.resize(n);
+  for (auto& v : out.values) v.resize(n);
+  return n > 0;
 }
 
 bool BagReader::read(ImuBlock& out, std::size_t max_rows) {
+  if (scan_) return read_direct(out, max_rows);
   out.clear();
   out.values.resize(6);
-  if (scan_) return read_direct(out, max_rows);
   try {
     for (; it_ != view_->end() && out.rows() < max_rows; ++it_) {
       ++index_;

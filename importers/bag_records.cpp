@@ -237,8 +237,8 @@ void BagScan::load_group() {
     end_ns = std::max(end_ns, chunks_[next_chunk_].end_ns);
     load_chunk(chunks_[next_chunk_++]);
   }
-  std::stable_sort(pending_.begin(), pending_.end(),
-                   [](const BagImu& a, const BagImu& b) { return a.receive_ns < b.receive_ns; });
+  const auto by_time = [](const BagImu& a, const BagImu& b) { return a.receive_ns < b.receive_ns; };
+  if (!std::is_sorted(pending_.begin(), pending_.end(), by_time)) std::stable_sort(pending_.begin(), pending_.end(), by_time);
 }
 
 // one chunk's messages on our connection, appended in file order
@@ -288,20 +288,12 @@ const BagImu* BagScan::peek() {
   return &pending_[pending_pos_];
 }
 
-bool BagScan::next(std::vector<BagImu>& out, std::size_t max) {
-  out.clear();
-  while (out.size() < max) {
-    if (pending_pos_ == pending_.size()) {
-      if (next_chunk_ == chunks_.size()) break;
-      load_group();
-      continue;
-    }
-    const std::size_t n = std::min(max - out.size(), pending_.size() - pending_pos_);
-    out.insert(out.end(), pending_.begin() + static_cast<std::ptrdiff_t>(pending_pos_),
-               pending_.begin() + static_cast<std::ptrdiff_t>(pending_pos_ + n));
-    pending_pos_ += n;
-  }
-  return !out.empty();
+std::size_t BagScan::take(std::size_t max, const BagImu*& first) {
+  first = peek();
+  if (first == nullptr) return 0;
+  const std::size_t n = std::min(max, pending_.size() - pending_pos_);
+  pending_pos_ += n;
+  return n;
 }
 
 }  // namespace driftless::importers

@@ -49,9 +49,11 @@ class BagScan {
   static std::optional<std::vector<BagConnection>> connections(const std::filesystem::path& path, std::string& why);
   /// The next message without taking it (nullptr at the end).
   const BagImu* peek();
-  /// Up to max messages of the topic, in rosbag::View order (receive time, then file order).
-  /// Returns false at the end. Throws std::runtime_error naming the record on a damaged one.
-  bool next(std::vector<BagImu>& out, std::size_t max);
+  /// Up to max messages of the topic, in rosbag::View order (receive time, then file order),
+  /// where they were decoded (no copy): `first` points at them until the next call; returns how
+  /// many (0 at the end). Throws std::runtime_error naming the record on a damaged one. (No
+  /// std::span: the bag reader compiles as C++17.)
+  std::size_t take(std::size_t max, const BagImu*& first);
   /// Messages of the topic in the whole bag (from the chunk infos).
   std::uint64_t count() const { return count_; }
 

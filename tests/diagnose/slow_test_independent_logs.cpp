@@ -46,9 +46,12 @@ struct Plant {
   bool temperature = false;
 };
 
-// g-sensitivity needs the specific force along its column to vary: sensor 2's flips about x
-// swap gravity between its y and z axes; sensor 1's flips are about z (along gravity), so its
-// x and y columns vary only with the box's tilt (pan/tilt and sweep, not the small wobble)
+// g-sensitivity needs the specific force along its column to vary while the platforms rest:
+// sensor 2's flips about x swap gravity between its y and z axes; sensor 1 rests at +-90 deg
+// about z, so its x axis is the box's y axis, which only a roll tilts, and no motion of the
+// generator rolls (its pan/tilt and sweep pitch): a planted x column changes no sample the fits
+// use (seed 11 planted s1 x<-x and the log was rightly consistent). Its y axis is the box's x
+// axis, which the pitch tilts (pan/tilt and sweep, not the small wobble)
 Plant random_plant(std::mt19937& g, const std::string& motion) {
   auto uni = [&](int n) { return std::uniform_int_distribution<int>(0, n - 1)(g); };
   const int s = 1 + uni(2);
@@ -66,7 +69,7 @@ Plant random_plant(std::mt19937& g, const std::string& motion) {
     }
     case 2: {
       const int sg = motion == "wobble" ? 2 : s;
-      const int r = uni(3), c = sg == 2 ? 1 + uni(2) : uni(2);
+      const int r = uni(3), pick = uni(2), c = sg == 2 ? 1 + pick : 1;
       return {fmt::format("gsens:{}:{}:{}:{}", sg, ax[r], ax[c], 0.1 * sign), Effect::kGSensitivity,
               fmt::format("s{}.matrix_dps_per_g[{}][{}]", sg, ax[r], ax[c]), 0.1 * sign};
     }

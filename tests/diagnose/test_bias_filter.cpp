@@ -125,6 +125,40 @@ TEST(BiasWhitener, MatchesAnExplicitKalmanFilterAndSmoother) {
   EXPECT_NEAR(w.final_bias_sigma_dps(), std::sqrt(e.p_end(0, 0)), 1e-12);
 }
 
+TEST(BiasWhitener, WhitenedGramIsTheGramOfTheWhitenedColumns) {
+  // GIVEN three regressor columns and a residual on a layout with a gap and partial blocks
+  const BlockSeries b = layout(700);  // more blocks than one chunk of the one-pass sum
+  ChannelNoise noise;
+  noise.white_dps_rthz = 0.006;
+  noise.gm_sigma_dps = 0.05;
+  noise.gm_tau_s = 7.0;
+  noise.rrw_dps_rts = 0.02;
+  const std::size_t m = b.t_s.size();
+  Eigen::MatrixXf X(static_cast<Eigen::Index>(m), 3);
+  for (int i = 0; i < 3; ++i) {
+    const std::vector<double> x = series(m, 11 + static_cast<unsigned>(i));
+    for (std::size_t j = 0; j < m; ++j) X(static_cast<Eigen::Index>(j), i) = static_cast<float>(x[j]);
+  }
+  const std::vector<double> z = series(m, 5);
+  // WHEN the Gram is formed in one pass, in float and in double columns
+  const WhitenedGram g = BiasWhitener::whitened_gram(b, noise, X, z);
+  const WhitenedGram gd = BiasWhitener::whitened_gram(b, noise, Eigen::MatrixXd(X.cast<double>()), z);
+  // THEN it is A'A of the columns whitened one by one (to 1e-12 of its scale), over the used blocks
+  const BiasWhitener w(b, noise);
+  Eigen::MatrixXd A(static_cast<Eigen::Index>(m), 4);
+  std::vector<double> col(m), out(m);
+  for (int i = 0; i < 4; ++i) {
+    for (std::size_t j = 0; j < m; ++j) col[j] = i < 3 ? static_cast<double>(X(static_cast<Eigen::Index>(j), i)) : z[j];
+    w.whiten(col, out);
+    for (std::size_t j = 0; j < m; ++j) A(static_cast<Eigen::Index>(j), i) = out[j];
+  }
+  const Eigen::MatrixXd want = A.transpose() * A;
+  EXPECT_EQ(g.used, w.used_count());
+  ASSERT_EQ(g.gram.rows(), 4);
+  EXPECT_LT((g.gram - want).cwiseAbs().maxCoeff(), 1e-12 * want.cwiseAbs().maxCoeff());
+  EXPECT_LT((gd.gram - want).cwiseAbs().maxCoeff(), 1e-12 * want.cwiseAbs().maxCoeff());
+}
+
 TEST(BiasWhitener, ConstantBiasIsTheWeightedMean) {
   // GIVEN only a constant bias (no drift) with prior sigma0 in white noise
   const BlockSeries b = layout(120);
