@@ -150,7 +150,6 @@ int run_hil(const HilOptions& o) {
   if (second) loop.set_motors(second->source, second->motors, second->schedule);
   // the terminal view: bias estimates as they converge
   double next_print = 0.0;
-  double last_flush = wall.now_s();
   std::uint64_t updates_seen = 0;
   fmt::print("driftless hil: {} -> {}{}\n", first->source->name(), log_path.string(),
              second ? fmt::format(" (switch to {} at t={} s)", second->source->name(), o.at_s) : "");
@@ -164,11 +163,6 @@ int run_hil(const HilOptions& o) {
                  filter.counters().updates, src.name());
       std::fflush(stdout);
       next_print = std::floor(s.t_s / o.print_every_s + 1.0) * o.print_every_s;
-    }
-    // rows reach the disk at least twice a second
-    if (wall.now_s() - last_flush > 0.5) {
-      writer.flush();
-      last_flush = wall.now_s();
     }
   });
   loop.on_event([&](double t, const std::string& text) { fmt::print("{:>10.2f}  event: {}\n", t, text); });

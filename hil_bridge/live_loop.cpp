@@ -11,6 +11,7 @@ void LiveParams::validate() const {
   if (!std::isnan(switch_at_s) && !(switch_at_s > 0.0)) throw std::invalid_argument("hil: --at must be > 0 s");
   if (!(reconnect_interval_s > 0.0)) throw std::invalid_argument("hil: reconnect_interval_s must be > 0 s");
   if (!(give_up_after_s > 0.0)) throw std::invalid_argument("hil: give_up_after_s must be > 0 s");
+  if (!(log_flush_every_s > 0.0)) throw std::invalid_argument("hil: log_flush_every_s must be > 0 s");
 }
 
 LiveLoop::LiveLoop(LiveParams p, Clock& clock, log::LogWriter* log, est::DriftlessFilter* filter)
@@ -20,7 +21,7 @@ LiveLoop::LiveLoop(LiveParams p, Clock& clock, log::LogWriter* log, est::Driftle
 
 void LiveLoop::event(const std::string& text) {
   ++stats_.events;
-  if (log_) log_->event(t_last_, text);
+  if (pump_) pump_->event(t_last_, text);
   if (on_event_) on_event_(t_last_, text);
 }
 
@@ -81,6 +82,20 @@ void LiveLoop::select_motors(const SampleSource* src) {
 }
 
 LiveStats LiveLoop::run(SampleSource& first, SampleSource* second, const std::atomic<bool>& stop) {
+  if (!log_) return run_loop(first, second, stop);
+  LogPump pump(*log_, p_.log_flush_every_s);
+  pump_ = &pump;
+  struct Unset {
+    LogPump*& p;
+    ~Unset() { p = nullptr; }
+  } unset{pump_};
+  LiveStats st = run_loop(first, second, stop);
+  pump.close();  // every row in the writer (or its error, e.g. a full disk, thrown here)
+  st.log_waits = pump.waits();
+  return st;
+}
+
+LiveStats LiveLoop::run_loop(SampleSource& first, SampleSource* second, const std::atomic<bool>& stop) {
   stats_ = LiveStats();
   t_last_ = kNaN;
   SampleSource* src = &first;
@@ -174,7 +189,7 @@ LiveStats LiveLoop::run(SampleSource& first, SampleSource* second, const std::at
         s.plat2_deg = known_angle_deg(motors_->end_stop(2));
       }
     }
-    if (log_) log_->write(s);
+    if (pump_) pump_->write(s);
     const est::PushStatus pushed = filter_ ? filter_->push(s) : est::PushStatus::kInvalid;
     t_last_ = s.t_s;
     if (fdi_ && filter_) {

@@ -16,6 +16,7 @@
 #include "estimator/log.hpp"
 #include "hil_bridge/clock.hpp"
 #include "hil_bridge/fdi_watch.hpp"
+#include "hil_bridge/log_pump.hpp"
 #include "hil_bridge/motors.hpp"
 #include "hil_bridge/source.hpp"
 
@@ -26,6 +27,7 @@ struct LiveParams {
   double switch_at_s = kNaN;         // session time of the switch-over, s (NaN: none)
   double reconnect_interval_s = 0.2; // between reconnect attempts, s (on the loop's clock)
   double give_up_after_s = 30.0;     // a device gone this long ends the run, s
+  double log_flush_every_s = 0.5;    // the log's rows reach the OS at least this often, s of wall time
   void validate() const;
 };
 
@@ -39,6 +41,7 @@ struct LiveStats {
   std::uint64_t lost_samples = 0;    // reported lost by the sources
   std::uint64_t gaps = 0;            // jumps in time of more than 1.5 periods
   std::uint64_t reconnects = 0;
+  std::uint64_t log_waits = 0;       // times the loop waited for the log's thread (ring full)
   bool switched = false;
   double t_first_s = kNaN, t_last_s = kNaN;  // session time of first and last row, s
   double t_switch_s = kNaN;                  // session time of the first row of the second source
@@ -48,7 +51,9 @@ struct LiveStats {
 
 class LiveLoop {
  public:
-  /// `log`, `filter` and `motors` may be null. They and `clock` must outlive the loop.
+  /// `log`, `filter` and `motors` may be null. They and `clock` must outlive the loop. During
+  /// run() the log is written on a thread of the loop's own (LogPump): nobody else may touch it
+  /// until run() returns.
   LiveLoop(LiveParams p, Clock& clock, log::LogWriter* log, est::DriftlessFilter* filter);
 
   /// While `source` streams, drives `motors` through `schedule` (may be null) on session time and
@@ -66,9 +71,11 @@ class LiveLoop {
   void on_event(std::function<void(double, const std::string&)> f) { on_event_ = std::move(f); }
 
   /// Runs: the sources must be configured; `first` is activated here, `second` at the switch.
+  /// Every row and event is in the log when it returns (or throws).
   LiveStats run(SampleSource& first, SampleSource* second, const std::atomic<bool>& stop);
 
  private:
+  LiveStats run_loop(SampleSource& first, SampleSource* second, const std::atomic<bool>& stop);
   void event(const std::string& text);
   void drain(SampleSource& src);
   bool reconnect(SampleSource& src, const std::atomic<bool>& stop);
@@ -76,6 +83,7 @@ class LiveLoop {
   LiveParams p_;
   Clock& clock_;
   log::LogWriter* log_;
+  LogPump* pump_ = nullptr;  // the log's thread while run() runs
   est::DriftlessFilter* filter_;
   FdiWatch* fdi_ = nullptr;
   struct MotorRig {

@@ -34,7 +34,7 @@ a=$(jq -r '.channels["gyro1_x"].N.value' "$t/allan/allan_fit.json"); b=$(jq -r '
 awk -v a="$a" -v b="$b" 'BEGIN { d = (a - b) / b; if (d < 0) d = -d; exit !(d < 1e-6) }' || fail "N: converted $a, original $b"
 # estimate needs two triads: refused, naming the file
 out=$("$bin" estimate --log "$t/static.csv" --out "$t/est" 2>&1) && fail "estimate accepted a single-sensor log"
-echo "$out" | grep -q "static.csv" || fail "estimate's refusal does not name the file: $out"
+grep -q "static.csv" <<< "$out" || fail "estimate's refusal does not name the file: $out"
 
 # 2. raw counts, no time column, 'Fs,100' line: t = k / 100 Hz, counts at 131 LSB per deg/s
 "$bin" convert --in "$raw" --out "$t/raw.csv" > "$t/raw.txt" || { cat "$t/raw.txt"; fail "convert of raw counts"; }
@@ -83,13 +83,13 @@ awk -F, '/^t,/ { for (i = 1; i <= NF; ++i) c[$i] = i; next }
 # a ground truth that does not overlap the IMU rows is refused, naming both spans
 awk 'NR <= 3 { sub(/^140363/, "140360"); print }' "$t/gt.csv" > "$t/gt_far.csv"
 out=$("$bin" convert --in "$t/data.csv" --ref "$t/gt_far.csv" --out "$t/far.csv" 2>&1) && fail "a ground truth far away was joined"
-echo "$out" | grep -q "gt_far.csv.*do not overlap" || fail "message for a ground truth that does not overlap: $out"
+grep -q "gt_far.csv.*do not overlap" <<< "$out" || fail "message for a ground truth that does not overlap: $out"
 
 # 4. refusals: a stamp that steps back with --time stamps; two triads without --columns
 printf 't,gx,gy,gz\n0.00,1,2,3\n0.01,1,2,3\n0.005,1,2,3\n0.02,1,2,3\n' > "$t/back.csv"
 out=$("$bin" convert --in "$t/back.csv" --time stamps --out "$t/back.log" 2>&1) && fail "stamps stepping back accepted"
-echo "$out" | grep -q "back.csv.*--time uniform" || fail "message for stamps stepping back: $out"
+grep -q "back.csv.*--time uniform" <<< "$out" || fail "message for stamps stepping back: $out"
 printf 't,g1x,g1y,g1z,g2x,g2y,g2z\n0.00,1,2,3,4,5,6\n0.01,1,2,3,4,5,6\n' > "$t/two.csv"
 out=$("$bin" convert --in "$t/two.csv" --out "$t/two.log" 2>&1) && fail "two triads accepted without --columns"
-echo "$out" | grep -q "two.csv.*--columns" || fail "message for two triads: $out"
+grep -q "two.csv.*--columns" <<< "$out" || fail "message for two triads: $out"
 echo "convert: ok"

@@ -78,8 +78,8 @@ look_page() {  # html-file label
   local result
   result=$(browse --dump-dom "file://$probe" | sed -n '/id="look-result"/,/<\/pre>/p')
   [ -n "$result" ] || fail "$2: Chromium did not load the page (no probe result)"
-  echo "$result" | grep -q "overflow 0:" || fail "$2: elements overflow the page: $result"
-  echo "$result" | grep -q "broken 0:" || fail "$2: images do not load: $result"
+  grep -q "overflow 0:" <<< "$result" || fail "$2: elements overflow the page: $result"
+  grep -q "broken 0:" <<< "$result" || fail "$2: images do not load: $result"
   browse --screenshot="$work/shot.png" "file://$1" >/dev/null
   local nb
   nb=$(not_background "$work/shot.png")

@@ -53,11 +53,11 @@ XML
   --width 160 --height 120 --fps 10 --camera cam_fixed > "$work/out.txt"
 probe=$(ffprobe -v error -count_frames -select_streams v:0 \
   -show_entries stream=codec_name,nb_read_frames,width,height,r_frame_rate -of default=nw=1 "$work/v.mp4")
-echo "$probe" | grep -qx "codec_name=h264" || fail "not H.264: $probe"
-echo "$probe" | grep -qx "nb_read_frames=20" || fail "frame count: $probe"
-echo "$probe" | grep -qx "width=160" || fail "width: $probe"
-echo "$probe" | grep -qx "height=120" || fail "height: $probe"
-echo "$probe" | grep -qx "r_frame_rate=10/1" || fail "fps: $probe"
+grep -qx "codec_name=h264" <<< "$probe" || fail "not H.264: $probe"
+grep -qx "nb_read_frames=20" <<< "$probe" || fail "frame count: $probe"
+grep -qx "width=160" <<< "$probe" || fail "width: $probe"
+grep -qx "height=120" <<< "$probe" || fail "height: $probe"
+grep -qx "r_frame_rate=10/1" <<< "$probe" || fail "fps: $probe"
 
 # 2. no ffmpeg: numbered PNG frames and a message that says so
 DRIFTLESS_FFMPEG=/nonexistent/ffmpeg "$bin" render --log "$work/run.csv" --model "$work/box.xml" \

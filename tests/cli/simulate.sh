@@ -23,7 +23,7 @@ cmp -s "$tmp/a/log.csv" "$tmp/c/log.csv" || fail "same seed, different bytes"
 expect_error() {  # name, pattern, yaml
   printf '%s' "$3" > "$tmp/$1.yaml"
   out=$("$bin" simulate --scenario "$tmp/$1.yaml" --out "$tmp/x" 2>&1) && fail "$1: exit code 0"
-  echo "$out" | grep -q -- "$2" || fail "$1: message '$out' lacks '$2'"
+  grep -q -- "$2" <<< "$out" || fail "$1: message '$out' lacks '$2'"
 }
 expect_error unknown_key "unknown_key.yaml:3: flip_schedule.standstil_s: unknown key" $'duration_s: 5\nflip_schedule:\n  standstil_s: 4\n'
 expect_error units2 "units2.yaml:3: motion.max_rate_deg: inconsistent units" $'motion:\n  type: pan_tilt\n  max_rate_deg: 50\n'
@@ -32,10 +32,10 @@ expect_error broken "broken.yaml:.*broken YAML" $'duration_s: 5\nmotion: [static
 expect_error badtype "badtype.yaml:2: motion.type: expected one of static, pan_tilt" $'motion:\n  type: rocket\n'
 # a duration no disk holds: refused before anything is written
 out=$("$bin" simulate --out "$tmp/long" --duration 1e12 2>&1) && fail "duration 1e12: exit 0"
-echo "$out" | grep -q "duration_s = .* must be in (0, 1e7\] s" || fail "duration 1e12: message '$out'"
+grep -q "duration_s = .* must be in (0, 1e7\] s" <<< "$out" || fail "duration 1e12: message '$out'"
 [ ! -e "$tmp/long/log.csv" ] || fail "duration 1e12: a log was started"
 out=$("$bin" simulate --scenario "$tmp/missing.yaml" --out "$tmp/x" 2>&1) && fail "missing file: exit 0"
-echo "$out" | grep -q "missing.yaml" || fail "missing file: '$out'"
+grep -q "missing.yaml" <<< "$out" || fail "missing file: '$out'"
 
 # Ctrl-C: a valid log marked complete: false
 "$bin" simulate --scenario vehicle --out "$tmp/int" --duration 36000 >/dev/null 2>&1 &

@@ -7,7 +7,7 @@ bin=$1; src=$2
 t=$(mktemp -d); trap 'rm -rf "$t"' EXIT
 fail() { echo "FAIL: $*"; exit 1; }
 command -v mpirun > /dev/null || { echo "mpirun not found: MPI sweep test skipped"; exit 0; }
-"$bin" sweep --help | grep -q -- "--config" || fail "no sweep command"
+grep -q -- "--config" <<< "$("$bin" sweep --help)" || fail "no sweep command"
 # Open MPI's runtime (libmpi and the MCA plugins it dlopen()s and unloads) leaves allocations at
 # exit that LeakSanitizer cannot attribute; under a sanitizer build leak checks stay on for the
 # single-process sweep above, which runs the same sweep code, and are off for the mpirun ranks.
