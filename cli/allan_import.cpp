@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <exception>
 #include <functional>
+#include <optional>
 #include <thread>
 
 #include <fmt/core.h>
@@ -164,9 +165,11 @@ void both(F&& side, G&& here) {
 // one channel's accumulators (one per deviation), fed the finite runs between breaks
 struct ChannelSink {
   std::vector<est::StreamingOctaveDeviation> acc;
+  std::optional<BlockMeans> seconds;  // the motion check's 1 s means (watched channels)
   bool pending_break = false;
   std::size_t nan = 0;
   void feed(const std::vector<double>& v, const std::vector<std::size_t>& gaps, bool ignore) {
+    if (seconds) seconds->push(v);
     std::size_t begin = 0, g = 0;
     auto flush = [&](std::size_t end) {
       if (end > begin) {
@@ -192,6 +195,22 @@ struct ChannelSink {
     flush(v.size());
   }
 };
+
+// the rate the first block shows, for the 1 s blocks of the motion check while the stream is read:
+// --rate, the file's own, else its stamps' mean rate (right for regular, jittering and bursty stamps)
+double first_block_rate(const InputArgs& a, const importers::ImuReader& r, const importers::ImuBlock& b) {
+  if (a.rate_hz > 0.0) return a.rate_hz;
+  if (r.info().nominal_rate_hz > 0.0) return r.info().nominal_rate_hz;
+  if (b.t_s.size() < 2 || !(b.t_s.back() > b.t_s.front())) return 0.0;
+  return static_cast<double>(b.t_s.size() - 1) / (b.t_s.back() - b.t_s.front());
+}
+
+void watch_for_motion(std::vector<ChannelSink>& sinks, const Loaded& meta, double rate_hz) {
+  if (!(rate_hz > 0.0)) return;
+  for (std::size_t c = 0; c < sinks.size(); ++c) {
+    if (watched_for_motion(meta.channels[c].name, meta.channels[c].quantity)) sinks[c].seconds.emplace(rate_hz);
+  }
+}
 
 }  // namespace
 
@@ -224,6 +243,8 @@ Streamed stream_octaves(const InputArgs& a, const std::vector<est::Deviation>& d
     st.gaps = st.full ? gap_rows(st.block, mon, reader->info().has_time, a.gaps_ignore) : std::vector<std::size_t>{};
   };
   read_into(cur);
+  const double watch_rate_hz = first_block_rate(a, *reader, cur.block);
+  watch_for_motion(sinks, out.meta, watch_rate_hz);
   while (cur.full) {
     // the channels split between this thread and one more
     auto work = [&](std::size_t from, std::size_t step) {
@@ -242,6 +263,14 @@ Streamed stream_octaves(const InputArgs& a, const std::vector<est::Deviation>& d
     for (const auto& acc : s.acc) cs.push_back(acc.finish(out.meta.rate_hz));
     out.curves.push_back(std::move(cs));
   }
+  std::vector<std::string> names;
+  std::vector<BlockMeans> means;
+  for (std::size_t c = 0; c < sinks.size(); ++c) {
+    if (!sinks[c].seconds) continue;
+    names.push_back(out.meta.channels[c].name);
+    means.push_back(*sinks[c].seconds);
+  }
+  if (!means.empty()) out.warnings = motion_warnings(names, means, watch_rate_hz);
   return out;
 }
 

@@ -32,6 +32,16 @@ std::vector<std::string> split_list(const std::string& s) {
   return out;
 }
 
+namespace {
+// a mean regular step this far from the median step is jitter, not rounding
+constexpr double kJitterRateTolerance = 1e-3;
+
+// a rate measured from stamps, to 10 significant digits: the stamps' own resolution is coarser, and
+// the digits beyond are the round-off of differences of large times (EuRoC's exact 5 ms steps gave
+// 200.0000000001819 Hz)
+double stamp_rate(double hz) { return std::stod(fmt::format("{:.10g}", hz)); }
+}  // namespace
+
 double resolve_rate(double given, double nominal, const importers::StampReport& st, std::vector<std::string>& notes,
                     const std::string& source) {
   if (given > 0.0) {
@@ -44,11 +54,19 @@ double resolve_rate(double given, double nominal, const importers::StampReport& 
   }
   if (st.rows >= 2 && st.bursty && std::isfinite(st.mean_rate_hz())) {
     notes.push_back(fmt::format("rate {:.6g} Hz = (samples - 1) / time span (bursty stamps)", st.mean_rate_hz()));
-    return st.mean_rate_hz();
+    return stamp_rate(st.mean_rate_hz());
   }
   if (st.rows >= 2 && st.step_s > 0.0) {
-    notes.push_back(fmt::format("rate {:.6g} Hz from the median stamp step", 1.0 / st.step_s));
-    return 1.0 / st.step_s;
+    // jittering stamps (a loop timed in whole ms): the mean of the regular steps is the sampling rate,
+    // the median only the most common step
+    const double mean = st.regular_rate_hz(), median = 1.0 / st.step_s;
+    if (std::isfinite(mean) && std::fabs(mean / median - 1.0) > kJitterRateTolerance) {
+      notes.push_back(fmt::format("rate {:.6g} Hz from the mean regular stamp step (the stamps jitter: the median step "
+                                  "{:.4g} ms would mean {:.6g} Hz)", mean, 1e3 * st.step_s, median));
+      return stamp_rate(mean);
+    }
+    notes.push_back(fmt::format("rate {:.6g} Hz from the median stamp step", median));
+    return stamp_rate(median);
   }
   throw std::invalid_argument(source + ": no timestamps and no rate in the file: give --rate HZ");
 }

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cmath>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -56,10 +57,29 @@ struct Loaded {
 /// Reads every channel into memory.
 Loaded load(const InputArgs& a);
 
+/// Means of consecutive blocks of about 1 s (round(rate) samples) of one channel, fed in pieces.
+struct BlockMeans {
+  explicit BlockMeans(double rate_hz);
+  void push(std::span<const double> x);
+  std::size_t per = 0;  // samples a block (0: no rate, nothing kept)
+  std::vector<double> means;
+  double sum = 0.0;
+  std::size_t seen = 0, finite = 0;
+};
+/// True for the channels the motion check watches: raw rate channels (not accelerometers, not corrected).
+bool watched_for_motion(const std::string& name, importers::Quantity q);
+/// Warnings when the record is not at rest (a rate channel's 1 s means move by more than a gyro's bias
+/// drift): its Allan deviation measures the motion. docs/allan.md.
+std::vector<std::string> motion_warnings(const std::vector<std::string>& names, const std::vector<BlockMeans>& per_channel,
+                                         double rate_hz);
+/// The same for channels read into memory.
+std::vector<std::string> motion_warnings(const Loaded& in);
+
 /// The octave curves of a streamed input: curves[c][d] for channel c and deviation d.
 struct Streamed {
   Loaded meta;                            // channels without samples, rate, notes, stamps
   std::vector<std::vector<est::AllanCurve>> curves;
+  std::vector<std::string> warnings;      // the record is not at rest (motion_warnings)
 };
 
 /// Streams an imported input through octave accumulators (Allan and/or Hadamard) at bounded

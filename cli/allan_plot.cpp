@@ -4,6 +4,8 @@
 // and the round-trip band when --validate ran (docs/allan.md, plots).
 #include <algorithm>
 #include <cmath>
+#include <string>
+#include <vector>
 
 #include <fmt/core.h>
 
@@ -96,8 +98,12 @@ std::string channel_body(const ChannelResult& c, const std::string& stem, const 
       "  set title '{}: Allan deviation with {:g} % intervals, fitted terms (bold: where each is at least half of the model)'\n",
       unit, lo / 4.0, hi * 3.0, c.name, 100.0 * c.fit_curve.confidence);
   if (std::isfinite(c.fit.B_min.value)) {
-    b += fmt::format("  set label 1 at {:.6e},{:.6e} point pt 6 ps 2 lc rgb '#2ca02c' offset 1,-1.5 '{} {:.3g} at {:.3g} s'\n",
-                     c.fit.B_min.tau_s, c.fit.B_min.value, c.fit.B_min.valid ? "B_min (datasheet)" : "B_min upper bound",
+    // the text runs away from the nearer end of the measured taus, so it stays inside the frame
+    const double mid_tau = std::sqrt(c.fit_curve.points.front().tau_s * c.fit_curve.points.back().tau_s);
+    const bool text_left = c.fit.B_min.tau_s > mid_tau;
+    b += fmt::format("  set label 1 at {:.6e},{:.6e} {} point pt 6 ps 2 lc rgb '#2ca02c' offset {},-1.5 '{} {:.3g} at {:.3g} s'\n",
+                     c.fit.B_min.tau_s, c.fit.B_min.value, text_left ? "right" : "left", text_left ? -1 : 1,
+                     c.fit.B_min.valid ? "B_min (datasheet)" : "B_min upper bound",
                      c.fit.B_min.valid ? c.fit.B_min.value : c.fit.B_min.upper_95, c.fit.B_min.tau_s);
   }
   b += "  plot ";
@@ -120,13 +126,27 @@ std::string channel_body(const ChannelResult& c, const std::string& stem, const 
   return b + "\n";
 }
 
+// the units of the overview's y axis: every channel is in its quantity's unit (deg/s, m/s^2), not
+// the file's; a record with both names both
+std::string units_in(const Result& r) {
+  std::vector<std::string> seen;
+  std::string u;
+  for (const auto& c : r.channels) {
+    const std::string one = importers::unit_of(c.quantity);
+    if (std::find(seen.begin(), seen.end(), one) != seen.end()) continue;
+    u += (seen.empty() ? "" : ", ") + one;
+    seen.push_back(one);
+  }
+  return u;
+}
+
 }  // namespace
 
 std::vector<std::string> write_plots(const std::filesystem::path& dir, const Result& r) {
   std::vector<std::string> warnings;
   // the overview: every channel's first deviation with its intervals
-  std::string body = fmt::format("  set logscale xy; set xlabel 'tau [s]'; set ylabel '{} [input units]'\n  set title '{}'\n  plot ",
-                                 est::to_string(r.deviations[0]), r.source);
+  std::string body = fmt::format("  set logscale xy; set xlabel 'tau [s]'; set ylabel '{} [{}]'\n  set title '{}'\n  plot ",
+                                 est::to_string(r.deviations[0]), units_in(r), r.source);
   const std::string table = r.deviations[0] == est::Deviation::kAllan ? "allan.csv" : std::string(est::to_string(r.deviations[0])) + ".csv";
   for (std::size_t c = 0; c < r.channels.size(); ++c) {
     body += fmt::format("'{}' using 1:{}:{}:{} with yerrorlines title '{}'{}", table, 2 + 3 * c, 3 + 3 * c, 4 + 3 * c,

@@ -133,9 +133,9 @@ void write_fit_json(const std::filesystem::path& dir, const Result& r) {
   std::string s = fmt::format(
       "{{\n  \"source\": {},\n  \"format\": {},\n  \"sample_rate_hz\": {},\n  \"samples\": {},\n  \"deviations\": {},\n"
       "  \"stamps\": {{\"rows\": {}, \"step_s\": {}, \"bursty\": {}, \"gaps\": {}, \"missing\": {}, \"largest_step_s\": {}, "
-      "\"backwards\": {}, \"repeated\": {}}},\n  \"notes\": {},\n  \"channels\": {{\n",
+      "\"backwards\": {}, \"repeated\": {}}},\n  \"notes\": {},\n  \"warnings\": {},\n  \"channels\": {{\n",
       str(r.source), str(r.format), num(r.rate_hz), r.samples, str_list(devs), st.rows, num(st.step_s), st.bursty ? "true" : "false",
-      st.gaps, st.missing, num(st.largest_step_s), st.backwards, st.repeated, str_list(r.notes));
+      st.gaps, st.missing, num(st.largest_step_s), st.backwards, st.repeated, str_list(r.notes), str_list(r.warnings));
   for (std::size_t c = 0; c < r.channels.size(); ++c) {
     s += "    " + str(r.channels[c].name) + ": " + channel_json(r.channels[c]) + (c + 1 < r.channels.size() ? ",\n" : "\n");
   }
@@ -146,13 +146,15 @@ void write_fit_json(const std::filesystem::path& dir, const Result& r) {
 void print_summary(const Result& r) {
   fmt::print("{}: {} samples at {:.6g} Hz ({}), {} channel(s)\n", r.source, r.samples, r.rate_hz, r.format, r.channels.size());
   for (const auto& n : r.notes) fmt::print("  note: {}\n", n);
-  fmt::print("  {:<22} {:>20} {:>24} {:>20} {:>20}\n", "channel", "N [/rtHz]", "B_min (datasheet) @tau", "B (IEEE 952)", "K [/rts]");
+  // the units stand in each row: a record may mix rate (deg/s) and acceleration (m/s^2) channels
+  fmt::print("  {:<22} {:>20} {:>24} {:>20} {:>20}  {}\n", "channel", "N", "B_min (datasheet) @tau", "B (IEEE 952)", "K", "units (N, B, K)");
   for (const auto& ch : r.channels) {
     const auto& f = ch.fit;
+    const auto u = units_of(ch.quantity);
     const std::string bmin = std::isfinite(f.B_min.value)
                                  ? fmt::format("{}{:.3e} @{:.3g} s", f.B_min.valid ? "" : "< ", f.B_min.valid ? f.B_min.value : f.B_min.upper_95, f.B_min.tau_s)
                                  : std::string("-");
-    fmt::print("  {:<22} {:>20} {:>24} {:>20} {:>20}\n", ch.name, cell(f.N), bmin, cell(f.B), cell(f.K));
+    fmt::print("  {:<22} {:>20} {:>24} {:>20} {:>20}  {}, {}, {}\n", ch.name, cell(f.N), bmin, cell(f.B), cell(f.K), u.n, u.b, u.k);
   }
   for (const auto& ch : r.channels) {
     for (const auto& w : ch.fit.warnings) fmt::print("  {}: {}\n", ch.name, w);

@@ -48,6 +48,7 @@ struct Result {
   std::size_t samples = 0;
   std::vector<est::Deviation> deviations;
   std::vector<std::string> notes;
+  std::vector<std::string> warnings;    // what makes the figures wrong for the sensor (a record that moves)
   importers::StampReport stamps;
   std::vector<ChannelResult> channels;
   Datasheet datasheet;

@@ -22,7 +22,7 @@ using allan::Result;
 struct AllanArgs {
   allan::InputArgs input;
   std::string out, taus = "octave", devs = "adev", datasheet, gaps = "split";
-  bool all_tau = false, non_overlapping = false, plot = false, stream = false, exact = false;
+  bool all_tau = false, non_overlapping = false, plot = false, stream = false, exact = false, strict = false;
   std::size_t exact_up_to = 65536;
   double confidence = 0.683;
   std::size_t validate = 0;
@@ -95,6 +95,7 @@ void fill_from_stream(Result& r, const AllanArgs& a, const est::AllanOptions& ba
   if (std::find(devs.begin(), devs.end(), est::Deviation::kAllan) == devs.end()) devs.push_back(est::Deviation::kAllan);
   auto s = allan::stream_octaves(a.input, devs, base.confidence, a.exact_up_to);
   r.format = s.meta.format, r.rate_hz = s.meta.rate_hz, r.notes = s.meta.notes, r.stamps = s.meta.stamps;
+  r.warnings = s.warnings;
   for (std::size_t c = 0; c < s.meta.channels.size(); ++c) {
     allan::ChannelResult ch{s.meta.channels[c].name, s.meta.channels[c].quantity, s.meta.channels[c].axis, {}, {}, {}, {}};
     for (std::size_t d = 0; d < devs.size(); ++d) {
@@ -109,6 +110,7 @@ void fill_from_stream(Result& r, const AllanArgs& a, const est::AllanOptions& ba
 void fill_in_memory(Result& r, const AllanArgs& a, est::AllanOptions base) {
   allan::Loaded L = allan::load(a.input);
   r.format = L.format, r.rate_hz = L.rate_hz, r.notes = L.notes, r.stamps = L.stamps;
+  r.warnings = allan::motion_warnings(L);
   base.sample_rate_hz = L.rate_hz;
   Progress progress("allan");
   for (std::size_t c = 0; c < L.channels.size(); ++c) {
@@ -152,6 +154,11 @@ int run_allan(AllanArgs a) {
   for (const auto& f : files) fmt::print("  wrote {}\n", f.string());
   if (a.plot) {
     for (const auto& w : allan::write_plots(a.out, r)) fmt::print(stderr, "driftless allan: warning: {}\n", w);
+  }
+  for (const auto& w : r.warnings) fmt::print(stderr, "driftless allan: warning: {}\n", w);
+  if (a.strict && !r.warnings.empty()) {
+    fmt::print(stderr, "driftless allan: --strict: {} warning(s) about the record: exit 1\n", r.warnings.size());
+    return 1;
   }
   return 0;
 }
@@ -202,6 +209,7 @@ const bool registered = register_command(40, [](CLI::App& app) {
   cmd->add_option("--export-topic", a->exports.topic, "rostopic written into the noise files (default /imu0)");
   cmd->add_option("--validate", a->validate, "Simulate N records from the fit with the twin's sensor model; 95 % band and verdict");
   cmd->add_option("--seed", a->seed, "Seed of --validate, 0 .. 2^64-1 (default 1)")->check(seed_number());
+  cmd->add_flag("--strict", a->strict, "Exit 1 when the record makes the figures wrong for the sensor (it is not at rest)");
   cmd->add_flag("--plot", a->plot, "Also write allan.png/svg and allan_<channel>.png/svg with their gnuplot scripts");
   return [a] { return run_allan(*a); };
 });

@@ -193,9 +193,9 @@ std::unique_ptr<RefJoin> open_ref(const ConvertArgs& a, const importers::StreamI
                                  j->at->first_s(), j->at->last_s(), tp.t0_s, imu_last_s, info.epoch_s));
   }
   j->notes.push_back(fmt::format(
-      "ref_q, ref_p = {} ({} poses, median step {:.6g} ms): attitude by slerp, position linearly, onto the IMU times; "
-      "its frame is taken as the log's reference frame (q_enu_from_body)",
-      a.ref, j->gt.poses.size(), 1e-6 * static_cast<double>(j->gt.median_step_ns)));
+      "ref_q, ref_p = {} ({} poses, median step {:.6g} ms, quaternion columns q {} as the header names them): attitude "
+      "by slerp, position linearly, onto the IMU times; its frame is taken as the log's reference frame (q_enu_from_body)",
+      a.ref, j->gt.poses.size(), 1e-6 * static_cast<double>(j->gt.median_step_ns), j->gt.quaternion_order));
   j->notes.push_back(fmt::format("IMU rows outside the ground truth's span {:.6f}..{:.6f} s are trimmed (left out); "
                                  "rows inside a gap of more than {:.6g} s get no reference",
                                  j->at->first_s(), j->at->last_s(), 1e-9 * static_cast<double>(max_gap_ns)));

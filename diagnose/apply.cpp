@@ -79,6 +79,7 @@ void write_param(CompareModel& m, const ParamRef& p, double v) {
     case Param::kFlipTransientDps:
     case Param::kMissingCodes:
     case Param::kDelaySecondOrderS2:
+    case Param::kDelayThirdOrderS3:
     case Param::kNoiseLag1:
     case Param::kModelLag1: return;  // written elsewhere (codes) or never
   }
@@ -131,6 +132,7 @@ double model_value(const CompareModel& m, const ParamRef& p) {
     case Param::kFlipTransientDps:
     case Param::kMissingCodes:
     case Param::kDelaySecondOrderS2:
+    case Param::kDelayThirdOrderS3:
     case Param::kNoiseLag1:
     case Param::kModelLag1: return 0.0;
   }

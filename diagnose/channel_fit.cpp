@@ -29,13 +29,24 @@ struct Partial {
   double J = 0.0;
 };
 
-Partial partial_out(const ChannelData& c, const std::vector<int>& xs) {
+// the nuisance columns given the held ones: every column with a prior that is not held, and a
+// held column whose value is given (not fitted) keeps its prior about that value (the held value
+// plus a nuisance on the same column: a signal chain's second-order term is held where its
+// delays put it, and the filter's shape, which the model does not know, spreads it)
+std::vector<int> nuisance_of(const ChannelData& c, const std::vector<int>& held, const std::vector<int>& given) {
+  std::vector<int> N;
+  for (int i = 0; i < static_cast<int>(c.cols.size()); ++i) {
+    const bool is_held = std::find(held.begin(), held.end(), i) != held.end();
+    const bool is_given = std::find(given.begin(), given.end(), i) != given.end();
+    if (c.prior[i] > 0 && (!is_held || is_given)) N.push_back(i);
+  }
+  return N;
+}
+
+Partial partial_out(const ChannelData& c, const std::vector<int>& xs, const std::vector<int>& given = {}) {
   const int P = static_cast<int>(c.cols.size());
   const int yi = P;
-  std::vector<int> N;
-  for (int i = 0; i < P; ++i) {
-    if (c.prior[i] > 0 && std::find(xs.begin(), xs.end(), i) == xs.end()) N.push_back(i);
-  }
+  const std::vector<int> N = nuisance_of(c, xs, given);
   const int n = static_cast<int>(N.size()), p = static_cast<int>(xs.size());
   Eigen::MatrixXd C(p + 1, p + 1);
   for (int q = 0; q < p; ++q) {
@@ -86,6 +97,7 @@ struct ChannelUse {
   std::vector<int> pos;                       // distinct positions in cols
   std::vector<std::vector<int>> free_of_pos;  // free parameter indices per position
   Eigen::VectorXd fixed;                      // summed fixed values per position
+  std::vector<int> given;                     // positions held at given values only (no free parameter)
 };
 ChannelUse channel_use(const ChannelData& c, int channel, const FitSpec& spec) {
   ChannelUse u;
@@ -115,6 +127,8 @@ ChannelUse channel_use(const ChannelData& c, int channel, const FitSpec& spec) {
   }
   u.fixed = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(u.pos.size()));
   for (const auto& [q, v] : fixed_at) u.fixed[q] += v;
+  for (std::size_t q = 0; q < u.pos.size(); ++q)
+    if (u.free_of_pos[q].empty()) u.given.push_back(u.pos[q]);
   return u;
 }
 
@@ -137,10 +151,6 @@ double fit_white_density(const ChannelData& c, const BlockSeries& blocks, std::s
   return std::exp(brent_min(f, std::log(n0) - 2.0, std::log(n0) + 2.0, std::log(n0), 1e-6));
 }
 
-namespace {
-
-}  // namespace
-
 // whitened Gram of [cols..., z] and the null (nuisance-only) fit's variance and objective
 void rebuild_gram(ChannelData& c, const BlockSeries& blocks) {
   WhitenedGram g = BiasWhitener::whitened_gram(blocks, c.noise, c.block_cols, c.z);
@@ -149,6 +159,17 @@ void rebuild_gram(ChannelData& c, const BlockSeries& blocks) {
   c.sigma2 = 1.0;
   const double j = partial_out(c, {}).J;
   c.sigma2 = std::max(1e-6, j / static_cast<double>(std::max<std::size_t>(c.m, 1)));
+  c.j0 = partial_out(c, {}).J;
+}
+
+void set_variance(ChannelData& c, const Eigen::VectorXd& coef) {
+  if (!c.present) return;
+  const auto P = static_cast<Eigen::Index>(c.cols.size());
+  Eigen::VectorXd v(P + 1);
+  v.head(P) = coef;
+  v[P] = -1.0;
+  const double rss = v.dot(c.gram * v);  // whitened residual sum of squares
+  c.sigma2 = std::max(1e-6, rss / static_cast<double>(std::max<std::size_t>(c.m, 1)));
   c.j0 = partial_out(c, {}).J;
 }
 
@@ -166,7 +187,10 @@ void fill_columns(const ColumnInputs& in, const Residual& res, ChannelData& c) {
     for (std::size_t b = 0; b < mb; ++b) ss += res.block_series.count[b] ? bm[b] * bm[b] : 0.0;
     if (ss < 1e-20) continue;  // not excited by this log
     c.cols.push_back(col);
-    c.prior.push_back(prior_sigma(in.params[c.s], c.j, col));
+    c.prior.push_back(prior_sigma(in.params[c.s], c.j, col, res.fs_hz));
+    // a latitude the log does not state: the Earth rate is a nuisance (kEarth is only excited then)
+    if (in.r.latitude_assumed && col == kLat) c.prior.back() = kAssumedLatitudeSigmaDeg;
+    if (col == kEarth) c.prior.back() = kAssumedEarthScaleSigma;
     kept.push_back(bm);
   }
   c.block_cols.resize(static_cast<Eigen::Index>(mb), static_cast<Eigen::Index>(kept.size()));
@@ -293,7 +317,7 @@ FitResult map_fit(const Channels& ch, const FitSpec& spec) {
   for (int c = 0; c < 6; ++c) {
     const ChannelUse u = channel_use(ch[c], c, spec);
     if (u.pos.empty()) continue;
-    const Partial pt = partial_out(ch[c], u.pos);
+    const Partial pt = partial_out(ch[c], u.pos, u.given);
     const auto q = static_cast<Eigen::Index>(u.pos.size());
     Eigen::MatrixXd A = Eigen::MatrixXd::Zero(q, P);
     for (Eigen::Index i = 0; i < q; ++i)
@@ -329,9 +353,10 @@ Eigen::VectorXd channel_coefficients(const ChannelData& c, int channel, const Fi
   for (const auto& [ref, v] : spec.fixed) hold(ref, v);
   // the nuisance at its MAP given the held columns:
   // beta_N = (G_NN + sigma^2/prior^2)^-1 (G_Ny - G_NX beta_X)
-  std::vector<int> N;
-  for (int i = 0; i < P; ++i)
-    if (c.prior[i] > 0 && std::find(held.begin(), held.end(), i) == held.end()) N.push_back(i);
+  std::vector<int> given;
+  const ChannelUse u = channel_use(c, channel, spec);
+  for (int i : u.given) given.push_back(i);
+  const std::vector<int> N = nuisance_of(c, held, given);
   if (N.empty()) return coef;
   const auto k = static_cast<Eigen::Index>(N.size());
   Eigen::MatrixXd A(k, k);
@@ -343,7 +368,7 @@ Eigen::VectorXd channel_coefficients(const ChannelData& c, int channel, const Fi
     for (int h : held) b[a] -= c.gram(N[a], h) * coef[h];
   }
   const Eigen::VectorXd x = A.ldlt().solve(b);
-  for (Eigen::Index a = 0; a < k; ++a) coef[N[a]] = x[a];
+  for (Eigen::Index a = 0; a < k; ++a) coef[N[a]] += x[a];  // a given column: its value plus the nuisance
   return coef;
 }
 

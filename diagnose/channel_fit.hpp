@@ -27,7 +27,9 @@ struct ChannelData {
   std::vector<double> z;          // block means of the residual, deg/s
   ChannelNoise noise;             // the model's bias processes and the fitted white density
   Eigen::MatrixXd gram;           // whitened [cols..., z]' [cols..., z]
-  double sigma2 = 1.0;            // whitened residual variance of the null fit
+  // the unit of every objective: the whitened residual variance under the model being tested
+  // (the null fit when the channels are built, the selected set's fit after each selection step)
+  double sigma2 = 1.0;
   double j0 = 0.0;                // null objective (whitened RSS + prior penalty) / sigma2
   std::size_t m = 0;              // blocks that enter the fit
   /// Position of column `col` in cols, or -1 when the log does not excite it.
@@ -69,6 +71,10 @@ double refit_white(ChannelData& c, const BlockSeries& blocks, std::span<const do
 
 /// Rebuilds a channel's whitened Gram and null fit after its noise model changed.
 void rebuild_gram(ChannelData& c, const BlockSeries& blocks);
+
+/// Sets the channel's variance unit to the whitened residual variance left by coefficients
+/// `coef` (cols order; all zero: the data's) over its m blocks, and its null objective in it.
+void set_variance(ChannelData& c, const Eigen::VectorXd& coef);
 
 /// Maximum-likelihood white density of a channel on block residual `z` (golden section on log N).
 double fit_white_density(const ChannelData& c, const BlockSeries& blocks, std::span<const double> z);

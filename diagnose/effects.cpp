@@ -6,6 +6,7 @@
 
 #include <fmt/core.h>
 
+#include "diagnose/signal_chain.hpp"
 #include "estimator/sample.hpp"
 
 namespace driftless::diagnose {
@@ -70,6 +71,7 @@ const ParamInfo kParams[] = {
     {Param::kRrwDpsRts, "k_dps_rts", "deg/s/rts", Effect::kRateRandomWalk, kNoLimit},
     {Param::kJitterSigmaS, "sigma_s", "s", Effect::kSampleJitter, kNoLimit},
     {Param::kDelaySecondOrderS2, "delay_second_order_s2", "s^2", Effect::kLowpass, kNoLimit},
+    {Param::kDelayThirdOrderS3, "delay_third_order_s3", "s^3", Effect::kLowpass, kNoLimit},
     {Param::kNoiseLag1, "noise_second_difference_lag1", "-", Effect::kLowpass, kNoLimit},
     {Param::kModelLag1, "model_second_difference_lag1", "-", Effect::kLowpass, kNoLimit},
 };
@@ -161,6 +163,7 @@ std::vector<ColumnUse> columns_of(const ParamRef& p) {
     case Param::kSampleDelayS: return on_sensor(s, kDelay);
     case Param::kTimeOffsetS: return on_both(kDelay);
     case Param::kDelaySecondOrderS2: return on_sensor(s, kDelay2);
+    case Param::kDelayThirdOrderS3: return on_sensor(s, kDelay3);
     default: return {};
   }
 }
@@ -183,17 +186,24 @@ double column_value(const ColumnInputs& in, int s, int j, int col, std::size_t k
       const double u = in.res.pred_dps(s, j, k) / fs;
       return fs * (col == kNonlin2 ? u * u : u * u * u) / 100.0;
     }
-    case kDelay: return -r.dw_radps2(s, k)[j] * kDegPerRad;
+    case kDelay: return -r.dw_axis_radps2(s, k, j) * kDegPerRad;
     case kDelay2: {
       const std::size_t a = k == 0 ? 0 : k - 1, b = k + 1 < r.size() ? k + 1 : k;
       if (b == a) return 0.0;
-      return (r.dw_radps2(s, b)[j] - r.dw_radps2(s, a)[j]) / (r.t_s[b] - r.t_s[a]) * kDegPerRad;
+      return (r.dw_axis_radps2(s, b, j) - r.dw_axis_radps2(s, a, j)) / (r.t_s[b] - r.t_s[a]) * kDegPerRad;
+    }
+    case kDelay3: {  // the second difference of dw/dt
+      if (k == 0 || k + 1 >= r.size()) return 0.0;
+      const double h = 0.5 * (r.t_s[k + 1] - r.t_s[k - 1]);
+      const double d = r.dw_axis_radps2(s, k + 1, j) - 2.0 * r.dw_axis_radps2(s, k, j) + r.dw_axis_radps2(s, k - 1, j);
+      return -d / (h * h) * kDegPerRad;
     }
     case kEndPlus: case kEndMinus: {
       if (r.rest_side[s][k] != (col == kEndPlus ? 1 : -1)) return 0.0;
       return -r.hinge_axis[s].cross(w)[j] * kDegPerRad * kRadPerDeg;
     }
     case kLat: return static_cast<double>(r.dw_dlat_radps[s][k][j]) * kDegPerRad * kRadPerDeg;
+    case kEarth: return r.earth_radps[s].empty() ? 0.0 : static_cast<double>(r.earth_radps[s][k][j]) * kDegPerRad;
     default: {  // flip bins
       const auto b = static_cast<std::size_t>(col - kFlip0);
       const double since = r.since_flip_s[s][k];
@@ -203,7 +213,7 @@ double column_value(const ColumnInputs& in, int s, int j, int col, std::size_t k
   }
 }
 
-double prior_sigma(const twin::SensorParams& p, int j, int col) {
+double prior_sigma(const twin::SensorParams& p, int j, int col, double fs_hz) {
   switch (col) {
     case kScale: return p.scale_factor.enabled ? p.scale_factor.sigma_pct[j] : 0.0;
     case kMisA: case kMisB: return p.misalignment.enabled ? p.misalignment.sigma_pct : 0.0;
@@ -216,6 +226,15 @@ double prior_sigma(const twin::SensorParams& p, int j, int col) {
     // into the stop (the twin's MuJoCo press, ~0.006 deg, is the model's mean) differs between
     // boxes and simulators
     case kEndPlus: case kEndMinus: return kRestAngleSigmaDeg;
+    // the signal chain's second-order term c2 = (D^2 + V)/2 (D the group delay, V the variance of
+    // the impulse response): the model knows its delays, not the filter's shape. V lies between 0
+    // (a pure delay) and about D^2 (a first-order pole), and a sample that averages its interval
+    // adds dt^2/12: the spread is half of that range. Without it the shape's amplitude response
+    // (c2 times the rate's second derivative) reads as a scale of ~0.02 % on fast motion
+    case kDelay2: {
+      const double D = lowpass_delay_s(p), dt = 1.0 / fs_hz;
+      return 0.25 * (D * D + dt * dt / 12.0);
+    }
     default: return 0.0;
   }
 }

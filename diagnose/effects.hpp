@@ -73,6 +73,7 @@ enum class Param : std::uint8_t {
   kRrwDpsRts,          // sensor.rate_random_walk.k_dps_rts[row]
   kJitterSigmaS,       // sensor.sample_jitter.sigma_s
   kDelaySecondOrderS2, // the signal chain's second-order term change (held, not fitted), s^2
+  kDelayThirdOrderS3,  // its third-order term change (held, not fitted), s^3
   kNoiseLag1,          // lag-1 correlation of the residual noise (data), diagnostic
   kModelLag1,          // the same as the model predicts, diagnostic
 };
@@ -103,8 +104,10 @@ enum Col : int {
   kNonlin2, kNonlin3,         // adc_nonlinearity, % FS:     FS u^2 / 100, FS u^3 / 100
   kDelay,                     // any delay, s:               -dw_j/dt
   kDelay2,                    // its second order, s^2:      d2w_j/dt2 (a delay d: d^2/2; a pole T: T^2)
+  kDelay3,                    // its third order, s^3:       -d3w_j/dt3 (a delay d: d^3/6; a pole T: T^3)
   kEndPlus, kEndMinus,        // end_stop_error, deg:        -(a x w)_j at rest on that side
   kLat,                       // latitude error, deg:        dy_j/dlat
+  kEarth,                     // the Earth rate's scale, 1:  its part of y_j (a nuisance where the latitude is assumed)
   kFlip0, kFlip1, kFlip2, kFlip3,  // flip transient, deg/s: dir * 1[bin after the stop]
   kNumCols
 };
@@ -112,6 +115,11 @@ enum Col : int {
 inline constexpr std::array<double, 5> kFlipBinsS = {0.0, 0.25, 0.5, 1.0, 2.0};
 /// Prior 1-sigma of a platform's rest angle on a stop, deg (servo press differs between boxes).
 inline constexpr double kRestAngleSigmaDeg = 0.01;
+/// Where a log states no latitude: prior 1-sigma of the Earth rate's latitude, deg, and of its
+/// scale (1 = as at the assumed latitude, 0 = a reference frame that does not turn with the
+/// Earth); together they span every Earth rate in the north-up plane, none included.
+inline constexpr double kAssumedLatitudeSigmaDeg = 45.0;
+inline constexpr double kAssumedEarthScaleSigma = 1.0;
 
 /// What a column needs besides the replay: the model's prediction (output and temperature, from
 /// the residual).
@@ -123,8 +131,9 @@ struct ColumnInputs {
 /// Value of column `col` for channel (sensor s, axis j) at sample k.
 double column_value(const ColumnInputs& in, int s, int j, int col, std::size_t k);
 /// Prior 1-sigma (file units) of a column's coefficient under the model: the run-to-run spread
-/// of an effect the model switches on; 0 = not a nuisance (the model says "exactly").
-double prior_sigma(const twin::SensorParams& p, int j, int col);
+/// of an effect the model switches on; 0 = not a nuisance (the model says "exactly"). The signal
+/// chain's second-order term (kDelay2) spreads with the filter's unknown shape at rate fs_hz.
+double prior_sigma(const twin::SensorParams& p, int j, int col, double fs_hz);
 
 /// One regressor a linear parameter drives: channel 0..5 (sensor*3 + axis) and column.
 struct ColumnUse {

@@ -152,7 +152,7 @@ PerChannel jitter(const Replay& r, const Residual& res, const std::array<double,
     for (std::size_t k = 0; k < res.n; ++k) {
       const double e = a.e(s * 3 + j, k);
       if (!res.mask[k] || !std::isfinite(e)) continue;
-      const double g2 = std::pow(r.dw_radps2(s, k)[j] * kDegPerRad, 2);
+      const double g2 = std::pow(r.dw_axis_radps2(s, k, j) * kDegPerRad, 2);
       const double var = 2.0 * std::pow(v0 + sj2 * g2, 2) + 1e-30;
       const Eigen::Vector2d x(1.0, g2);
       A += x * x.transpose() / var;

@@ -36,9 +36,11 @@ struct ReplayOptions {
 /// Per-sample truth rebuilt from a log, plus what was measured. Sensor index s = 0, 1.
 struct Replay {
   std::size_t size() const { return t_s.size(); }
-  /// d(w_radps)/dt of sensor s at sample k by central differences (one-sided at the ends, 0
-  /// where unknown), rad/s^2, sensor axes: computed when asked (a stored copy was 17 MB an hour)
-  Eigen::Vector3d dw_radps2(int s, std::size_t k) const;
+  /// d(w_radps)/dt of sensor s, axis j, at sample k by the maximally flat central
+  /// differentiator over 2 x 4 neighbours (central differences near the ends and where a
+  /// neighbour is not finite, 0 where unknown), rad/s^2, sensor axes: computed when asked (a
+  /// stored copy was 17 MB an hour), one axis at a time (what a channel's column needs)
+  double dw_axis_radps2(int s, std::size_t k, int j) const;
 
   std::vector<double> t_s;                               // s, log time
   std::array<std::vector<Eigen::Vector3d>, 2> gyro_dps;  // measured, sensor axes, deg/s
@@ -48,6 +50,9 @@ struct Replay {
   std::array<std::vector<Eigen::Vector3f>, 2> f_mps2;    // specific force, sensor axes
   // d(y_i)/d(latitude) per rad of latitude: the Earth-rate part's sensitivity, sensor axes
   std::array<std::vector<Eigen::Vector3f>, 2> dw_dlat_radps;
+  // the Earth-rate part of y_i, sensor axes, rad/s: kept only where the latitude is assumed (the
+  // log states none: whether its reference frame turns with the Earth is then unknown too)
+  std::array<std::vector<Eigen::Vector3f>, 2> earth_radps;
   std::vector<Eigen::Vector3d> w_body_radps;             // box inertial rate, box axes
   std::vector<Eigen::Vector3f> f_body_mps2;              // box specific force, box axes
   std::array<std::vector<double>, 2> plat_deg;           // as logged; NaN when unknown
@@ -61,6 +66,7 @@ struct Replay {
 
   std::array<Eigen::Vector3d, 2> hinge_axis{Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitX()};
   double latitude_deg = kNaN;
+  bool latitude_assumed = false;  // the log states no latitude_deg (default_latitude_deg is used)
   double sample_rate_hz = kNaN;   // Hz, of the replayed series (after any resampling)
   double log_rate_hz = kNaN;      // Hz, as found in the log
   bool resampled = false;

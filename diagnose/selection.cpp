@@ -80,6 +80,11 @@ std::vector<ParamRef> make_universe(const Channels& ch) {
   return u;
 }
 
+// a signal chain's second- and third-order terms, s^2 and s^3
+struct ChainTerms {
+  double c2 = 0.0, c3 = 0.0;
+};
+
 // the evaluation of one parameter given the selection
 struct Eval {
   ParamRef ref;
@@ -97,7 +102,7 @@ class Selector {
       model_sample_delay_[s] = model_value(in.model, ParamRef{Param::kSampleDelayS, static_cast<std::int8_t>(s)});
       null_penalty_[s] = colour_penalty_at(s, model_delay_[s]);
       model_extra_delay_[s] = model_sample_delay_[s] + in.model.time_offset_s;
-      model_c2_[s] = chain_c2(s, model_delay_[s], model_extra_delay_[s]);
+      model_c_[s] = chain_terms(s, model_delay_[s], model_extra_delay_[s]);
     }
   }
   Selection run();
@@ -110,7 +115,7 @@ class Selector {
   }
   FitSpec spec_of(const Terms& S) const;
   FitSpec solve(const Terms& S, FitResult* fit) const;
-  double chain_c2(int s, double lowpass_delay_s, double extra_delay_s) const;
+  ChainTerms chain_terms(int s, double lowpass_delay_s, double extra_delay_s) const;
   double total(const Terms& S, FitResult* fit = nullptr) const;
   double best_delay(int s, const Terms& S, double* best_total) const;
   void optimise_delays(Terms& S) const;
@@ -118,8 +123,9 @@ class Selector {
   std::vector<Eval> evaluate_all(const Terms& S, double base) const;
   std::vector<Terms> options(Effect e, const std::vector<Eval>& evals, const Terms& S, int step_no) const;
   bool step(Terms& S, int step_no, double& base);
-  void prune(Terms& S) const;
+  void prune(Terms& S, std::size_t from = 0) const;
   bool refit_noise(const Terms& S);
+  void set_variances(const Terms& S);
   Candidate make_selected(Effect e, const Terms& S, const FitResult& fit) const;
   std::vector<Candidate> make_not_supported(const Terms& S, double base) const;
   FittedParam fitted(const ParamRef& ref, double value, double sigma) const;
@@ -129,7 +135,8 @@ class Selector {
   double log_m_;
   std::vector<ParamRef> universe_;
   std::array<double, 2> model_delay_{}, model_sample_delay_{}, null_penalty_{};
-  std::array<double, 2> model_extra_delay_{}, model_c2_{};  // the model's sample delay + time offset, its c2
+  std::array<double, 2> model_extra_delay_{};  // the model's sample delay + time offset
+  std::array<ChainTerms, 2> model_c_{};         // the model's chain's higher-order terms
   std::map<Effect, double> evidence_added_, gain_added_;
   std::vector<int> adc_steps_;  // step per entry of in_.adc (0 = not selected)
   int noise_refits_ = 0;
@@ -150,10 +157,12 @@ FitSpec Selector::spec_of(const Terms& S) const {
   return spec;
 }
 
-// the second-order coefficient of sensor s's signal chain (delays change the signal by
-// -c1 dw/dt + c2 d2w/dt2): a low-pass of group delay D with pole time T, then a pure delay d,
-// has c1 = D + d, c2 = (D^2 + T^2)/2 + d D + d^2/2
-double Selector::chain_c2(int s, double lowpass_delay_s, double extra_delay_s) const {
+// the higher-order coefficients of sensor s's signal chain (delays change the signal by
+// -c1 dw/dt + c2 d2w/dt2 - c3 d3w/dt3, c_n = E[t^n]/n! of the chain's impulse response): a
+// low-pass of group delay D with pole time T (an exponential of mean T after a pure delay D - T),
+// then a pure delay d, has c1 = D + d, c2 = (D^2 + T^2)/2 + d D + d^2/2 and, with a = D - T + d,
+// c3 = (6 T^3 + 6 a T^2 + 3 a^2 T + a^3)/6
+ChainTerms Selector::chain_terms(int s, double lowpass_delay_s, double extra_delay_s) const {
   const twin::SensorParams p = with_lowpass_delay(in_.model.sensor[static_cast<std::size_t>(s)], lowpass_delay_s);
   double T = 0.0;
   if (p.lowpass_latency.enabled) {
@@ -161,11 +170,11 @@ double Selector::chain_c2(int s, double lowpass_delay_s, double extra_delay_s) c
     const double a = twin::design_lowpass(set.gyro_bandwidth_hz, set.gyro_delay_s, in_.res.fs_hz).pole;
     T = a / (1.0 - a) / in_.res.fs_hz;
   }
-  const double D = lowpass_delay_s, d = extra_delay_s;
-  return 0.5 * (D * D + T * T) + d * D + 0.5 * d * d;
+  const double D = lowpass_delay_s, d = extra_delay_s, a = D - T + d;
+  return {0.5 * (D * D + T * T) + d * D + 0.5 * d * d, (6.0 * T * T * T + 6.0 * a * T * T + 3.0 * a * a * T + a * a * a) / 6.0};
 }
 
-// the MAP fit of a selection; when it changes a signal chain, the chains' second-order terms
+// the MAP fit of a selection; when it changes a signal chain, the chains' second- and third-order terms
 // (from the first solve's delays) are held and the fit solved again
 FitSpec Selector::solve(const Terms& S, FitResult* fit) const {
   FitSpec spec = spec_of(S);
@@ -184,8 +193,10 @@ FitSpec Selector::solve(const Terms& S, FitResult* fit) const {
   }
   for (int s = 0; s < 2; ++s) {
     const auto k = static_cast<std::size_t>(s);
-    const double dc2 = chain_c2(s, D[k], d[k]) - model_c2_[k];
+    const ChainTerms c = chain_terms(s, D[k], d[k]);
+    const double dc2 = c.c2 - model_c_[k].c2, dc3 = c.c3 - model_c_[k].c3;
     if (dc2 != 0.0) spec.fixed.emplace_back(ParamRef{Param::kDelaySecondOrderS2, static_cast<std::int8_t>(s)}, dc2);
+    if (dc3 != 0.0) spec.fixed.emplace_back(ParamRef{Param::kDelayThirdOrderS3, static_cast<std::int8_t>(s)}, dc3);
   }
   *fit = map_fit(in_.ch, spec);
   return spec;
@@ -291,8 +302,8 @@ std::vector<Eval> Selector::evaluate_all(const Terms& S, double base) const {
   return out;
 }
 
-// the ways an effect can be added: its parameters with positive evidence; for the low-pass
-// either both sensors' filter at once or each sensor's own (they exclude each other)
+// the ways an effect can be added: its parameters with positive evidence, per sensor; for the
+// low-pass either both sensors' filter at once or each sensor's own (they exclude each other)
 std::vector<Terms> Selector::options(Effect e, const std::vector<Eval>& evals, const Terms& S, int step_no) const {
   std::vector<Terms> out;
   auto add_where = [&](const std::function<bool(const Eval&)>& keep) {
@@ -302,7 +313,9 @@ std::vector<Terms> Selector::options(Effect e, const std::vector<Eval>& evals, c
     if (trial.size() > S.size()) out.push_back(std::move(trial));
   };
   if (e != Effect::kLowpass) {
-    add_where([](const Eval&) { return true; });
+    // per sensor (two instruments: the same kind of error on each is two findings, and one
+    // sensor's parameters must not ride on another's signal), box-wide parameters on their own
+    for (int s = -1; s < 2; ++s) add_where([s](const Eval& ev) { return ev.ref.sensor == s; });
     return out;
   }
   add_where([](const Eval& ev) { return ev.ref.sensor < 0; });
@@ -313,18 +326,31 @@ std::vector<Terms> Selector::options(Effect e, const std::vector<Eval>& evals, c
 // one forward step: the effect whose supported parameters add the most evidence
 bool Selector::step(Terms& S, int step_no, double& base) {
   const std::vector<Eval> evals = evaluate_all(S, base);
-  double best_ev = in_.threshold;
-  Effect best = Effect::kCount;
-  Terms best_trial;
+  // every (effect, sensor) option, scored on the machine's cores into its own slot; the best is
+  // then taken in catalogue order (the same choice, bit for bit, on any thread count)
+  std::vector<std::pair<Effect, Terms>> opts;
   for (int ei = 0; ei < kEffectCount; ++ei) {
     const auto e = static_cast<Effect>(ei);
     if (effect_info(e).family == Family::kNoiseModel || effect_info(e).family == Family::kAdc) continue;
-    for (Terms& trial : options(e, evals, S, step_no)) {
-      const auto added = static_cast<double>(trial.size() - S.size());
-      if (e == Effect::kLowpass || e == Effect::kSampleDelay || e == Effect::kTimeOffset) optimise_delays(trial);
-      const double ev = total(trial) - base - added * log_m_;
-      if (ev > best_ev) best_ev = ev, best = e, best_trial = std::move(trial);
-    }
+    for (Terms& trial : options(e, evals, S, step_no)) opts.emplace_back(e, std::move(trial));
+  }
+  std::vector<double> score(opts.size());
+  for_each_index(static_cast<int>(opts.size()), [&](int i) {
+    auto& [e, trial] = opts[static_cast<std::size_t>(i)];
+    if (e == Effect::kLowpass || e == Effect::kSampleDelay || e == Effect::kTimeOffset) optimise_delays(trial);
+    // the effect's parameters that each add evidence alone, less those the others make
+    // redundant: an effect is scored by what it explains, not by the noise its spare
+    // parameters fit (two names for one signal, a cross-axis pair and a mounting rotation,
+    // would otherwise be ranked by their count of spare parameters)
+    if (trial.size() > S.size() + 1) prune(trial, S.size());
+    const auto added = static_cast<double>(trial.size() - S.size());
+    score[static_cast<std::size_t>(i)] = total(trial) - base - added * log_m_;
+  });
+  double best_ev = in_.threshold;
+  Effect best = Effect::kCount;
+  Terms best_trial;
+  for (std::size_t i = 0; i < opts.size(); ++i) {
+    if (score[i] > best_ev) best_ev = score[i], best = opts[i].first, best_trial = opts[i].second;
   }
   int best_adc = -1;
   for (std::size_t a = 0; a < in_.adc.size(); ++a) {
@@ -343,19 +369,21 @@ bool Selector::step(Terms& S, int step_no, double& base) {
   prune(S);
   optimise_delays(S);
   if (noise_refits_ < kMaxNoiseRefits && refit_noise(S)) ++noise_refits_;
+  set_variances(S);
   base = total(S);
   evidence_added_[best] += best_ev;
   gain_added_[best] += base - before;
   return true;
 }
 
-// backward: drop the least supported parameter while its removal costs less than its penalty
-void Selector::prune(Terms& S) const {
+// backward: drop the least supported parameter (of those from index `from` on) while its
+// removal costs less than its penalty
+void Selector::prune(Terms& S, std::size_t from) const {
   for (;;) {
     const double t = total(S);
     double worst = 0.0;
     std::size_t worst_i = S.size();
-    for (std::size_t i = 0; i < S.size(); ++i) {
+    for (std::size_t i = from; i < S.size(); ++i) {
       Terms without = S;
       without.erase(without.begin() + static_cast<std::ptrdiff_t>(i));
       const double ev = t - total(without) - log_m_;
@@ -380,9 +408,23 @@ bool Selector::refit_noise(const Terms& S) {
   return std::any_of(change.begin(), change.end(), [](double d) { return d > 0.02; });
 }
 
+// the unit of every objective becomes each channel's residual variance under the selected set:
+// a candidate x is then scored against the variance of the model it extends (the score form of
+// the test of S + x against S). Measured against the null fit's variance instead, a mismatch the
+// selection has already taken out (a signal chain the log does not share) stayed in the unit and
+// deflated every later candidate's evidence
+void Selector::set_variances(const Terms& S) {
+  FitResult fit;
+  const FitSpec spec = solve(S, &fit);
+  for_each_index(in_.res.channels(), [&](int c) {
+    set_variance(in_.ch[c], channel_coefficients(in_.ch[c], c, spec, fit));
+  });
+}
+
 Selection Selector::run() {
   adc_steps_.assign(in_.adc.size(), 0);
   Terms S;
+  set_variances(S);
   double base = 0.0;
   int step_no = 1;
   for (; step_no <= in_.max_steps; ++step_no) {

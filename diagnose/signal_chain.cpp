@@ -53,8 +53,8 @@ std::vector<double> without_delay_signature(const Replay& r, const Residual& res
   const std::size_t n = res.n;
   std::vector<double> d1(n, 0.0), d2(n, 0.0);
   for (std::size_t k = 1; k + 1 < n; ++k) {
-    d1[k] = -r.dw_radps2(s, k)[j] * kDegPerRad;
-    d2[k] = (r.dw_radps2(s, k + 1)[j] - r.dw_radps2(s, k - 1)[j]) / (r.t_s[k + 1] - r.t_s[k - 1]) * kDegPerRad;
+    d1[k] = -r.dw_axis_radps2(s, k, j) * kDegPerRad;
+    d2[k] = (r.dw_axis_radps2(s, k + 1, j) - r.dw_axis_radps2(s, k - 1, j)) / (r.t_s[k + 1] - r.t_s[k - 1]) * kDegPerRad;
   }
   Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
   Eigen::Vector3d b = Eigen::Vector3d::Zero();

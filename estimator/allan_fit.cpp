@@ -169,13 +169,15 @@ Profile profile(FitAt&& fit_at, double a, double b, double step, double kappa, c
 }
 
 // the flicker model; the white noise's low-pass time constant Tf by a profile from tau0/20 to
-// 20 tau0, against no low-pass at all (kept unless Tf improves chi2 by more than 4 kappa: 2 sigma)
+// 20 tau0, against no low-pass at all (kept unless Tf improves chi2 by more than 9 kappa: 3 sigma;
+// at 2 sigma one white-noise channel in 25 was reported low-passed, the profile over Tf being a
+// search over many values)
 Profile fit_flicker(const FitData& d, double kappa) {
   const Solution none = fit_detail::fit_columns(d, kFlickerTerms, {});
   auto fit_at = [&](double x) { return fit_detail::fit_columns(d, kFlickerTerms, {std::pow(10.0, x), 0.0}, &none.model); };
   const double a = std::log10(d.tau0_s / 20.0), b = std::log10(d.tau0_s * 20.0);
   Profile p = profile(fit_at, a, b, 0.25, kappa, nullptr);
-  if (chi2_of(p.best) < chi2_of(none) - 4.0 * kappa) return p;
+  if (chi2_of(p.best) < chi2_of(none) - 9.0 * kappa) return p;
   Profile q = profile(fit_at, a, b, 0.25, kappa, &none);
   q.lo_s = q.hi_s = kNaN;
   return q;

@@ -135,6 +135,14 @@ struct EstimatorConfig {
   double box_dwell_rate_dps = 2.0;   // deg/s, |corrected fused rate| below this: the box rests
   double box_dwell_min_s = 1.0;      // s, shortest dwell used (after the margins)
   double box_dwell_margin_s = 0.2;   // s, dropped at the start and the end of each dwell
+  // self-calibrating mode with scale/misalignment states: each flip of one platform while the
+  // other rests is a measurement too: the moving sensor's readings integrated over the flip carry
+  // E times the flip angle (docs/estimator.md section 1f). The rest angles before and after are
+  // the flip angle; flip_angle_sigma is each reading's 1 sigma (end-stop errors: the twin's
+  // default box has up to 0.05 deg). A window is dropped when it lasts longer than flip_max.
+  bool flip_updates = true;
+  double flip_angle_sigma_deg = 0.05;  // deg, 1 sigma of each rest-angle reading
+  double flip_max_s = 5.0;             // s, longest flip used (settle_s is added after it)
 
   Calibration calibration;  // optional calibrated matrices (issue 4); empty = rotations
 

@@ -101,6 +101,8 @@ void EstimatorConfig::validate() const {
   positive(box_dwell_rate_dps, "box_dwell_rate_dps", "deg/s");
   non_negative(box_dwell_min_s, "box_dwell_min_s", "s");
   non_negative(box_dwell_margin_s, "box_dwell_margin_s", "s");
+  non_negative(flip_angle_sigma_deg, "flip_angle_sigma_deg", "deg");
+  positive(flip_max_s, "flip_max_s", "s");
   if (mode == FilterMode::kPaper && (self_calibration || box_at_rest)) {
     throw std::invalid_argument("estimator config: self_calibration and box_at_rest need mode: general");
   }
@@ -162,7 +164,10 @@ const char* to_string(PushStatus s) {
 // the filter
 
 DriftlessFilter::DriftlessFilter(const EstimatorConfig& cfg, const BoxGeometry& box)
-    : cfg_(cfg), box_(box), standstill_((cfg_.validate(), cfg_), (box_.validate(), box_)) {
+    : cfg_(cfg),
+      box_(box),
+      standstill_((cfg_.validate(), cfg_), (box_.validate(), box_)),
+      flips_(cfg_.settle_s, cfg_.flip_max_s, box_.sample_rate_hz) {
   q_rate_dps2_per_s_ = cfg_.q_dps2_per_s();
   x_.setZero();
   x_.head<kStateDim>().setConstant(cfg_.initial_bias_dps);
@@ -228,6 +233,7 @@ void DriftlessFilter::on_source_switch(const BoxGeometry* box) {
     cache_deg_ = {kNaN, kNaN};
   }
   standstill_.restart(box_);
+  flips_.reset();
   prev_res_.valid = false;
   dwell_ = StandstillSegment{};
   dwell_recent_.clear();
@@ -315,12 +321,9 @@ Vector6d DriftlessFilter::bias_at(const Sample& s, const StateVector& x, const s
 }
 
 namespace {
-// d(M G f)/d vec(G) for row-major vec(G): column 3 r + c is M.col(r) f_c
+// d(M G f)/d vec(G) for row-major vec(G) (estimator/flip_update.hpp)
 Eigen::Matrix<double, 3, 9> gsens_jacobian(const Eigen::Matrix3d& M, const Eigen::Vector3d& f_g) {
-  Eigen::Matrix<double, 3, 9> J;
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) J.col(3 * r + c) = M.col(r) * f_g[c];
-  return J;
+  return matrix_error_jacobian(M, f_g);
 }
 }  // namespace
 
@@ -630,6 +633,7 @@ PushStatus DriftlessFilter::push_corrected(const Sample& s) {
   out_.t_s = s.t_s;
   if (!finite(s.t_s) || !s.gyros_finite()) {
     ++counters_.invalid;
+    if (uses_flips()) flips_.reset();  // a flip with a hole in it is not integrated
     out_.status = PushStatus::kInvalid;
     return out_.status;
   }
@@ -668,7 +672,12 @@ PushStatus DriftlessFilter::push_corrected(const Sample& s) {
 
   // 3. outputs with the estimate now in force
   fuse_rate(s, st);
-  // 4. a box dwell (box_dwell_updates): its vertical rate is the Earth's
+  // 4. a flip of one platform that just ended: its integrated readings measure E (section 1f)
+  if (uses_flips() && flips_.push(s, dt, st) == FlipWindow::Event::kClosed) {
+    use_flip();
+    predict_temperature(s.temp1_c, s.temp2_c);
+  }
+  // 5. a box dwell (box_dwell_updates): its vertical rate is the Earth's
   if (uses_box_dwells()) track_box_dwell(s);
   return out_.status;
 }
@@ -768,6 +777,59 @@ void DriftlessFilter::use_box_dwell(const StandstillSegment& seg) {
   ++counters_.box_dwell_updates;
   if (!ok) ++counters_.box_dwell_rejected;
   predict_to(std::max(seg.t_last_s, t_filter_s_));
+}
+
+// ---------------------------------------------------------------------------------------------
+// flip updates (docs/estimator.md section 1f): one platform flipped, the other rested
+
+SensorErrors DriftlessFilter::errors_of(int sensor) const {
+  SensorErrors e;
+  e.b_dps = x_.segment<3>(sensor == 1 ? kBias1.start : kBias2.start);
+  if (has_gsens_states()) e.G_dps_per_g = g_sensitivity_dps_per_g(sensor);
+  e.E_frac = scale_misalign(sensor);
+  return e;
+}
+
+void DriftlessFilter::use_flip() {
+  // the profile and the E regressor use the corrected rates: only once the correction is known
+  // (as for the box dwells); before, a flip would pass the bias error into E
+  if (!(correction_sigma_dps().maxCoeff() < 0.1 * cfg_.box_dwell_rate_dps)) return;
+  const int m = flips_.moving(), r = 3 - m;
+  FlipModel fm;
+  fm.M_moving_start = body_from_sensor(m, flips_.start_deg());
+  fm.M_rest = body_from_sensor(r, flips_.rest_deg());
+  fm.hinge_box = (m == 1 ? box_.hinge1_axis : box_.hinge2_axis).normalized();
+  fm.moving = errors_of(m);
+  fm.rest = errors_of(r);
+  fm.use_g = has_gsens_states();
+  const double n = double(flips_.samples().size());
+  const double rate_hz = n / (flips_.t_end_s() - flips_.t_start_s());
+  fm.sample_var_dps2 = cfg_.sample_variance_dps2(std::isfinite(box_.sample_rate_hz) ? box_.sample_rate_hz : rate_hz);
+  fm.angle_sigma_deg = cfg_.flip_angle_sigma_deg;
+  const FlipRows fr = flip_rows(flips_, fm);
+  if (!fr.valid) return;
+  const auto at = [](StateSlice first, int sensor, Eigen::Index width) { return first.start + width * (sensor - 1); };
+  Eigen::Matrix<double, 3, kFullStateDim> H = Eigen::Matrix<double, 3, kFullStateDim>::Zero();
+  H.block<3, 3>(0, at(kBias1, m, 3)) = fr.H_b_moving;
+  H.block<3, 3>(0, at(kBias1, r, 3)) = fr.H_b_rest;
+  if (has_gsens_states()) {
+    H.block<3, 9>(0, at(kGSens1, m, 9)) = fr.H_G_moving;
+    H.block<3, 9>(0, at(kGSens1, r, 9)) = fr.H_G_rest;
+  }
+  H.block<3, 9>(0, at(kScale1, m, 9)) = fr.H_E_moving;
+  H.block<3, 9>(0, at(kScale1, r, 9)) = fr.H_E_rest;
+  // the regressors use the estimate: its error times E (3 terms per sensor, as in scale_rows)
+  const double sb = std::sqrt(P_.diagonal().head<kStateDim>().maxCoeff());
+  const double se = std::sqrt(P_.diagonal().segment<18>(kScale1.start).maxCoeff());
+  Eigen::Matrix3d R = fr.R_deg2;
+  R.diagonal().array() += 6.0 * se * se * sb * sb * fr.span_s * fr.span_s;
+  predict_to(std::max(0.5 * (flips_.t_start_s() + flips_.t_end_s()), t_filter_s_));
+  UpdateRecord rec;  // not emitted: the standstill updates' record and counts stay theirs
+  const bool ok = update<3>(fr.z_deg, H, R, rec, false);
+  ++counters_.flip_updates;
+  if (!ok) ++counters_.flip_rejected;
+  if (ok) counters_.flip_nis_sum += rec.nis;
+  predict_to(std::max(flips_.t_end_s(), t_filter_s_));
 }
 
 template bool DriftlessFilter::update<1>(const Eigen::Matrix<double, 1, 1>&, const Eigen::Matrix<double, 1, kFullStateDim>&,

@@ -14,6 +14,7 @@
 
 #include "estimator/box_geometry.hpp"
 #include "estimator/config.hpp"
+#include "estimator/flip_update.hpp"
 #include "estimator/sample.hpp"
 #include "estimator/standstill.hpp"
 
@@ -114,6 +115,10 @@ struct FilterCounters {
   // box-dwell updates of the vertical rate (box_dwell_updates; not in `updates`/`rejected`)
   std::uint64_t box_dwell_updates = 0;
   std::uint64_t box_dwell_rejected = 0;
+  // flip updates of the scale/misalignment (flip_updates; not in `updates`/`rejected`)
+  std::uint64_t flip_updates = 0;
+  std::uint64_t flip_rejected = 0;
+  double flip_nis_sum = 0.0;  // sum of the accepted flip updates' NIS (3 dof each)
 };
 
 /// What an accepted update changed (for an offline smoother: estimator/smoother.hpp). The pointers
@@ -188,6 +193,9 @@ class DriftlessFilter {
   /// Box dwells measure the vertical rate (self-calibrating mode, box_dwell_updates, and not
   /// box_at_rest, whose standstill rows measure the same already)
   bool uses_box_dwells() const { return cfg_.self_calibration && cfg_.box_dwell_updates && !cfg_.box_at_rest; }
+  /// Each flip of one platform measures the moving sensor's scale/misalignment (flip_updates,
+  /// self-calibrating mode with scale states; docs/estimator.md section 1f)
+  bool uses_flips() const { return has_scale_states() && cfg_.flip_updates; }
   /// Sigma of the correction the filter applies, o_i = b_i + G_i f_i at the specific force of
   /// the last update (deg/s): what "locked" means. The bias sigma without self-calibration; with
   /// it, b_i alone may stay unobservable (a g-sensitivity along a fixed gravity looks like bias).
@@ -242,6 +250,9 @@ class DriftlessFilter {
   void track_box_dwell(const Sample& s);
   void close_box_dwell(double temp1_c, double temp2_c);
   void use_box_dwell(const StandstillSegment& seg);
+  // flip updates (cfg_.flip_updates, docs/estimator.md section 1f)
+  SensorErrors errors_of(int sensor) const;
+  void use_flip();
 
   EstimatorConfig cfg_;
   BoxGeometry box_;
@@ -266,6 +277,7 @@ class DriftlessFilter {
   double last_t_s_ = kNaN;
 
   StandstillDetector standstill_;
+  FlipWindow flips_;
   // the box dwell in progress: samples older than box_dwell_margin_s in dwell_, the newer ones
   // (dropped if the dwell ends now) in dwell_recent_; armed once the correction is known
   struct DwellSample {

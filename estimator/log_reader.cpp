@@ -150,7 +150,11 @@ void LogReader::map_columns() {
     fail("header lacks required column(s) " + missing +
          (single ? " (required in the single-sensor form: t, gyro1_x..gyro1_z"
                  : " (required: t, gyro1_x..gyro2_z, plat1_deg, plat2_deg") +
-         "; see docs/log-format.md)");
+         "; see docs/log-format.md)" +
+         (meta_.has("format") ? std::string()
+                              : std::string("; the file has no '# format: driftless-log 1' line: a recording from "
+                                            "another tool? make a log of it with 'driftless convert --in FILE --out "
+                                            "LOG.csv' (docs/import.md)")));
   }
   if (single) {
     fields_ |= kLayoutSingleSensor;
@@ -329,6 +333,11 @@ bool LogReader::next(Sample& out) {
   if (last_line_unterminated_ && !meta_.complete() && opts_.tolerate_truncated_tail) {
     dropped_truncated_ = true;
     return false;
+  }
+  if (!ok && last_line_unterminated_) {
+    problem += meta_.complete() ? "; it is the last line and has no line end: the log was cut mid-write (copied while "
+                                  "being written?) although it says 'complete: true' (set 'complete: false' to use the rows before it)"
+                                : "; it is the last line and has no line end: cut mid-write";
   }
   if (!ok) fail(problem);
   for (std::size_t c = 0; c < columns_.size(); ++c) {

@@ -149,6 +149,10 @@ LiveStats LiveLoop::run_loop(SampleSource& first, SampleSource* second, const st
       stats_.end_reason = src->name() + " ended";
       break;
     }
+    if (st == ReadStatus::kFailed) {
+      stats_.end_reason = src->name() + " failed: " + src->failure();
+      break;
+    }
     if (st == ReadStatus::kDisconnected) {
       if (!reconnect(*src, stop)) {
         stats_.complete = stop.load();

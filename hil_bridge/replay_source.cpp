@@ -57,10 +57,12 @@ ReadStatus ReplaySource::read(Sample& out) {
   try {
     got = reader_->next(out);
   } catch (const std::exception& e) {
-    // a malformed row ends the replay; the rows before it stand
-    report(EventKind::kInfo, kNaN, std::string("replay stopped: ") + e.what());
+    // a malformed row ends the replay; the rows before it stand, and the session says it is
+    // incomplete (the recording was not replayed to its end)
+    failure_ = std::string("replay stopped: ") + e.what();
+    report(EventKind::kCorruptFrame, kNaN, failure_);
     ended_ = true;
-    return ReadStatus::kEnd;
+    return ReadStatus::kFailed;
   }
   // the recording's own event lines
   const auto& ev = reader_->events();

@@ -31,6 +31,7 @@ class ReplaySource final : public SampleSource {
   Status activate() override;
   ReadStatus read(Sample& out) override;
   void deactivate() override;
+  std::string failure() const override { return failure_; }
 
  private:
   Clock& clock_;
@@ -43,6 +44,7 @@ class ReplaySource final : public SampleSource {
   double wall0_s_ = 0.0;
   std::size_t events_seen_ = 0;
   bool ended_ = false;
+  std::string failure_;  // why read() returned kFailed
 };
 
 }  // namespace driftless::hil

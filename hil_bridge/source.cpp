@@ -9,6 +9,7 @@ const char* to_string(ReadStatus s) {
     case ReadStatus::kFault: return "fault";
     case ReadStatus::kDisconnected: return "disconnected";
     case ReadStatus::kEnd: return "end";
+    case ReadStatus::kFailed: return "failed";
   }
   return "?";
 }

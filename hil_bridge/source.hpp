@@ -35,6 +35,8 @@ enum class ReadStatus {
   kFault,         // a transient fault (bus error, corrupt frame...); see the events; call again
   kDisconnected,  // the device is gone; call reconnect() until it returns ok
   kEnd,           // the stream ended (replay finished, simulation over)
+  kFailed,        // the stream cannot go on (a malformed row in a replayed log); see the events:
+                  // the session ends there, its log says it is incomplete
 };
 
 const char* to_string(ReadStatus s);
@@ -90,6 +92,8 @@ class SampleSource {
   virtual Status reconnect() { return Status::DeviceError(name() + ": cannot reconnect"); }
   /// Stops the stream and releases the device (safe to call twice).
   virtual void deactivate() = 0;
+  /// After kFailed: why the stream cannot go on.
+  virtual std::string failure() const { return "no cause given"; }
 
   /// Moves the events gathered since the last call into `out` (appends).
   void take_events(std::vector<SourceEvent>& out) {

@@ -5,6 +5,13 @@
 #include <stdexcept>
 #include <string_view>
 
+#ifdef DRIFTLESS_HAVE_BZ2
+#include <bzlib.h>
+#endif
+#ifdef DRIFTLESS_HAVE_LZ4
+#include <lz4frame.h>
+#endif
+
 namespace driftless::importers {
 namespace {
 
@@ -115,6 +122,56 @@ struct RecordReader {
 
 std::string str(std::string_view v) { return std::string(v.data() == nullptr ? "" : v); }
 
+// a chunk's compression ("none", "bz2", "lz4"); false when this build cannot undo it
+bool chunk_codec(const std::string& name, BagScan::Codec& out) {
+  if (name == "none") return out = BagScan::Codec::kNone, true;
+#ifdef DRIFTLESS_HAVE_BZ2
+  if (name == "bz2") return out = BagScan::Codec::kBz2, true;
+#endif
+#ifdef DRIFTLESS_HAVE_LZ4
+  if (name == "lz4") return out = BagScan::Codec::kLz4, true;
+#endif
+  return false;
+}
+
+// a chunk's data uncompressed into `plain` (exactly `size` bytes, as its header says); `fail`
+// throws naming the chunk
+template <class Fail>
+std::string_view decompress(BagScan::Codec codec, std::string_view in, std::uint32_t size, std::vector<char>& plain,
+                            Fail&& fail) {
+  plain.resize(size);
+#ifdef DRIFTLESS_HAVE_BZ2
+  if (codec == BagScan::Codec::kBz2) {
+    unsigned int got = size;
+    const int rc = BZ2_bzBuffToBuffDecompress(plain.data(), &got, const_cast<char*>(in.data()),
+                                              static_cast<unsigned int>(in.size()), 0, 0);
+    if (rc != BZ_OK || got != size) fail("bz2 chunk does not decompress to its " + std::to_string(size) + " bytes (bzip2 code " + std::to_string(rc) + ")");
+    return {plain.data(), size};
+  }
+#endif
+#ifdef DRIFTLESS_HAVE_LZ4
+  if (codec == BagScan::Codec::kLz4) {
+    // roslz4 writes the LZ4 frame format
+    LZ4F_dctx* ctx = nullptr;
+    if (LZ4F_isError(LZ4F_createDecompressionContext(&ctx, LZ4F_VERSION))) fail("lz4: no decompression context");
+    std::size_t out_pos = 0, in_pos = 0, hint = 1;
+    while (hint != 0 && in_pos < in.size() && out_pos <= size) {
+      std::size_t out_n = size - out_pos, in_n = in.size() - in_pos;
+      hint = LZ4F_decompress(ctx, plain.data() + out_pos, &out_n, in.data() + in_pos, &in_n, nullptr);
+      if (LZ4F_isError(hint)) break;
+      out_pos += out_n, in_pos += in_n;
+      if (out_n == 0 && in_n == 0) break;
+    }
+    LZ4F_freeDecompressionContext(ctx);
+    if (hint != 0 || out_pos != size) fail("lz4 chunk does not decompress to its " + std::to_string(size) + " bytes");
+    return {plain.data(), size};
+  }
+#endif
+  (void)codec, (void)in;
+  fail("chunk compression not supported by this build");
+  return {};
+}
+
 }  // namespace
 
 BagScan::~BagScan() {
@@ -217,10 +274,12 @@ std::unique_ptr<BagScan> BagScan::open(const std::filesystem::path& path, const 
     }
     rr.read_at(s->chunks_[k].pos, false);
     if (rr.fields().op() != kOpChunk) rr.fail(s->chunks_[k].pos, "expected a chunk record");
-    if (str(rr.fields().get("compression")) != "none") {
-      why = "compressed chunks (" + str(rr.fields().get("compression")) + ")";
+    const std::string comp = str(rr.fields().get("compression"));
+    if (!chunk_codec(comp, s->chunks_[k].codec)) {
+      why = "compressed chunks (" + comp + (comp == "bz2" || comp == "lz4" ? ": this build has no lib" + comp + ")" : ")");
       return nullptr;
     }
+    s->chunks_[k].plain_size = s->chunks_[k].codec == Codec::kNone ? 0 : rr.fields().num<std::uint32_t>("size", s->path_);
   }
   return s;
 }
@@ -245,10 +304,17 @@ void BagScan::load_group() {
 void BagScan::load_chunk(const Chunk& c) {
   RecordReader rr{file_, path_, buf_};
   rr.read_at(c.pos, true);
-  const std::string_view d = rr.data();
   const std::uint64_t base = c.pos + 8 + rr.header_len;
+  std::string_view d = rr.data();
+  if (c.codec != Codec::kNone) {
+    d = decompress(c.codec, d, c.plain_size, plain_, [&](const std::string& what) { rr.fail(c.pos, what); });
+  }
   for (std::size_t p = 0; p < d.size();) {
-    auto bad = [&](const std::string& what) { rr.fail(base + p, what); };
+    // a compressed chunk's records are located by their offset in the chunk's uncompressed data
+    auto bad = [&](const std::string& what) {
+      if (c.codec == Codec::kNone) rr.fail(base + p, what);
+      rr.fail(c.pos, "uncompressed offset " + std::to_string(p) + ": " + what);
+    };
     if (d.size() - p < 8) bad("truncated record in a chunk");
     const auto hl = load<std::uint32_t>(d.data() + p);
     if (hl > d.size() - p - 8) bad("truncated record header in a chunk");

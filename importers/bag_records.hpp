@@ -2,9 +2,10 @@
 // file's end (connections, chunk infos), then the chunks in file order, decoding only the
 // sensor_msgs/Imu messages of one connection. No ROS library: librosbag builds a time-sorted
 // index of every message at open and deserialises each message's header map, 1.2 us a message;
-// this reads a record in a few tens of ns. Only uncompressed bags with the topic on one
-// connection are read this way (BagScan::open says why not); the reader falls back to librosbag
-// otherwise. The messages and their order are those of rosbag::View.
+// this reads a record in a few tens of ns. Bags with the topic on one connection, their
+// chunks uncompressed, bz2 or lz4 (undone here with libbz2 / liblz4), are read this way
+// (BagScan::open says why not); the reader falls back to librosbag otherwise. The messages
+// and their order are those of rosbag::View.
 #pragma once
 
 #include <cstdint>
@@ -35,8 +36,10 @@ struct BagConnection {
 
 class BagScan {
  public:
+  /// A chunk's compression (bz2 and lz4 read when the build found libbz2 / liblz4).
+  enum class Codec : std::uint8_t { kNone, kBz2, kLz4 };
   /// Reads the bag's index. Returns nothing, with `why` set, when the direct path cannot give
-  /// rosbag::View's messages in its order: compressed chunks, no index (an unfinished bag), the
+  /// rosbag::View's messages in its order: chunks compressed in a way this build cannot undo, no index (an unfinished bag), the
   /// topic on several connections, chunks overlapping in time over more than 4 M messages. Throws std::runtime_error on a
   /// damaged file.
   static std::unique_ptr<BagScan> open(const std::filesystem::path& path, const std::string& topic, std::string& why);
@@ -62,6 +65,8 @@ class BagScan {
     std::uint64_t pos = 0;
     std::uint64_t start_ns = 0, end_ns = 0;
     std::uint32_t ours = 0;  // messages of our connection in it
+    Codec codec = Codec::kNone;
+    std::uint32_t plain_size = 0;  // bytes, uncompressed (compressed chunks)
   };
   BagScan() = default;
   // opens the file and reads the bag header: the index's position and size (false: why set)
@@ -80,6 +85,7 @@ class BagScan {
   std::vector<BagImu> pending_;  // the current chunk's messages not yet handed out
   std::size_t pending_pos_ = 0;
   std::vector<char> buf_;
+  std::vector<char> plain_;  // a compressed chunk's data, uncompressed
 };
 
 }  // namespace driftless::importers

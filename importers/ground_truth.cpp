@@ -1,6 +1,8 @@
 #include "importers/ground_truth.hpp"
 
 #include <algorithm>
+#include <array>
+#include <cctype>
 #include <cmath>
 #include <fstream>
 
@@ -16,9 +18,39 @@ constexpr const char* kLayout = "#timestamp [ns], p x y z [m], q w x y z (EuRoC 
 
 std::string where(const std::string& file, std::size_t line) { return file + ":" + std::to_string(line); }
 
+// The quaternion's order in columns 5..8 from the header's names: the axis letter each name ends in
+// (EuRoC " q_RS_w []", "qx", "q.w"), after its unit in brackets. EuRoC's w x y z unless the four names
+// spell another order of w, x, y, z (many tools write x y z w: read as w x y z that is another rotation,
+// with a norm of 1, so nothing else would notice). order[k]: the column (0..3) holding w, x, y, z.
+std::array<int, 4> quaternion_order(const std::string& header, std::string& said) {
+  std::vector<std::string_view> names;
+  split_fields(header, ',', names);
+  std::array<int, 4> order{0, 1, 2, 3};
+  said = "w x y z";
+  if (names.size() < 8) return order;
+  std::array<int, 4> found{-1, -1, -1, -1};
+  for (int c = 0; c < 4; ++c) {
+    std::string_view n = names[static_cast<std::size_t>(4 + c)];
+    n = n.substr(0, std::min(n.find('['), n.find('(')));
+    while (!n.empty() && (n.back() == ' ' || n.back() == '\t')) n.remove_suffix(1);
+    if (n.empty()) return order;
+    const char last = static_cast<char>(std::tolower(static_cast<unsigned char>(n.back())));
+    const auto k = std::string_view("wxyz").find(last);
+    if (k == std::string_view::npos || found[k] >= 0) return order;
+    found[k] = c;
+  }
+  said.clear();
+  for (int c = 0; c < 4; ++c) {
+    for (int k = 0; k < 4; ++k) {
+      if (found[static_cast<std::size_t>(k)] == c) said += std::string(said.empty() ? "" : " ") + "wxyz"[k];
+    }
+  }
+  return found;
+}
+
 // one data row into a pose; throws naming the line
 PoseStamp parse_pose(std::string_view line, const std::string& file, std::size_t line_no,
-                     std::vector<std::string_view>& fields) {
+                     std::vector<std::string_view>& fields, const std::array<int, 4>& q_order, const std::string& q_said) {
   split_fields(line, ',', fields);
   if (fields.size() < 8) {
     throw ImportError(where(file, line_no) + ": expected at least 8 fields (" + kLayout + "), got " +
@@ -36,11 +68,12 @@ PoseStamp parse_pose(std::string_view line, const std::string& file, std::size_t
     }
   }
   p.p_ref_m = Eigen::Vector3d(v[0], v[1], v[2]);
-  p.q_ref_from_body = Eigen::Quaterniond(v[3], v[4], v[5], v[6]);
+  const double* q = v + 3;
+  p.q_ref_from_body = Eigen::Quaterniond(q[q_order[0]], q[q_order[1]], q[q_order[2]], q[q_order[3]]);
   const double n = p.q_ref_from_body.norm();
   if (!(n > 0.5 && n < 1.5)) {
     throw ImportError(where(file, line_no) + ": quaternion norm " + std::to_string(n) +
-                      " is not close to 1 (columns 5..8 are q w x y z, scalar first)");
+                      " is not close to 1 (columns 5..8 are q " + q_said + ")");
   }
   p.q_ref_from_body.normalize();
   return p;
@@ -63,6 +96,7 @@ GroundTruth read_ground_truth(const std::filesystem::path& path) {
   std::string line;
   std::size_t line_no = 0;
   bool header = false;
+  std::array<int, 4> q_order{0, 1, 2, 3};
   std::vector<std::string_view> fields;
   while (std::getline(in, line)) {
     ++line_no;
@@ -73,10 +107,11 @@ GroundTruth read_ground_truth(const std::filesystem::path& path) {
         throw ImportError(where(gt.source, line_no) + ": expected the header " + kLayout + ", got '" + line.substr(0, 60) + "'");
       }
       header = true;
+      q_order = quaternion_order(line, gt.quaternion_order);
       continue;
     }
     if (line[0] == '#') continue;
-    const PoseStamp p = parse_pose(line, gt.source, line_no, fields);
+    const PoseStamp p = parse_pose(line, gt.source, line_no, fields, q_order, gt.quaternion_order);
     if (!gt.poses.empty() && p.t_ns <= gt.poses.back().t_ns) {
       throw ImportError(where(gt.source, line_no) + ": timestamp " + std::to_string(p.t_ns) +
                         " ns does not increase (previous " + std::to_string(gt.poses.back().t_ns) + " ns)");

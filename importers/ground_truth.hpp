@@ -27,9 +27,11 @@ struct GroundTruth {
   std::string source;
   std::vector<PoseStamp> poses;
   std::int64_t median_step_ns = 0;  // ns, the regular step (median)
+  std::string quaternion_order = "w x y z";  // the file's order of columns 5..8, from its header's names
 };
 
-/// Reads a EuRoC / Vicon ground-truth CSV. Throws ImportError naming the file and line: no
+/// Reads a EuRoC / Vicon ground-truth CSV (the quaternion's column order from the header's names:
+/// EuRoC's w x y z, or x y z w and others when the names end in those letters). Throws ImportError naming the file and line: no
 /// `#timestamp` header, a row with fewer than 8 fields or a non-number, a quaternion whose norm is
 /// not within 0.5..1.5, a stamp that does not increase, fewer than 2 rows.
 GroundTruth read_ground_truth(const std::filesystem::path& path);

@@ -21,6 +21,11 @@ double StampReport::mean_rate_hz() const {
   return static_cast<double>(rows - 1) / (last_t_s - first_t_s);
 }
 
+double StampReport::regular_rate_hz() const {
+  if (regular_steps == 0 || !(regular_sum_s > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+  return static_cast<double>(regular_steps) / regular_sum_s;
+}
+
 void StampMonitor::learn(std::span<const double> t) {
   std::vector<double> steps;
   for (std::size_t i = 1; i < t.size(); ++i) {
@@ -59,6 +64,8 @@ StampMonitor::Step StampMonitor::push(double t, std::uint64_t loc) {
     r_.missing += static_cast<std::uint64_t>(std::max(0.0, std::round(d / r_.step_s) - 1.0));
     return Step::kGap;
   }
+  ++r_.regular_steps;
+  r_.regular_sum_s += d;
   return Step::kRegular;
 }
 

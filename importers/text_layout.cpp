@@ -1,6 +1,9 @@
 #include "importers/text_layout.hpp"
 
+#include "estimator/log.hpp"
 #include "estimator/mpu6050.hpp"
+#include "estimator/sample.hpp"
+#include "importers/stamp_ns.hpp"
 
 #include <algorithm>
 #include <array>
@@ -16,6 +19,13 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kG = 9.80665;
+// the noisiest MEMS gyros' white noise (deg/s/sqrt(Hz)): 40x an MPU6050's 0.005, 4x an industrial unit's 0.05
+constexpr double kMaxGyroNoiseDensityDpsRtHz = 0.2;
+// the quietest MEMS gyros' (deg/s/sqrt(Hz)): navigation-grade MEMS reach 0.0015 (0.09 deg/sqrt(h)); below it
+// fibre-optic gyros
+constexpr double kMinMemsNoiseDensityDpsRtHz = 1e-3;
+// deg/s: the largest full scale of common MEMS gyros (the log format's default, docs/log-format.md)
+constexpr double kMaxGyroFullScaleDps = log::kDefaultGyroFullScaleDps;
 
 struct Line {
   std::string_view text;
@@ -134,9 +144,9 @@ constexpr std::array<const char*, 16> kGyroBases = {"g", "gyro", "gyr", "w", "om
 constexpr std::array<const char*, 13> kAccelBases = {"a", "acc", "accel", "alpha", "linear_acceleration",
                                                      "field_linear_acceleration", "a_rs_s", "accelerometer",
                                                      "accel1", "lin_acc", "acc_", "a_", "accel_"};
-constexpr std::array<const char*, 14> kTimeNames = {"t", "time", "sec", "secs", "seconds", "timestamp", "time_s",
+constexpr std::array<const char*, 18> kTimeNames = {"t", "time", "sec", "secs", "seconds", "timestamp", "time_s",
                                                     "stamp", "t_s", "field_header_stamp", "time_ns", "timestamp_ns",
-                                                    "time_us", "t_ns"};
+                                                    "time_us", "t_ns", "t_ms", "t_us", "millis", "micros"};
 constexpr std::array<const char*, 5> kTempNames = {"temp", "temperature", "temp_c", "temp1", "die_temp"};
 
 template <std::size_t N>
@@ -237,7 +247,12 @@ bool parse_field(std::string_view f, double& out) {
   const char* e = b + f.size();
   if (*b == '+') ++b;
   const auto r = fast_float::from_chars(b, e, out);
-  return r.ec == std::errc() && r.ptr == e;
+  if (r.ec == std::errc() && r.ptr == e) return true;
+  // a date and time, "2024-05-01 12:00:00.125": s since 1970 (the time column's stamps are read exactly)
+  std::int64_t ns = 0;
+  if (!parse_datetime_ns(b, e, ns)) return false;
+  out = static_cast<double>(ns) * 1e-9;
+  return true;
 }
 
 // ---- the layout: separator, rows, header, columns, units, time ----
@@ -256,7 +271,13 @@ std::vector<std::string> header_before(const std::vector<Line>& lines, std::size
     if (f.size() != fields || numeric_row(t, sep, f)) return {};
     split_fields(t, sep, f);
     notes.push_back("header at line " + std::to_string(lines[i].number));
-    return {f.begin(), f.end()};
+    std::vector<std::string> names;
+    for (auto n : f) {
+      // "Time (s)" as spreadsheets, R and phyphox quote it
+      if (n.size() >= 2 && n.front() == '"' && n.back() == '"') n = trim(n.substr(1, n.size() - 2));
+      names.emplace_back(n);
+    }
+    return names;
   }
   return {};
 }
@@ -303,6 +324,19 @@ void pick_time(TextLayout& L, const ImportOptions& opt, const std::string& file,
     L.time_index = 0;
     L.assumptions.push_back("no header: column 1 taken as the time");
   }
+}
+
+// a time column of dates and times is read as UTC seconds: said, with the first row's text
+void say_datetime_time(TextLayout& L, std::string_view first_row) {
+  if (L.time_index < 0) return;
+  std::vector<std::string_view> f;
+  split_fields(first_row, L.separator, f);
+  if (static_cast<std::size_t>(L.time_index) >= f.size()) return;
+  const auto v = f[static_cast<std::size_t>(L.time_index)];
+  std::int64_t ns = 0;
+  if (!parse_datetime_ns(v.data(), v.data() + v.size(), ns)) return;
+  L.assumptions.push_back("time column '" + column_name(L, L.time_index) + "' holds dates and times ('" + std::string(v) +
+                          "'): read as UTC, to the ns (no zone given: UTC)");
 }
 
 // rate (and accel) columns from the options, the header names, or the column count
@@ -387,22 +421,23 @@ void check_positional_swap(TextLayout& L, const std::vector<std::vector<double>>
   }
 }
 
-// the unit of the rate channels: option, header, EuRoC, raw counts, SI file, else deg/s
+// the unit of the rate channels: option, header, EuRoC, raw counts, SI file, else deg/s. `from_name`:
+// the unit was written in a header name.
 Unit rate_unit(const TextLayout& L, const ImportOptions& opt, const std::vector<std::vector<double>>& rows, bool euroc,
-               const std::string& file, bool accel_in_si) {
+               bool accel_in_si, bool& from_name) {
+  from_name = false;
   if (!opt.units.empty()) return parse_rate_unit(opt.units, "--units");
   for (const auto& p : L.picks) {
     if (p.channel.quantity != Quantity::kRate) continue;
-    if (auto u = unit_in_name(p.channel.name, Quantity::kRate)) return *u;
+    if (auto u = unit_in_name(p.channel.name, Quantity::kRate)) return from_name = true, *u;
   }
-  (void)file;
-  if (euroc) return {57.295779513082320876798, "rad/s"};
+  if (euroc) return {kDegPerRad, "rad/s"};
   const auto g = triad(L, Quantity::kRate);
   if (complete(g)) {
     const Stats s = triad_stats(rows, g);
     if (s.integers && s.max_abs > 20.0) return {1.0 / mpu6050::gyro_lsb_per_dps(0), "lsb:131"};
   }
-  if (accel_in_si) return {57.295779513082320876798, "rad/s"};
+  if (accel_in_si) return {kDegPerRad, "rad/s"};
   return {1.0, "deg/s"};
 }
 
@@ -435,15 +470,103 @@ void scale_picks(TextLayout& L, const Unit& rate, const Unit& accel) {
   }
 }
 
-void pick_units(TextLayout& L, const ImportOptions& opt, const std::vector<std::vector<double>>& rows, bool euroc,
-                const std::string& file) {
+// the sample rate the first rows show (Hz): the file's own, else the median stamp step; 0 when unknown
+double head_rate_hz(const TextLayout& L, const std::vector<std::vector<double>>& rows) {
+  if (L.nominal_rate_hz > 0.0) return L.nominal_rate_hz;
+  if (L.time_index < 0) return 0.0;
+  std::vector<double> steps;
+  for (std::size_t i = 1; i < rows.size(); ++i) {
+    const double d = rows[i][static_cast<std::size_t>(L.time_index)] - rows[i - 1][static_cast<std::size_t>(L.time_index)];
+    if (d > 0.0) steps.push_back(d * L.time_scale);
+  }
+  if (steps.empty()) return 0.0;
+  std::nth_element(steps.begin(), steps.begin() + static_cast<std::ptrdiff_t>(steps.size() / 2), steps.end());
+  return 1.0 / steps[steps.size() / 2];
+}
+
+// the white noise (deg/s/sqrt(Hz)) of a triad as read, from the median first difference of the first rows
+// (robust to motion): median |difference| = 0.6745 sqrt(2) sigma of a sample; N = sigma / sqrt(fs). NaN when
+// the rows cannot tell; `rate_hz` the rate used (the file's or the stamps'; 1 kHz, the fastest common rate and
+// so the smallest density, when unknown).
+double white_density(const TextLayout& L, const std::vector<std::vector<double>>& rows, double& rate_hz) {
+  const auto g = triad(L, Quantity::kRate);
+  rate_hz = head_rate_hz(L, rows);
+  if (!complete(g) || rows.size() < 3) return kNaN;
+  std::vector<double> diffs;
+  for (std::size_t i = 1; i < rows.size(); ++i) {
+    for (const int k : g) {
+      const double d = rows[i][static_cast<std::size_t>(k)] - rows[i - 1][static_cast<std::size_t>(k)];
+      if (std::isfinite(d)) diffs.push_back(std::fabs(d));
+    }
+  }
+  if (diffs.empty()) return kNaN;
+  std::nth_element(diffs.begin(), diffs.begin() + static_cast<std::ptrdiff_t>(diffs.size() / 2), diffs.end());
+  return diffs[diffs.size() / 2] / (0.6745 * std::sqrt(2.0)) / std::sqrt(rate_hz > 0.0 ? rate_hz : 1000.0);
+}
+
+// a deg/s guess whose white noise lies below every MEMS gyro's: a fibre-optic gyro, or a MEMS file in rad/s
+std::string deg_s_too_quiet(const TextLayout& L, const std::vector<std::vector<double>>& rows) {
+  double rate = 0.0;
+  const double n = white_density(L, rows, rate);
+  if (!(n > 0.0) || n >= kMinMemsNoiseDensityDpsRtHz || rate <= 0.0) return {};
+  char b[240];
+  std::snprintf(b, sizeof b,
+                "; as deg/s the white noise is %.3g deg/s/sqrt(Hz), below every MEMS gyro's (%.2g and up): a "
+                "fibre-optic gyro, or a MEMS file in rad/s (then %.3g): give --units",
+                n, kMinMemsNoiseDensityDpsRtHz, n * kDegPerRad);
+  return b;
+}
+
+// An SI file's rates are a guess from its accelerometer (m/s^2); a file in deg/s with an accelerometer in m/s^2
+// read as rad/s gives a white noise 57x too large. The guess stands unless the rates read as rad/s are beyond
+// every MEMS gyro: a white-noise density above kMaxGyroNoiseDensityDpsRtHz (from the median first difference of
+// the first rows, robust to motion) or a reading beyond the full scale of common MEMS gyros. Empty: the guess
+// stands; else the reason to read deg/s instead.
+std::string rad_s_implausible(const TextLayout& L, const std::vector<std::vector<double>>& rows) {
+  const auto g = triad(L, Quantity::kRate);
+  if (!complete(g)) return {};
+  double max_abs = 0.0;
+  for (const auto& r : rows) {
+    for (const int k : g) {
+      if (std::isfinite(r[static_cast<std::size_t>(k)])) max_abs = std::max(max_abs, std::fabs(r[static_cast<std::size_t>(k)]));
+    }
+  }
+  char b[320];
+  if (max_abs * kDegPerRad > kMaxGyroFullScaleDps) {
+    std::snprintf(b, sizeof b, "as rad/s a reading would be %.0f deg/s, beyond the +-%.0f deg/s of any MEMS gyro",
+                  max_abs * kDegPerRad, kMaxGyroFullScaleDps);
+    return b;
+  }
+  double rate = 0.0;
+  const double density_dps = white_density(L, rows, rate) * kDegPerRad;
+  if (!(density_dps > kMaxGyroNoiseDensityDpsRtHz)) return {};
+  std::snprintf(b, sizeof b,
+                "as rad/s its white noise would be %.3g deg/s/sqrt(Hz)%s, over the %.2g of the noisiest MEMS gyros "
+                "(an MPU6050 has 0.005); as deg/s it is %.3g",
+                density_dps, rate > 0.0 ? "" : " (at an assumed 1 kHz)", kMaxGyroNoiseDensityDpsRtHz, density_dps / kDegPerRad);
+  return b;
+}
+
+void pick_units(TextLayout& L, const ImportOptions& opt, const std::vector<std::vector<double>>& rows, bool euroc) {
   const bool has_accel = complete(triad(L, Quantity::kAccel));
   const Unit au = accel_unit(L, opt, rows, euroc);
   const bool accel_si = has_accel && au.name == "m/s^2" && std::fabs(triad_stats(rows, triad(L, Quantity::kAccel)).mean_norm - kG) < 1.5;
-  const Unit ru = rate_unit(L, opt, rows, euroc, file, accel_si);
-  std::string how = how_unit(ru.name, !opt.units.empty(), "rates");
-  if (opt.units.empty() && ru.name == "rad/s" && accel_si && !euroc) how = "rates in rad/s: the accelerometer reads g in m/s^2, an SI file (give --units to change)";
-  if (opt.units.empty() && ru.name == "deg/s" && !euroc) how = "rates in deg/s: no unit given or written in the header (give --units rad/s if not)";
+  bool from_name = false;
+  Unit ru = rate_unit(L, opt, rows, euroc, accel_si, from_name);
+  const bool guessed = opt.units.empty() && !from_name && !euroc;
+  std::string how = from_name ? "rates in " + ru.name + " (from the header)" : how_unit(ru.name, !opt.units.empty(), "rates");
+  if (guessed && ru.name == "rad/s") {
+    const std::string why = rad_s_implausible(L, rows);
+    if (why.empty()) {
+      how = "rates in rad/s: the accelerometer reads g in m/s^2, an SI file (give --units to change)";
+    } else {
+      ru = {1.0, "deg/s"};
+      how = "rates in deg/s, although the accelerometer reads g in m/s^2 (an SI file would have rad/s): " + why +
+            " (give --units rad/s to change)";
+    }
+  } else if (guessed && ru.name == "deg/s") {
+    how = "rates in deg/s: no unit given or written in the header (give --units rad/s if not)" + deg_s_too_quiet(L, rows);
+  }
   L.assumptions.push_back(how);
   if (has_accel) L.assumptions.push_back(how_unit(au.name, !opt.accel_units.empty(), "accelerations"));
   scale_picks(L, ru, au);
@@ -459,6 +582,12 @@ void pick_time_unit(TextLayout& L, const ImportOptions& opt, const std::vector<s
   if (auto u = time_unit_in_name(name)) {
     L.time_scale = u->scale;
     L.assumptions.push_back("time column '" + name + "' in " + u->name + " (from its name)");
+    return;
+  }
+  // Arduino sketches log millis() or micros(), the board's clock in whole ms or us
+  if (const std::string n = normalise(name); n == "millis" || n == "micros") {
+    L.time_scale = n == "millis" ? 1e-3 : 1e-6;
+    L.assumptions.push_back("time column '" + name + "' in " + (n == "millis" ? "ms" : "us") + " (Arduino's " + n + "())");
     return;
   }
   if (euroc) {
@@ -504,6 +633,7 @@ TextLayout detect_text_layout(std::string_view head, const std::string& file, co
   const auto rows = sample_rows(lines, start, L.separator, L.fields);
   const bool positional = L.header.empty() && opt.columns.empty() && !opt.all_columns;
   pick_time(L, opt, file, positional);
+  say_datetime_time(L, lines[start].text);
   if (!pick_channels(L, opt, file)) {
     if (!positional || !pick_positional(L)) {
       std::string names;
@@ -514,8 +644,8 @@ TextLayout detect_text_layout(std::string_view head, const std::string& file, co
     }
     check_positional_swap(L, rows);
   }
-  pick_units(L, opt, rows, euroc, file);
-  pick_time_unit(L, opt, rows, euroc);
+  pick_time_unit(L, opt, rows, euroc);  // first: the rate checks the unit of the rates
+  pick_units(L, opt, rows, euroc);
   if (L.time_index < 0) L.assumptions.push_back("no time column: the rate must come from the file or --rate");
   return L;
 }

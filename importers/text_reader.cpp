@@ -141,7 +141,27 @@ TextReader::TextReader(const std::filesystem::path& path, const ImportOptions& o
   if (layout_.time_index >= 0) slot_[static_cast<std::size_t>(layout_.time_index)] = kTimeSlot;
   if (info_.has_time) set_epoch(head);
   std::rewind(file_);
-  if (map_file()) eof_ = true, len_ = map_bytes_;
+  if (map_file()) {
+    eof_ = true;
+    len_ = map_bytes_ - cut_tail_bytes();
+  }
+}
+
+// A recording stopped mid-write (a crash, a power cut, a copy of a file still being written) ends in a
+// line without its line end and with fewer fields than the rows: that line is left out and said. Any
+// other malformed line stays an error; a last line without a line end but with every field is a row.
+std::size_t TextReader::cut_tail_bytes() {
+  if (map_bytes_ == 0 || map_[map_bytes_ - 1] == '\n') return 0;
+  const char* e = map_ + map_bytes_;
+  const char* b = e;
+  while (b > map_ && b[-1] != '\n') --b;
+  if (b == map_) return 0;  // one line only: the layout has already refused or taken it
+  std::vector<std::string_view> f;
+  split_fields(std::string_view(b, static_cast<std::size_t>(e - b)), layout_.separator, f);
+  if (f.empty() || f.size() >= layout_.fields) return 0;
+  info_.assumptions.push_back("the last line is cut off (no line end, " + std::to_string(f.size()) + " of " +
+                              std::to_string(layout_.fields) + " fields: a recording stopped mid-write): left out");
+  return static_cast<std::size_t>(e - b);
 }
 
 TextReader::~TextReader() {

@@ -27,6 +27,9 @@ class TextReader : public ImuReader {
   void refill();
   /// Maps a regular file whole (read-only); false when it cannot be mapped (a pipe, an empty file).
   bool map_file();
+  /// Bytes of a last line cut off mid-write (no line end, too few fields) to leave out, said in the
+  /// assumptions; 0 when the mapped file ends in a whole row.
+  std::size_t cut_tail_bytes();
   /// Gives back the mapped pages already parsed (the page cache keeps them; RSS stays bounded).
   void release_parsed();
   const char* data() const { return map_ != nullptr ? map_ : buf_.get(); }

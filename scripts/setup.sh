@@ -9,6 +9,7 @@ packages=(
   ffmpeg gnuplot-nox openmpi-bin libopenmpi-dev
   clang libclang-rt-14-dev  # libFuzzer harnesses (tests/fuzz, CI)
   librosbag-dev libsensor-msgs-dev
+  libbz2-dev liblz4-dev  # compressed bag chunks read directly (importers/bag_records.cpp)
   chromium  # the look test (tests/cli/look.sh) opens the report and the figures headless
   python3-numpy  # the independent log generator of the diagnose tests (tests/diagnose/independent_log.py)
 )

@@ -64,6 +64,10 @@ jq -e '.channels.gyro_x.validation.records == 3 and (.channels.gyro_x.validation
   || fail "round trip"
 grep -q "round trip" "$t/x.txt" || fail "round-trip verdict not printed"
 if command -v gnuplot > /dev/null; then [[ -s $t/x/allan_gyro_x.png ]] || fail "channel plot"; fi
+# the overview's axis names the units the deviations are in, and B_min's text stays inside the
+# frame: its minimum lies in the upper half of the taus, so the text is set to its left
+grep -q "set ylabel 'adev \[deg/s\]'" "$t/x/allan.gp" || fail "overview y axis: $(grep ylabel "$t/x/allan.gp")"
+grep -Eq "set label 1 at [0-9.e+-]+,[0-9.e+-]+ right point" "$t/x/allan_gyro_x.gp" || fail "B_min label: $(grep 'label 1' "$t/x/allan_gyro_x.gp")"
 
 # regular stamps with a gap: gap-aware by default, joined with --gaps ignore
 awk 'BEGIN { print "t,gx"; srand(3); for (i = 0; i < 6000; ++i) { if (i == 3000) i += 50; printf "%.3f,%.6f\n", i / 100, rand() - 0.5 } }' > "$t/gap.csv"

@@ -30,6 +30,17 @@ grep -q "sample interval: 0.010000 .. 0.010000 s" "$out/b.check" || fail "switch
 [ "$(grep -c '^# event: t=49.990000 switch: replay:.* -> emu-i2c' "$out/b/log.csv")" = 1 ] || fail "switch: no event line"
 grep -q "^50.000000," "$out/b/log.csv" || fail "switch: no row at t = 50 s"
 
+# a replayed log with a damaged row: the session stops there, exits non-zero naming file:line, and
+# its log keeps the rows before and says it is incomplete
+awk -F, '$1 == "30.000000" { $2 = "x" } 1' OFS=, "$out/a/log.csv" > "$out/damaged.csv"
+line=$(grep -n '^30.000000,' "$out/damaged.csv" | cut -d: -f1)
+if "$bin" hil --source "replay:$out/damaged.csv" --out "$out/dmg" > "$out/dmg.txt" 2> "$out/dmg.err"; then
+  fail "damaged replay: exit 0"
+fi
+grep -q "damaged.csv:$line: column 'gyro1_x'" "$out/dmg.err" || fail "damaged replay: cause not named: $(cat "$out/dmg.err")"
+grep -q "^# incomplete: replay:.*damaged.csv:$line" "$out/dmg/log.csv" || fail "damaged replay: log does not say it is incomplete"
+[ "$(grep -c '^[0-9]' "$out/dmg/log.csv")" = 3000 ] || fail "damaged replay: the 3000 rows before the damage are not all kept"
+
 # the twin, then emulated hardware from t = 20 s; and emu-i2c driven by the twin's sensor model
 "$bin" hil --source twin --switch-to emu-i2c --at 20 --duration 40 --out "$out/t" > "$out/t.txt"
 "$bin" check --log "$out/t/log.csv" > "$out/t.check"

@@ -54,8 +54,8 @@ struct SynthParams {
   // sensor errors beyond the paper's (zero = its ideal sensor); true_bias holds b + k (T - T0)
   std::array<Eigen::Matrix3d, 2> G_dps_per_g{Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero()};
   std::array<Eigen::Vector3d, 2> temp_coef_dps_per_degc{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
-  // scale-factor and misalignment error per sensor (fraction): y_i += E_i (R_i^T w), w the box's
-  // inertial rate (hinge rates excluded: they are zero at every standstill)
+  // scale-factor and misalignment error per sensor (fraction): y_i += E_i (R_i^T w + thetadot_i a_i),
+  // w the box's inertial rate: the sensor scales whatever turns it, the flips included
   std::array<Eigen::Matrix3d, 2> E_frac{Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero()};
   double temp0_c = 25.0, temp_rise_c = 0.0, temp_tau_s = 600.0;  // T = T0 + rise (1 - e^-t/tau), degC
   bool write_accel_temp = false;  // log accel (m/s^2, sensor axes) and temperature columns
@@ -146,8 +146,8 @@ inline void synth_samples(const SynthParams& p, const std::function<void(const S
     s.gyro1_dps = R1.transpose() * w + w1 * p.hinge1.normalized() + b1 + p.G_dps_per_g[0] * f1;
     s.gyro2_dps = R2.transpose() * w + w2 * p.hinge2.normalized() + b2 + p.G_dps_per_g[1] * f2;
     if (!p.E_frac[0].isZero(0.0) || !p.E_frac[1].isZero(0.0)) {
-      s.gyro1_dps += p.E_frac[0] * (R1.transpose() * w);
-      s.gyro2_dps += p.E_frac[1] * (R2.transpose() * w);
+      s.gyro1_dps += p.E_frac[0] * (R1.transpose() * w + w1 * p.hinge1.normalized());
+      s.gyro2_dps += p.E_frac[1] * (R2.transpose() * w + w2 * p.hinge2.normalized());
     }
     if (p.write_accel_temp) {
       s.accel1_mps2 = f1 * kStandardGravityMps2;

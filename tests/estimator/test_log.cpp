@@ -380,3 +380,39 @@ TEST(LogTest, RefusedHeadersLeakNoFileDescriptor) {
 
 }  // namespace
 }  // namespace driftless::log
+
+namespace driftless::log {
+namespace {
+
+TEST(LogTest, ForeignRecordIsToldToConvertAndACutCompleteLogSaysWhy) {
+  // GIVEN a recording another tool wrote (no '# format:' line, its own columns)
+  const auto foreign = temp_file("foreign.csv");
+  write_text(foreign, "time,gx,gy,gz\n0,1,2,3\n0.01,1,2,3\n");
+  // THEN the refusal names the command that reads it
+  const std::string msg = message_of([&] { LogReader r(foreign); });
+  EXPECT_NE(msg.find("lacks required column(s)"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("driftless convert --in FILE --out LOG.csv"), std::string::npos) << msg;
+  // GIVEN a driftless log missing a column: no such hint (it is a log)
+  const auto own = temp_file("own.csv");
+  write_text(own, "# format: driftless-log 1\nt,gyro1_x,gyro1_y\n0,1,2\n");
+  EXPECT_EQ(message_of([&] { LogReader r(own); }).find("convert"), std::string::npos);
+  // GIVEN a log that says complete: true but whose last row was cut mid-write (no line end)
+  const auto cut = temp_file("cut_complete.csv");
+  write_text(cut,
+             "# format: driftless-log 1\n# complete: true\n"
+             "t,gyro1_x,gyro1_y,gyro1_z,gyro2_x,gyro2_y,gyro2_z,plat1_deg,plat2_deg\n"
+             "0.00,1,2,3,4,5,6,90,90\n0.01,1,2,3,4,5");
+  const std::string why = message_of([&] {
+    LogReader r(cut);
+    Sample s;
+    while (r.next(s)) {
+    }
+  });
+  // THEN the error names the line, and says it is the unterminated last line of a log claiming completeness
+  EXPECT_NE(why.find(":5: expected 9 fields as in the header, got 6; it is the last line and has no line end"),
+            std::string::npos) << why;
+  EXPECT_NE(why.find("complete: true"), std::string::npos) << why;
+}
+
+}  // namespace
+}  // namespace driftless::log

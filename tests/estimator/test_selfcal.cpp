@@ -78,7 +78,8 @@ TEST(SelfCalTest, TheVerticalCommonModeNeedsTheBoxAtRest) {
   cfg.box_dwell_updates = false;
   const DriftlessFilter free_box = run(p, cfg);
   EXPECT_GT(free_box.g_sensitivity_sigma_dps_per_g(2)(1, 1), 0.7 * cfg.gsens_sigma_dps_per_g);
-  EXPECT_GT(free_box.correction_sigma_dps()[2], 0.05);
+  // (the flip updates, section 1f, see gravity at the platform's intermediate angles: a little)
+  EXPECT_GT(free_box.correction_sigma_dps()[2], 0.03);
   EXPECT_EQ(free_box.counters().box_dwell_updates, 0u);
   for (const bool at_rest : {true, false}) {
     EstimatorConfig c = config(true);
@@ -221,14 +222,22 @@ TEST(SelfCalTest, ScaleAndMisalignmentOnATurningBoxAreRecovered) {
 }
 
 // GIVEN the static box (only the Earth rate, 0.004 deg/s, turns it) WHEN the self-calibrating
-// filter runs THEN every scale/misalignment element keeps (within 10 %: 30 updates of the Earth
-// rate against 0.0016 deg/s of noise give 1.5 %) its prior sigma and stays near 0 (the bias
-// error of the first standstills must not pass for a rate)
+// filter runs THEN every scale/misalignment element off the hinge columns keeps (within 10 %: 30
+// updates of the Earth rate against 0.0016 deg/s of noise give 1.5 %) its prior sigma and every
+// element stays near 0 (the bias error of the first standstills must not pass for a rate); the
+// hinge columns (E1 . z, E2 . x) are what the flips measure (section 1f, test_flip_update.cpp)
 TEST(SelfCalTest, ScaleAndMisalignmentOnAStaticBoxKeepTheirPrior) {
   const EstimatorConfig cfg = config(true);
   const DriftlessFilter f = run(static_box(10.0), cfg);
   for (int i = 1; i <= 2; ++i) {
-    EXPECT_GT(f.scale_misalign_sigma(i).minCoeff(), 0.9 * cfg.scale_misalign_sigma_frac) << i;
+    const int hinge_col = i == 1 ? 2 : 0;
+    const Eigen::Matrix3d S = f.scale_misalign_sigma(i);
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) {
+        if (c == hinge_col) continue;
+        EXPECT_GT(S(r, c), 0.9 * cfg.scale_misalign_sigma_frac) << i << " " << r << " " << c;
+      }
+    }
     EXPECT_LT(f.scale_misalign(i).cwiseAbs().maxCoeff(), 1e-3) << i;
   }
 }

@@ -2,19 +2,30 @@
 # Builds the libFuzzer harnesses with clang (only the sources each needs) and runs each for a
 # bounded time on a copy of its corpus (tests/fuzz/corpus/<name>). Any crash, sanitizer report,
 # timeout or out-of-memory is a finding: the script prints it and exits 1.
-# Usage: tests/fuzz/run.sh [BUILD_DIR] [SECONDS_PER_HARNESS]
+# Usage: tests/fuzz/run.sh [BUILD_DIR] [SECONDS_PER_HARNESS] [all|build|run]
+#   all (default): build, then run; build: only configure and build (CI builds the harnesses beside
+#   the Release pass); run: only run the harnesses already built in BUILD_DIR
 set -euo pipefail
 root=$(cd "$(dirname "$0")/../.." && pwd)
 build=${1:-"$root/build-fuzz"}
 seconds=${2:-15}
-command -v clang++ >/dev/null || { echo "fuzz: clang++ not found (scripts/setup.sh installs clang)"; exit 1; }
-export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$root} CCACHE_NOHASHDIR=${CCACHE_NOHASHDIR:-1}
-CC=clang CXX=clang++ cmake -S "$root/tests/fuzz" -B "$build" -DCMAKE_BUILD_TYPE=None >/dev/null
-cmake --build "$build" -j "$(nproc 2>/dev/null || echo 2)"
+step=${3:-all}
+case $step in
+  all|build|run) ;;
+  *) echo "fuzz: step '$step': expected all, build or run" >&2; exit 2 ;;
+esac
+if [[ $step != run ]]; then
+  command -v clang++ >/dev/null || { echo "fuzz: clang++ not found (scripts/setup.sh installs clang)"; exit 1; }
+  export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$root} CCACHE_NOHASHDIR=${CCACHE_NOHASHDIR:-1}
+  CC=clang CXX=clang++ cmake -S "$root/tests/fuzz" -B "$build" -DCMAKE_BUILD_TYPE=None >/dev/null
+  cmake --build "$build" -j "$(nproc 2>/dev/null || echo 2)"
+fi
+[[ $step == build ]] && exit 0
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 # one harness per core at a time: each runs single-threaded for its bounded time, so the stage takes
-# about ceil(harnesses / cores) x SECONDS instead of harnesses x SECONDS
+# about ceil(harnesses / cores) x SECONDS instead of harnesses x SECONDS. DRIFTLESS_FUZZ_JOBS sets
+# how many at once (CI: 1, beside the sanitizer suite, which keeps the other core)
 fuzz_one() {
   local name=$1 corpus=$2
   local work="$build/work/$name" log="$build/$name.log"
@@ -27,7 +38,8 @@ fuzz_one() {
     echo "fuzz $name: FINDING (full log: $log)"; tail -40 "$log"; return 1
   fi
 }
-cores=$(nproc 2>/dev/null || echo 2)
+cores=${DRIFTLESS_FUZZ_JOBS:-$(nproc 2>/dev/null || echo 2)}
+[[ $cores =~ ^[1-9][0-9]*$ ]] || { echo "fuzz: DRIFTLESS_FUZZ_JOBS='$cores': expected a positive whole number" >&2; exit 2; }
 status=0
 pids=()
 for corpus in "$root"/tests/fuzz/corpus/*/; do

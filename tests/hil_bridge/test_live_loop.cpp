@@ -4,10 +4,13 @@
 // filter object carries its state across the switch.
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -116,20 +119,23 @@ TEST(LiveLoop, EmulatedI2cRunConvergesAndLogsEveryRow) {
   fs::remove(path);
 }
 
+// a log of `duration_s` recorded from emulated sensors with flipping platforms, to be replayed
+void record_emu_log(const fs::path& path, std::uint64_t seed, double duration_s) {
+  EmuRig rig(seed);
+  ASSERT_TRUE(rig.src.configure().ok());
+  log::LogWriter writer(path, box_meta(), rig.src.fields());
+  LiveParams lp;
+  lp.duration_s = duration_s;
+  LiveLoop loop(lp, rig.clock, &writer, nullptr);
+  loop.set_motors(&rig.src, &rig.motors, &rig.schedule);
+  std::atomic<bool> stop{false};
+  writer.finish(loop.run(rig.src, nullptr, stop).complete);
+}
+
 TEST(LiveLoop, SwitchOverKeepsTheEstimatorAndLosesNoSample) {
   // GIVEN a recorded log (the "simulation") and emulated hardware
   const fs::path rec = temp_file("recorded.csv");
-  {
-    EmuRig rig(7);
-    ASSERT_TRUE(rig.src.configure().ok());
-    log::LogWriter writer(rec, box_meta(), rig.src.fields());
-    LiveParams lp;
-    lp.duration_s = 60.0;
-    LiveLoop loop(lp, rig.clock, &writer, nullptr);
-    loop.set_motors(&rig.src, &rig.motors, &rig.schedule);
-    std::atomic<bool> stop{false};
-    writer.finish(loop.run(rig.src, nullptr, stop).complete);
-  }
+  ASSERT_NO_FATAL_FAILURE(record_emu_log(rec, 7, 60.0));
   VirtualClock replay_clock;
   ReplaySource replay(replay_clock, {rec.string(), false, 1.0});
   ASSERT_TRUE(replay.configure().ok());
@@ -187,6 +193,45 @@ TEST(LiveLoop, SwitchOverKeepsTheEstimatorAndLosesNoSample) {
   EXPECT_EQ(filter.counters().source_switches, 1u);
   fs::remove(rec);
   fs::remove(path);
+}
+
+TEST(LiveLoop, AMalformedRowInAReplayEndsTheSessionIncompleteAndSaysWhere) {
+  // GIVEN a recorded log of 20 s whose row at t = 10 s is damaged (a field that is not a number)
+  const fs::path rec = temp_file("damaged.csv");
+  ASSERT_NO_FATAL_FAILURE(record_emu_log(rec, 9, 20.0));
+  std::string text;
+  {
+    std::ifstream in(rec);
+    text.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  const std::size_t row = text.find("\n10.000000,");
+  ASSERT_NE(row, std::string::npos);
+  const std::size_t field = text.find(',', row + 1);
+  text.replace(field + 1, 1, "x");
+  std::ofstream(rec, std::ios::trunc) << text;
+  const std::size_t damaged_line = 1 + static_cast<std::size_t>(std::count(text.begin(), text.begin() + row + 1, '\n'));
+
+  // WHEN it is replayed into a session
+  VirtualClock clock;
+  ReplaySource replay(clock, {rec.string(), false, 1.0});
+  ASSERT_TRUE(replay.configure().ok());
+  LiveParams lp;
+  LiveLoop loop(lp, clock, nullptr, nullptr);
+  std::vector<std::string> events;
+  loop.on_event([&](double, const std::string& e) { events.push_back(e); });
+  std::atomic<bool> stop{false};
+  const LiveStats st = loop.run(replay, nullptr, stop);
+
+  // THEN the rows before it stand, and the session is incomplete with the file and line as its cause
+  EXPECT_EQ(st.samples, 1000u);
+  EXPECT_FALSE(st.complete);
+  const std::string where = rec.string() + ":" + std::to_string(damaged_line);
+  EXPECT_NE(st.end_reason.find("failed"), std::string::npos) << st.end_reason;
+  EXPECT_NE(st.end_reason.find(where), std::string::npos) << st.end_reason << " (expected " << where << ")";
+  EXPECT_EQ(st.faults, 1u);
+  ASSERT_FALSE(events.empty());
+  EXPECT_NE(events.back().find(where), std::string::npos) << events.back();
+  fs::remove(rec);
 }
 
 TEST(LiveLoop, FaultsBecomeEventLinesAndGapsNeverCloseSilently) {

@@ -1,6 +1,8 @@
 // ROS 1 bags: written in the test with librosbag from the real recording, read back through the
-// importer; topic choice, receive times, and files that are no bag. C++17 (ROS 1 headers).
+// importer; uncompressed, bz2 and lz4 chunks; topic choice, receive times, and files that are no
+// bag. C++17 (ROS 1 headers).
 #include <cmath>
+#include <fstream>
 
 #include <gtest/gtest.h>
 
@@ -8,10 +10,12 @@
 
 #ifdef DRIFTLESS_HAVE_ROSBAG
 #include <rosbag/bag.h>
+#include <rosbag/view.h>
 #include <sensor_msgs/Imu.h>
 #include <std_msgs/Float64.h>
 
 #include "importers/bag_records.hpp"
+#include "importers/stamp_ns.hpp"
 #endif
 
 namespace driftless::importers::test {
@@ -61,12 +65,13 @@ TEST(BagImport, RealRecordingWrittenAsImuMessagesReadsBack) {
   }
 }
 
-// the same messages in two bags: chunks of `chunk_bytes`, uncompressed or bz2
-void write_pair(const std::filesystem::path& plain, const std::filesystem::path& bz2, int n) {
-  rosbag::Bag a(plain.string(), rosbag::bagmode::Write), b(bz2.string(), rosbag::bagmode::Write);
-  a.setChunkThreshold(16 * 1024);
-  b.setChunkThreshold(16 * 1024);
+// the same messages in three bags: chunks of 16 kB, uncompressed, bz2 and lz4
+void write_bags(const std::filesystem::path& dir, int n) {
+  rosbag::Bag a((dir / "plain.bag").string(), rosbag::bagmode::Write), b((dir / "bz2.bag").string(), rosbag::bagmode::Write),
+      c((dir / "lz4.bag").string(), rosbag::bagmode::Write);
+  for (rosbag::Bag* bag : {&a, &b, &c}) bag->setChunkThreshold(16 * 1024);
   b.setCompression(rosbag::compression::BZ2);
+  c.setCompression(rosbag::compression::LZ4);
   for (int i = 0; i < n; ++i) {
     const std::vector<double> r = {0, 0.01 * (i % 7), -0.02, 1.0 + 1e-3 * (i % 11), 0.1 * (i % 13), -0.3, 0.5 + 1e-4 * i, 25};
     // receive times: steps of 2.5 ms, every 50th message 1 ms before its predecessor, every
@@ -74,7 +79,7 @@ void write_pair(const std::filesystem::path& plain, const std::filesystem::path&
     const double t = 100.0 + 0.0025 * i - (i % 50 == 49 ? 0.0035 : 0.0) - (i % 70 == 69 ? 0.0025 : 0.0);
     sensor_msgs::Imu m = message(r, 0.0025 * i, false);
     m.header.frame_id = std::string(static_cast<std::size_t>(i % 5), 'f');  // headers of varying length
-    for (rosbag::Bag* bag : {&a, &b}) {
+    for (rosbag::Bag* bag : {&a, &b, &c}) {
       bag->write("/imu0", ros::Time(t), m);
       if (i % 3 == 0) {
         std_msgs::Float64 other;
@@ -85,38 +90,83 @@ void write_pair(const std::filesystem::path& plain, const std::filesystem::path&
   }
 }
 
-// GIVEN a bag written uncompressed (read directly, record by record) and the same messages
-// compressed (read by librosbag), with receive times out of order inside chunks, ties, varying
-// header lengths and a second topic, WHEN both are imported, THEN every sample, stamp and
-// message number is the same, in the same order
-TEST(BagImport, DirectReadingGivesLibrosbagsMessagesInItsOrder) {
+// GIVEN the same messages uncompressed, bz2 and lz4 (every chunk read directly, the compressed
+// ones undone here), with receive times out of order inside chunks, ties, varying header lengths
+// and a second topic, WHEN they are imported, THEN every sample, stamp and message number is the
+// same, in rosbag::View's order (read here through librosbag itself)
+TEST(BagImport, DirectReadingGivesLibrosbagsMessagesInItsOrderCompressedOrNot) {
   const auto dir = scratch("bag_direct");
-  write_pair(dir / "plain.bag", dir / "bz2.bag", 3000);
+  write_bags(dir, 3000);
   std::string why;
-  ASSERT_NE(BagScan::open(dir / "plain.bag", "/imu0", why), nullptr) << why;
-  EXPECT_EQ(BagScan::open(dir / "bz2.bag", "/imu0", why), nullptr);
-  EXPECT_EQ(why, "compressed chunks (bz2)");
+  for (const char* name : {"plain.bag", "bz2.bag", "lz4.bag"}) {
+    EXPECT_NE(BagScan::open(dir / name, "/imu0", why), nullptr) << name << ": " << why;
+  }
   EXPECT_EQ(BagScan::open(dir / "plain.bag", "/temperature", why), nullptr);
   EXPECT_EQ(why, "/temperature carries std_msgs/Float64");
-  auto direct = open_imu(dir / "plain.bag", {});
-  auto library = open_imu(dir / "bz2.bag", {});
-  EXPECT_EQ(direct->info().rows_estimate, 3000u);
-  EXPECT_EQ(direct->info().epoch_s, library->info().epoch_s);
-  EXPECT_EQ(direct->info().assumptions, library->info().assumptions);
-  const Table a = read_all(*direct, 777), b = read_all(*library, 1000);
+  // librosbag's view of the plain bag: the stamps' ns and the x rate in rad/s, in its order
+  std::vector<std::int64_t> view_ns;
+  std::vector<double> view_wx;
+  {
+    rosbag::Bag bag((dir / "plain.bag").string(), rosbag::bagmode::Read);
+    for (const rosbag::MessageInstance& mi : rosbag::View(bag, rosbag::TopicQuery("/imu0"))) {
+      const auto m = mi.instantiate<sensor_msgs::Imu>();
+      view_ns.push_back(static_cast<std::int64_t>(m->header.stamp.sec) * 1'000'000'000 + m->header.stamp.nsec);
+      view_wx.push_back(m->angular_velocity.x);
+    }
+  }
+  auto plain = open_imu(dir / "plain.bag", {});
+  const Table a = read_all(*plain, 777);
   ASSERT_EQ(a.t.size(), 3000u);
-  EXPECT_EQ(a.t, b.t);
-  EXPECT_EQ(a.ch, b.ch);
-  EXPECT_EQ(a.loc, b.loc);
+  ASSERT_EQ(view_ns.size(), 3000u);
+  EXPECT_EQ(plain->info().rows_estimate, 3000u);
+  for (std::size_t i = 0; i < a.t.size(); ++i) {
+    ASSERT_EQ(a.t[i], seconds_since(view_ns[i], plain->info().epoch_s)) << i;
+    ASSERT_EQ(a.ch[0][i], view_wx[i] * kDegPerRad) << i;
+    ASSERT_EQ(a.loc[i], i + 1);
+  }
+  for (const char* name : {"bz2.bag", "lz4.bag"}) {
+    auto rd = open_imu(dir / name, {});
+    EXPECT_EQ(rd->info().epoch_s, plain->info().epoch_s);
+    EXPECT_EQ(rd->info().assumptions, plain->info().assumptions);
+    const Table b = read_all(*rd, 1000);
+    EXPECT_EQ(a.t, b.t) << name;
+    EXPECT_EQ(a.ch, b.ch) << name;
+    EXPECT_EQ(a.loc, b.loc) << name;
+  }
   // (the order is by receive time: message 49 came before 48)
   EXPECT_NEAR(a.t[48], 1000.0 + 0.0025 * 49 - 1000, 1e-9);
+}
+
+// GIVEN a bz2 and an lz4 bag with a chunk's compressed bytes overwritten, WHEN imported, THEN
+// the error names the file, the message being read and the chunk's byte
+TEST(BagImport, DamagedCompressedChunkIsRefusedNamingFileAndChunk) {
+  const auto dir = scratch("bag_damaged");
+  write_bags(dir, 500);
+  for (const char* name : {"bz2.bag", "lz4.bag"}) {
+    // the first chunk record starts at byte 4117, after the 13-byte magic line and the bag header
+    // record (librosbag pads it to 4104 bytes); its compressed data begin within 100 bytes
+    std::fstream f(dir / name, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(4117 + 300);
+    const std::string junk(200, '\x5a');
+    f.write(junk.data(), static_cast<std::streamsize>(junk.size()));
+    f.close();
+    try {
+      auto rd = open_imu(dir / name, {});
+      read_all(*rd);
+      FAIL() << name << ": a damaged chunk was read";
+    } catch (const ImportError& e) {
+      const std::string msg = e.what();
+      EXPECT_NE(msg.find(std::string(name) + ": message 1"), std::string::npos) << msg;
+      EXPECT_NE(msg.find(std::string(name) + ": byte 4117: "), std::string::npos) << msg;
+    }
+  }
 }
 
 // GIVEN a bag cut short inside its last chunk (no index: librosbag refuses it), WHEN imported,
 // THEN the error names the file
 TEST(BagImport, TruncatedBagIsRefusedNamingTheFile) {
   const auto dir = scratch("bag_cut");
-  write_pair(dir / "plain.bag", dir / "bz2.bag", 500);
+  write_bags(dir, 500);
   const auto size = std::filesystem::file_size(dir / "plain.bag");
   std::filesystem::copy_file(dir / "plain.bag", dir / "cut.bag", std::filesystem::copy_options::overwrite_existing);
   std::filesystem::resize_file(dir / "cut.bag", size / 2);

@@ -84,3 +84,35 @@ TEST(GroundTruth, DamagedFilesAreRefusedWithTheirLine) {
 
 }  // namespace
 }  // namespace driftless::importers::test
+
+namespace driftless::importers::test {
+namespace {
+
+TEST(GroundTruth, QuaternionOrderComesFromTheHeaderNames) {
+  const auto dir = scratch("ground_truth_order");
+  // GIVEN the same 30 deg turn about z written scalar first (EuRoC) and scalar last (many tools: x y z w)
+  const double c = std::cos(M_PI / 12.0), s = std::sin(M_PI / 12.0);
+  const Eigen::Quaterniond truth(c, 0.0, 0.0, s);
+  char row[160];
+  std::snprintf(row, sizeof row, "1000,1,2,3,%.17g,0,0,%.17g\n2000,1,2,3,%.17g,0,0,%.17g\n", c, s, c, s);
+  write_text(dir / "wxyz.csv", std::string("#timestamp [ns],p_x [m],p_y [m],p_z [m],q_w [],q_x [],q_y [],q_z []\n") + row);
+  std::snprintf(row, sizeof row, "1000,1,2,3,0,0,%.17g,%.17g\n2000,1,2,3,0,0,%.17g,%.17g\n", s, c, s, c);
+  write_text(dir / "xyzw.csv", std::string("#timestamp, p_RS_R_x [m], p_RS_R_y [m], p_RS_R_z [m], q_RS_x [], q_RS_y [], "
+                                           "q_RS_z [], q_RS_w []\n") + row);
+  // THEN both read as the same rotation, and the order read is said
+  const GroundTruth a = read_ground_truth(dir / "wxyz.csv"), b = read_ground_truth(dir / "xyzw.csv");
+  EXPECT_EQ(a.quaternion_order, "w x y z");
+  EXPECT_EQ(b.quaternion_order, "x y z w");
+  EXPECT_LT(a.poses[0].q_ref_from_body.angularDistance(truth), 1e-12);
+  EXPECT_LT(b.poses[0].q_ref_from_body.angularDistance(truth), 1e-12);
+  EXPECT_EQ(b.poses[1].p_ref_m, Eigen::Vector3d(1, 2, 3));
+  // GIVEN names that do not spell an order (no axis letters, or one twice): EuRoC's w x y z
+  write_text(dir / "plain.csv", std::string("#timestamp,a,b,c,d,e,f,g\n") + "1000,0,0,0,1,0,0,0\n2000,0,0,0,1,0,0,0\n");
+  EXPECT_EQ(read_ground_truth(dir / "plain.csv").quaternion_order, "w x y z");
+  write_text(dir / "twice.csv", std::string("#timestamp,px,py,pz,qx,qx,qy,qz\n") + "1000,0,0,0,1,0,0,0\n2000,0,0,0,1,0,0,0\n");
+  EXPECT_EQ(read_ground_truth(dir / "twice.csv").quaternion_order, "w x y z");
+}
+
+}  // namespace
+}  // namespace driftless::importers::test
+

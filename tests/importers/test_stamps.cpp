@@ -1,5 +1,7 @@
 // Stamps made by others: a regular step with gaps, stamps that go backwards or repeat, and bursty
 // arrival stamps (the real sunsided recording).
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 #include "import_fixture.hpp"
@@ -33,6 +35,23 @@ TEST(Stamps, GapsBackwardsAndRepeatsAreCountedWithTheirPlace) {
   const auto text = r.describe("line");
   ASSERT_GE(text.size(), 3u);
   EXPECT_NE(text[0].find("the first at line 51"), std::string::npos) << text[0];
+}
+
+TEST(Stamps, JitteringWholeMillisecondStampsGiveTheMeanRateNotTheMedian) {
+  // GIVEN a loop that takes 3.3 ms stamped in whole ms (Arduino millis()): steps of 3, 3, 4 ms, and one
+  // gap of 50 ms
+  std::vector<double> t;
+  for (int i = 0; i < 3000; ++i) t.push_back(1e-3 * std::floor(3.3 * i + (i >= 1500 ? 50.0 : 0.0)));
+  StampMonitor m;
+  m.learn(std::span<const double>(t.data(), 1000));
+  for (std::size_t i = 0; i < t.size(); ++i) m.push(t[i], i + 2);
+  const auto& r = m.report();
+  // THEN the median step is 3 ms (333 Hz) but the regular steps' rate is the loop's 303 Hz (the gap left
+  // out: with it the mean over the record reads 0.5 % slower)
+  EXPECT_NEAR(r.step_s, 3e-3, 1e-12);
+  EXPECT_EQ(r.gaps, 1u);
+  EXPECT_NEAR(r.regular_rate_hz(), 1.0 / 3.3e-3, 0.2);
+  EXPECT_LT(r.mean_rate_hz(), 0.997 / 3.3e-3);
 }
 
 TEST(Stamps, RealBurstyArrivalStampsAreNotGaps) {
@@ -72,6 +91,67 @@ TEST(StampNs, DecimalStampsBecomeWholeNanosecondsExactly) {
   EXPECT_NEAR(seconds_since(1403636579758555392LL + 5'000'000LL * 1000, 1403636579), 5.758555392, 1e-15);
   EXPECT_EQ(ns_per_unit_of(1e-3), 1'000'000);
   EXPECT_EQ(ns_per_unit_of(0.5), 0);
+}
+
+}  // namespace
+}  // namespace driftless::importers::test
+
+namespace driftless::importers::test {
+namespace {
+
+std::int64_t dt_ns(const std::string& s) {
+  std::int64_t ns = -1;
+  EXPECT_TRUE(parse_datetime_ns(s.data(), s.data() + s.size(), ns)) << s;
+  return ns;
+}
+
+bool refused(const std::string& s) {
+  std::int64_t ns = 0;
+  return !parse_datetime_ns(s.data(), s.data() + s.size(), ns);
+}
+
+TEST(StampNs, DatesAndTimesBecomeWholeNanosecondsSince1970Utc) {
+  // GIVEN the forms phone apps and Python loggers write; THEN ns since 1970-01-01 UTC, exactly
+  EXPECT_EQ(dt_ns("1970-01-01 00:00:00"), 0);
+  EXPECT_EQ(dt_ns("2024-05-01T12:00:00.125Z"), 1714564800125000000LL);  // 19844 days + 12 h
+  EXPECT_EQ(dt_ns("2024-05-01 14:00:00.125+02:00"), 1714564800125000000LL);
+  EXPECT_EQ(dt_ns("2000-02-29 23:59:59.999999999"), 951868799999999999LL);
+  EXPECT_EQ(dt_ns("2024-05-01 12:00:00.1234567891"), 1714564800123456789LL);  // below 1 ns dropped
+  // a date-time as a stamp in s (the unit the step gives), not in another unit
+  const std::string t = "2024-05-01 12:00:00.010";
+  std::int64_t ns = 0;
+  EXPECT_TRUE(parse_stamp_ns(t.data(), t.data() + t.size(), 1'000'000'000, ns));
+  EXPECT_EQ(ns, 1714564800010000000LL);
+  EXPECT_FALSE(parse_stamp_ns(t.data(), t.data() + t.size(), 1'000'000, ns));
+  // THEN what is not a date and time is refused
+  for (const char* bad : {"2024-13-01 00:00:00", "2023-02-29 00:00:00", "2024-05-01 24:00:00", "2024-05-01",
+                          "2024-05-01 12:00:00.", "2024-05-01 12:00:00 UTC", "2024/05/01 12:00:00"}) {
+    EXPECT_TRUE(refused(bad)) << bad;
+  }
+}
+
+TEST(TextImport, DateTimeColumnIsTheTimeReadExactly) {
+  const auto dir = scratch("datetime");
+  // GIVEN a logger that stamps rows with the date and time, 100 Hz
+  std::string s = "time,gx,gy,gz\n";
+  char b[120];
+  for (int i = 0; i < 30; ++i) {
+    const double sec = 59.8 + 0.01 * i;
+    const int minute = static_cast<int>(std::floor(sec / 60.0));
+    std::snprintf(b, sizeof b, "2024-05-01 12:%02d:%06.3f,0.5,-0.3,0.2\n", minute, sec - 60.0 * minute);
+    s += b;
+  }
+  write_text(dir / "dt.csv", s);
+  auto r = open_imu(dir / "dt.csv", {});
+  const Table t = read_all(*r);
+  // THEN the column is the time, said, and the steps are 10 ms across the minute's end
+  EXPECT_TRUE(r->info().has_time);
+  EXPECT_EQ(r->info().channels.size(), 3u);
+  bool said = false;
+  for (const auto& a : r->info().assumptions) said = said || a.find("holds dates and times") != std::string::npos;
+  EXPECT_TRUE(said);
+  ASSERT_EQ(t.t.size(), 30u);
+  for (std::size_t i = 1; i < t.t.size(); ++i) EXPECT_NEAR(t.t[i] - t.t[i - 1], 0.01, 1e-9) << i;
 }
 
 }  // namespace

@@ -1,6 +1,10 @@
 // Delimited text: the real recordings of both folders, headers or none, separators, units and time
 // bases detected, columns by name or index, and bad files named by file:line.
 #include <cmath>
+#include <cstdio>
+#include <random>
+#include <string>
+#include <tuple>
 
 #include <gtest/gtest.h>
 
@@ -262,6 +266,140 @@ TEST(TextImport, LongFilesParsedOnTwoThreadsGiveTheSameRowsAndLineNumbers) {
   } catch (const ImportError& e) {
     EXPECT_NE(std::string(e.what()).find("bad.csv:120003: column 'gy' (3)"), std::string::npos) << e.what();
   }
+}
+
+}  // namespace
+}  // namespace driftless::importers::test
+
+namespace driftless::importers::test {
+namespace {
+
+// "t,gx,gy,gz,ax,ay,az" at 100 Hz: gyro white noise of sigma_dps (in `rate_scale` units per deg/s) on a
+// turn of amplitude turn_dps at 0.5 Hz; accelerometer at rest in m/s^2 (gravity on z)
+std::string si_like_file(double sigma_dps, double turn_dps, double rate_scale, int rows = 300) {
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> n(0.0, 1.0);
+  std::string s = "t,gx,gy,gz,ax,ay,az\n";
+  char b[200];
+  for (int i = 0; i < rows; ++i) {
+    const double turn = turn_dps * std::sin(2.0 * 3.141592653589793 * 0.5 * 0.01 * i);
+    std::snprintf(b, sizeof b, "%.2f,%.7f,%.7f,%.7f,%.4f,%.4f,%.4f\n", 0.01 * i, rate_scale * (0.5 + turn + sigma_dps * n(rng)),
+                  rate_scale * (-0.3 + sigma_dps * n(rng)), rate_scale * (0.2 + sigma_dps * n(rng)), 0.02 * n(rng),
+                  0.02 * n(rng), kG + 0.02 * n(rng));
+    s += b;
+  }
+  return s;
+}
+
+TEST(TextImport, DegreesPerSecondBesideAnSiAccelerometerAreNotTakenAsRadians) {
+  const auto dir = scratch("si_guess");
+  // GIVEN gyro in deg/s (MPU6050-like noise, 0.1 deg/s per sample at 100 Hz: 0.01 deg/s/sqrt(Hz)) beside an
+  // accelerometer in m/s^2, no units in the header
+  write_text(dir / "dps.csv", si_like_file(0.1, 0.0, 1.0));
+  auto r = open_imu(dir / "dps.csv", {});
+  const Table t = read_all(*r);
+  // THEN rad/s (57x the noise: 0.57 deg/s/sqrt(Hz), beyond every MEMS gyro) is refused as the guess, and said
+  EXPECT_TRUE(says(*r, "rates in deg/s, although the accelerometer reads g in m/s^2")) << r->info().assumptions[2];
+  EXPECT_TRUE(says(*r, "as rad/s its white noise would be"));
+  double mean = 0.0;
+  for (double v : t.ch[1]) mean += v / static_cast<double>(t.ch[1].size());
+  EXPECT_NEAR(mean, -0.3, 0.03);  // deg/s as written
+  // GIVEN the same sensor written in rad/s, at rest and turning +-115 deg/s (2 rad/s)
+  for (const double turn : {0.0, 115.0}) {
+    write_text(dir / "rad.csv", si_like_file(0.1, turn, 1.0 / kDegPerRad));
+    auto s = open_imu(dir / "rad.csv", {});
+    const Table u = read_all(*s);
+    // THEN the SI guess stands: rad/s, converted to deg/s
+    EXPECT_TRUE(says(*s, "rates in rad/s: the accelerometer reads g in m/s^2, an SI file")) << turn;
+    double m = 0.0;
+    for (double v : u.ch[1]) m += v / static_cast<double>(u.ch[1].size());
+    EXPECT_NEAR(m, -0.3, 0.03) << turn;
+  }
+  // GIVEN deg/s readings of a fast turn (+-500 deg/s): as rad/s they would pass any MEMS full scale
+  write_text(dir / "fast.csv", si_like_file(0.01, 500.0, 1.0));
+  auto f = open_imu(dir / "fast.csv", {});
+  EXPECT_TRUE(says(*f, "beyond the +-4000 deg/s of any MEMS gyro"));
+  // GIVEN a unit in the header: taken from it, and said so (not "no unit given")
+  write_text(dir / "named.csv", "t,gx [deg/s],gy [deg/s],gz [deg/s]\n0,1,2,3\n0.01,1,2,3\n0.02,1,2,3\n0.03,1,2,3\n0.04,1,2,3\n");
+  auto n = open_imu(dir / "named.csv", {});
+  EXPECT_TRUE(says(*n, "rates in deg/s (from the header)"));
+  EXPECT_FALSE(says(*n, "no unit given"));
+}
+
+TEST(TextImport, ArduinoMillisAndMicrosColumnsAreTheTime) {
+  const auto dir = scratch("arduino");
+  // GIVEN the header names of Arduino sketches' clocks, whole ms and whole us
+  for (const auto& [name, step, scale] : {std::tuple{"millis", 10, 1e-3}, std::tuple{"micros", 10000, 1e-6}}) {
+    std::string s = std::string(name) + ",gx,gy,gz\n";
+    for (int i = 0; i < 20; ++i) s += std::to_string(5000 + step * i) + ",1,2,3\n";
+    write_text(dir / "a.csv", s);
+    auto r = open_imu(dir / "a.csv", {});
+    const Table t = read_all(*r);
+    // THEN the column is the time, in its unit, and said so
+    EXPECT_TRUE(r->info().has_time) << name;
+    EXPECT_TRUE(says(*r, std::string("Arduino's ") + name + "()")) << name;
+    ASSERT_EQ(t.t.size(), 20u);
+    EXPECT_NEAR(t.t[1] - t.t[0], step * scale, 1e-12) << name;
+    EXPECT_EQ(r->info().channels.size(), 3u) << name;
+  }
+}
+
+TEST(TextImport, QuotedHeaderNamesAndARadianFileWithoutUnitsAreSaid) {
+  const auto dir = scratch("phone");
+  // GIVEN a phyphox-like file: quoted names with their units, rad/s
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> n(0.0, 0.1 / kDegPerRad);  // a phone MEMS: 0.01 deg/s/sqrt(Hz) at 100 Hz
+  std::string q = "\"Time (s)\",\"Gyroscope x (rad/s)\",\"Gyroscope y (rad/s)\",\"Gyroscope z (rad/s)\"\n";
+  std::string bare = "time,gx,gy,gz\n";
+  char b[160];
+  for (int i = 0; i < 300; ++i) {
+    std::snprintf(b, sizeof b, "%.2f,%.9e,%.9e,%.9e\n", 0.01 * i, n(rng), n(rng), n(rng));
+    q += b;
+    bare += b;
+  }
+  write_text(dir / "phyphox.csv", q);
+  auto r = open_imu(dir / "phyphox.csv", {});
+  // THEN the names come without their quotes, time and units from them
+  ASSERT_EQ(r->info().channels.size(), 3u);
+  EXPECT_EQ(r->info().channels[0].name, "Gyroscope x (rad/s)");
+  EXPECT_TRUE(r->info().has_time);
+  EXPECT_TRUE(says(*r, "rates in rad/s (from the header)"));
+  // GIVEN the same rad/s numbers without any unit: read as deg/s, and the note says they are too quiet
+  // for a MEMS gyro in deg/s (1.7e-4 deg/s/sqrt(Hz)) and what they would be in rad/s
+  write_text(dir / "bare.csv", bare);
+  auto s = open_imu(dir / "bare.csv", {});
+  EXPECT_TRUE(says(*s, "below every MEMS gyro's")) << s->info().assumptions[3];
+  // GIVEN an MPU6050-like file in deg/s (0.1 deg/s per sample at 100 Hz): no such remark
+  std::string dps = "time,gx,gy,gz\n";
+  for (int i = 0; i < 300; ++i) {
+    std::snprintf(b, sizeof b, "%.2f,%.6f,%.6f,%.6f\n", 0.01 * i, n(rng) * kDegPerRad, n(rng) * kDegPerRad, n(rng) * kDegPerRad);
+    dps += b;
+  }
+  write_text(dir / "dps.csv", dps);
+  auto d = open_imu(dir / "dps.csv", {});
+  EXPECT_TRUE(says(*d, "rates in deg/s: no unit given"));
+  EXPECT_FALSE(says(*d, "below every MEMS gyro's"));
+}
+
+TEST(TextImport, RecordingCutOffMidWriteLosesItsLastLineOnly) {
+  const auto dir = scratch("cut_tail");
+  const std::string rows = "t,gx,gy,gz\n0,1,2,3\n0.01,1,2,3\n0.02,1,2,3\n0.03,1,2,3\n0.04,1,2,3\n0.05,1,2,3\n";
+  // GIVEN a last line cut mid-write: no line end and too few fields
+  write_text(dir / "cut.csv", rows + "0.06,1,");
+  auto r = open_imu(dir / "cut.csv", {});
+  const Table t = read_all(*r);
+  // THEN the rows before it are read and the cut line is said, not an error
+  EXPECT_EQ(t.t.size(), 6u);
+  EXPECT_TRUE(says(*r, "the last line is cut off (no line end, 3 of 4 fields"));
+  // GIVEN a last line without a line end but whole: a row
+  write_text(dir / "whole.csv", rows + "0.06,1,2,3");
+  auto w = open_imu(dir / "whole.csv", {});
+  EXPECT_EQ(read_all(*w).t.size(), 7u);
+  EXPECT_FALSE(says(*w, "cut off"));
+  // GIVEN a short line that ends in a line end: still an error naming its line
+  write_text(dir / "short.csv", rows + "0.06,1,\n");
+  auto s = open_imu(dir / "short.csv", {});
+  EXPECT_THROW(read_all(*s), ImportError);
 }
 
 }  // namespace
