@@ -40,7 +40,9 @@ Status ReplaySource::configure() {
   fields_ = reader_->fields();
   rate_hz_ = meta_.get_number("sample_rate_hz", kNaN);
   if (!(rate_hz_ > 0.0)) {
-    return Status::BadConfig("replay: " + p_.path + " has no sample_rate_hz in its metadata");
+    // the session's period, gap detection and the filter's noise per sample need the rate
+    return Status::BadConfig("replay: " + p_.path + " has no sample_rate_hz in its metadata: add a line "
+                             "'# sample_rate_hz: <Hz>' before its header row (docs/log-format.md)");
   }
   return Status::Ok();
 }

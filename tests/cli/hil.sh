@@ -136,4 +136,9 @@ rc=0; "$bin" hil --source "replay:$out/a/log.csv" --switch-to emu-i2c --at 200 -
 [[ $rc -eq 1 ]] || fail "a switch after the replay's end: exit $rc, expected 1"
 grep -q "switch to emu-i2c at t=200 s did not happen: replay:.* ended at t=119.990 s" "$out/w.err" || fail "missed switch: $(cat "$out/w.err")"
 grep -q "^# event: t=119.990000 switch: to emu-i2c at t=200 s did not happen" "$out/w/log.csv" || fail "missed switch: no event line"
+# a replayed log without sample_rate_hz: refused, saying what to add
+grep -v '^# sample_rate_hz:' "$out/a/log.csv" > "$out/norate.csv"
+if "$bin" hil --source "replay:$out/norate.csv" --out "$out/nr" > /dev/null 2> "$out/nr.err"; then fail "a replay without a rate accepted"; fi
+grep -q "norate.csv has no sample_rate_hz in its metadata: add a line '# sample_rate_hz: <Hz>'" "$out/nr.err" ||
+  fail "replay without a rate: $(cat "$out/nr.err")"
 echo "hil: ok"
