@@ -390,7 +390,10 @@ bool DriftlessFilter::update(const Eigen::Matrix<double, D, 1>& r, const Eigen::
     P_.diagonal().head<kStateDim>().array() += innov.squaredNorm();
     ++counters_.relocks;
     rec.relocked = true;
-    return update<D>(r, H, R, rec);
+    // one try on the widened P: the part of the innovation outside H's range (a rank-deficient
+    // stacked H, a residual the model cannot explain) does not shrink with P, so a second re-lock
+    // from here would recurse without end
+    return update<D>(r, H, R, rec, /*may_relock=*/false);
   }
   consecutive_rejections_ = 0;
   // an offline smoother keeps the state before the gain (the prediction) and after it

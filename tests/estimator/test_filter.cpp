@@ -205,6 +205,32 @@ TEST(FilterTest, NisGateRejectsAnOutlierStandstillAndReportsIt) {
   EXPECT_LT((f.bias_dps() - truth(p)).cwiseAbs().maxCoeff(), 0.01);
 }
 
+TEST(FilterTest, AReLockThatCannotExplainTheInnovationEndsInARejection) {
+  // GIVEN the paper's filter (stacked 6-row H of rank 5) on a turning box whose sensor 1 reads
+  // 10 % high: the residual holds 0.1 M1 w, which changes from one standstill to the next and
+  // lies partly outside H's range, so no widening of P brings its NIS under the gate
+  SynthParams p;
+  p.duration_s = 300.0;
+  p.noise_sigma_dps = 0.05;
+  p.body_rate_dps = [](double t) { return Eigen::Vector3d(20.0 * std::sin(0.2 * t), 15.0, -10.0 * std::cos(0.1 * t)); };
+  EstimatorConfig cfg = paper_config();
+  cfg.noise_density_dps_rthz = 0.005;
+  DriftlessFilter f(cfg, test::synth_geometry(p));
+  // WHEN it runs (before the fix each re-lock called the next: a stack overflow)
+  std::uint64_t rejected_pushes = 0;
+  test::synth_samples(p, [&](const Sample& s) {
+    Sample x = s;
+    x.gyro1_dps *= 1.1;
+    if (f.push(x) == PushStatus::kRejected) ++rejected_pushes;
+  });
+  // THEN it re-locks, each re-lock is one try on the widened P, and the tries that fail are
+  // counted as rejections
+  EXPECT_GE(f.counters().relocks, 1u);
+  EXPECT_GE(f.counters().rejected, f.counters().relocks);
+  EXPECT_EQ(f.counters().rejected, rejected_pushes);
+  EXPECT_LE(f.counters().relocks, f.counters().updates + f.counters().rejected);
+}
+
 TEST(FilterTest, ARunOfRejectionsRelocksOntoABiasStep) {
   // GIVEN a converged filter and then a 1 deg/s step in sensor 1's x bias (as after a switch
   // to another sensor, or a real bias jump), far outside the gate
