@@ -56,7 +56,7 @@ const ParamInfo kParams[] = {
     {Param::kNonlinCubicPctFs, "cubic_pct_fs", "% FS", Effect::kAdcNonlinearity, 5.0},
     {Param::kMountingDeg, "angles_deg", "deg", Effect::kMountingMisalignment, 10.0},
     {Param::kStopErrorDeg, "stop_deg", "deg", Effect::kEndStopError, 5.0},
-    {Param::kLatitudeErrorDeg, "latitude_error_deg", "deg", Effect::kEarthRate, 10.0},
+    {Param::kLatitudeDeg, "latitude_deg", "deg", Effect::kEarthRate, 10.0},  // limit: on the change
     {Param::kFlipTransientDps, "dps", "deg/s", Effect::kFlipTransient, 5.0},
     {Param::kLowpassDelayS, "delay_s", "s", Effect::kLowpass, 0.1},
     {Param::kSampleDelayS, "delay_s", "s", Effect::kSampleDelay, 0.2},
@@ -157,7 +157,7 @@ std::vector<ColumnUse> columns_of(const ParamRef& p) {
     case Param::kNonlinCubicPctFs: return {{s * 3 + j, kNonlin3}};
     case Param::kMountingDeg: return on_sensor(s, kMount0 + j);
     case Param::kStopErrorDeg: return on_sensor(s, p.col == 1 ? kEndPlus : kEndMinus);
-    case Param::kLatitudeErrorDeg: return on_both(kLat);
+    case Param::kLatitudeDeg: return on_both(kLat);
     case Param::kFlipTransientDps: return {{s * 3 + j, kFlip0 + p.col}};
     case Param::kLowpassDelayS: return s < 0 ? on_both(kDelay) : on_sensor(s, kDelay);  // -1: both sensors' filter
     case Param::kSampleDelayS: return on_sensor(s, kDelay);

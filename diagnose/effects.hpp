@@ -58,7 +58,7 @@ enum class Param : std::uint8_t {
   kNonlinCubicPctFs,   // sensor.adc_nonlinearity.cubic_pct_fs (fitted on axis row)
   kMountingDeg,        // sensor.mounting_misalignment.angles_deg[row], deg
   kStopErrorDeg,       // box.stop<s>_error_deg[col: 0 at -stop, 1 at +stop], deg
-  kLatitudeErrorDeg,   // scenario latitude_deg, deg
+  kLatitudeDeg,        // scenario latitude_deg, deg (fitted as a change; plausibility on the change)
   kFlipTransientDps,   // deg/s on axis row in bin col after a flip (not writable)
   kLowpassDelayS,      // sensor.lowpass_latency.delay_s (0 = no filter), s; sensor -1: both sensors
   kSampleDelayS,       // sensor.sample_delay.delay_s, s

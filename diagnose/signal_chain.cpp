@@ -106,6 +106,11 @@ std::array<NoiseColour, 2> measure_noise_colour(const Replay& r, const Residual&
   return out;
 }
 
+ChainTerms chain_moments(double group_delay_s, double pole_time_s, double extra_delay_s) {
+  const double D = group_delay_s, T = pole_time_s, d = extra_delay_s, a = D - T + d;
+  return {0.5 * (D * D + T * T) + d * D + 0.5 * d * d, (6.0 * T * T * T + 6.0 * a * T * T + 3.0 * a * a * T + a * a * a) / 6.0};
+}
+
 double lowpass_delay_s(const twin::SensorParams& p) {
   return p.lowpass_latency.enabled ? twin::lowpass_setting(p.lowpass_latency).gyro_delay_s : 0.0;
 }
