@@ -356,10 +356,11 @@ PlatformMotion platform_motion(Raw& raw, const ReplayOptions& opt, Replay& out) 
     std::vector<double>& rate = pm.rate_dps[s];
     rate.resize(n);
     if (out.has_temp) {
-      out.temp_c[s] = std::move(raw.temp[s]);
+      out.temp_c[s].assign(raw.temp[s].begin(), raw.temp[s].end());
     } else {
-      out.temp_c[s].assign(n, kNaN), raw.temp[s] = std::vector<double>();
+      out.temp_c[s].assign(n, std::numeric_limits<float>::quiet_NaN());
     }
+    raw.temp[s] = std::vector<double>();
     pm.moving[s].assign(n, 0);
     for (std::size_t k = 0; k < n; ++k) {
       const std::size_t a = k == 0 ? 0 : k - 1, b = k + 1 < n ? k + 1 : n - 1;
@@ -448,7 +449,8 @@ void sensor_truth(Raw& raw, const std::vector<Eigen::Vector3d>& w_body, const st
     }
     raw.a[s] = std::vector<Eigen::Vector3d>();
     out.gyro_dps[s] = std::move(raw.g[s]);
-    out.plat_deg[s] = std::move(raw.plat[s]);
+    out.plat_deg[s].assign(raw.plat[s].begin(), raw.plat[s].end());
+    raw.plat[s] = std::vector<double>();
   }
   out.rows_missing_gyro = static_cast<std::size_t>(std::count(out.usable.begin(), out.usable.end(), 0));
 }

@@ -61,8 +61,10 @@ struct Replay {
   /// where the angle is unknown.
   Eigen::Matrix3d sensor_from_box(int s, std::size_t k) const;
   std::vector<Eigen::Vector3f> f_body_mps2;              // box specific force, box axes
-  std::array<std::vector<double>, 2> plat_deg;           // as logged; NaN when unknown
-  std::array<std::vector<double>, 2> temp_c;             // logged die temperature, NaN if absent
+  // as float (7 digits: 1e-5 deg of an angle, 4e-6 degC of a temperature; the sensors' series
+  // were made from the logged doubles)
+  std::array<std::vector<float>, 2> plat_deg;            // as logged; NaN when unknown
+  std::array<std::vector<float>, 2> temp_c;              // logged die temperature, NaN if absent
   std::vector<std::uint8_t> usable;    // gyro finite and the truth is known
   std::vector<std::uint8_t> flipping;  // a platform moves, or its angle is unknown
   std::vector<std::uint8_t> rough;     // the rate cannot be rebuilt from ref_q here (a kink)
