@@ -3,6 +3,7 @@
 // the embedded default model, as `driftless diagnose` without --model.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "tests/diagnose/independent_logs.hpp"
@@ -61,6 +62,37 @@ TEST(IndependentLogsFast, CleanLogIsConsistentOrOnlyItsSignalChain) {
   // THEN nothing physical is reported
   EXPECT_TRUE(r.verdict == Verdict::kConsistent || others_signal_chain(r, Effect::kCount)) << r.statement;
   EXPECT_NE(r.verdict, Verdict::kUnexplained) << r.statement;
+}
+
+TEST(IndependentLogsFast, ColumnSweepGivesEveryColumnAsColumnValueDoes) {
+  // GIVEN a 30 s pan/tilt log with temperature, made apart from twin/, and its residual against
+  // the embedded model
+  indep::Source src;
+  src.seed = 5;
+  src.duration_s = 30.0;
+  src.temperature = true;
+  const auto log = indep::generate(src, "fast_sweep");
+  const Replay r = replay_log(log, ReplayOptions{});
+  std::filesystem::remove(log);
+  const CompareModel model = default_compare_model();
+  const Residual res = make_residual(r, model, 0.1);
+  const ColumnInputs in{r, res, model.sensor};
+  // WHEN every column of every channel is swept over the fit samples (with the gaps where
+  // samples are left out, so the kept stencil is both rolled and rebuilt)
+  int compared = 0;
+  for (int c = 0; c < 6; ++c) {
+    ColumnSweep sweep(in, c / 3, c % 3);
+    for (std::size_t k = 0; k < res.n; ++k) {
+      if (!res.bmask[k]) continue;
+      for (int col = 0; col < kNumCols; ++col) {
+        // THEN each value is column_value's (to rounding: the two forms may contract differently)
+        const double want = column_value(in, c / 3, c % 3, col, k), got = sweep.value(col, k);
+        ASSERT_NEAR(got, want, 1e-12 * std::max(1.0, std::abs(want))) << "channel " << c << " column " << col << " sample " << k;
+        ++compared;
+      }
+    }
+  }
+  EXPECT_GT(compared, 100000);
 }
 
 }  // namespace
