@@ -67,8 +67,12 @@ Partial partial_out(const ChannelData& c, const std::vector<int>& xs, const std:
   return {C.topLeftCorner(p, p) / c.sigma2, C.col(p).head(p) / c.sigma2, C(p, p) / c.sigma2};
 }
 
-// pseudo-inverse of a symmetric positive semi-definite matrix (eigenvalues below 1e-9 of the
-// largest are not identified) and its rank
+// pseudo-inverse of a symmetric positive semi-definite matrix and its rank. What is identified
+// is decided on H scaled to unit diagonal (D H D, D = diag(H)^-1/2): eigenvalues below 1e-9 of
+// the largest there are collinear directions. Unscaled, the test compared parameters in their
+// own units: a delay's curvature per s^2 is ~1e9 times a scale's per %^2, so a scale fitted
+// beside a free sample delay was "not identified" and never selected (a 3 % scale on a wobble
+// with one sensor late went to the temperature coefficient it resembles)
 struct PseudoInverse {
   Eigen::MatrixXd inv;
   int rank = 0;
@@ -78,25 +82,28 @@ PseudoInverse pseudo_inverse(const Eigen::MatrixXd& H) {
   PseudoInverse out;
   out.inv = Eigen::MatrixXd::Zero(p, p);
   if (p == 0) return out;
-  // a well-conditioned H (the usual case: every free parameter identified) by Cholesky, a tenth
+  Eigen::VectorXd d(p);  // a parameter the data do not touch (zero curvature) stays unidentified
+  for (int i = 0; i < p; ++i) d[i] = H(i, i) > 0.0 ? 1.0 / std::sqrt(H(i, i)) : 0.0;
+  const Eigen::MatrixXd Hs = d.asDiagonal() * H * d.asDiagonal();
+  // a well-conditioned Hs (the usual case: every free parameter identified) by Cholesky, a tenth
   // of an eigendecomposition's cost; its reciprocal condition estimate (1-norm, an upper bound
   // that is rarely 10x off) far above the 1e-9 cut-off below means full rank there too
-  const Eigen::LLT<Eigen::MatrixXd> llt(H);
-  if (llt.info() == Eigen::Success && llt.rcond() > 1e-6) {
-    out.inv = llt.solve(Eigen::MatrixXd::Identity(p, p));
+  const Eigen::LLT<Eigen::MatrixXd> llt(Hs);
+  if ((d.array() > 0.0).all() && llt.info() == Eigen::Success && llt.rcond() > 1e-6) {
+    out.inv = d.asDiagonal() * llt.solve(Eigen::MatrixXd::Identity(p, p)) * d.asDiagonal();
     out.rank = p;
     return out;
   }
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(H);
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(Hs);
   const double top = std::max(es.eigenvalues().maxCoeff(), 1e-300);
-  Eigen::VectorXd d = Eigen::VectorXd::Zero(p);
+  Eigen::VectorXd e = Eigen::VectorXd::Zero(p);
   for (int i = 0; i < p; ++i) {
     if (es.eigenvalues()[i] > 1e-9 * top && es.eigenvalues()[i] > 1e-12) {
-      d[i] = 1.0 / es.eigenvalues()[i];
+      e[i] = 1.0 / es.eigenvalues()[i];
       ++out.rank;
     }
   }
-  out.inv = es.eigenvectors() * d.asDiagonal() * es.eigenvectors().transpose();
+  out.inv = d.asDiagonal() * (es.eigenvectors() * e.asDiagonal() * es.eigenvectors().transpose()) * d.asDiagonal();
   return out;
 }
 
