@@ -82,8 +82,10 @@ PseudoInverse pseudo_inverse(const Eigen::MatrixXd& H) {
   PseudoInverse out;
   out.inv = Eigen::MatrixXd::Zero(p, p);
   if (p == 0) return out;
-  Eigen::VectorXd d(p);  // a parameter the data do not touch (zero curvature) stays unidentified
-  for (int i = 0; i < p; ++i) d[i] = H(i, i) > 0.0 ? 1.0 / std::sqrt(H(i, i)) : 0.0;
+  // a parameter the data barely touch stays unidentified: curvature below 1e-12 per unit^2 (a
+  // sigma above 1e6 file units; its column's variation is the float block means' rounding)
+  Eigen::VectorXd d(p);
+  for (int i = 0; i < p; ++i) d[i] = H(i, i) > 1e-12 ? 1.0 / std::sqrt(H(i, i)) : 0.0;
   const Eigen::MatrixXd Hs = d.asDiagonal() * H * d.asDiagonal();
   // a well-conditioned Hs (the usual case: every free parameter identified) by Cholesky, a tenth
   // of an eigendecomposition's cost; its reciprocal condition estimate (1-norm, an upper bound
