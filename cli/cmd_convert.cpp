@@ -342,12 +342,13 @@ const bool registered = register_command(
                                                          "(MPU6050 default: 250)")
           ->check(positive_number("deg/s"));
       cmd->add_option("--source", a->source_name, "Text for the log's 'source' key (default: the file and its format)");
-      cmd->add_option("--ref", a->ref, "Ground truth to join into ref_q/ref_p (EuRoC state_groundtruth_estimate0 or "
+      auto* ref = cmd->add_option("--ref", a->ref, "Ground truth to join into ref_q/ref_p (EuRoC state_groundtruth_estimate0 or "
                                        "vicon0 data.csv: ns stamp, p x y z, q w x y z); rows outside its span are trimmed")
           ->check(CLI::ExistingFile);
       cmd->add_option("--ref-max-gap", a->ref_max_gap_s, "s: a longer step of the ground truth is a gap, rows in it get "
                                                          "no reference (default: 10 of its median steps)")
-          ->check(positive_number("s"));
+          ->check(positive_number("s"))
+          ->needs(ref);
       return [a] { return run_convert(*a); };
     },
     Interrupt::kPolls);

@@ -344,11 +344,12 @@ void say_datetime_time(TextLayout& L, std::string_view first_row) {
 void add_named_pick(TextLayout& L, const std::string& name, const char* option, Quantity q, int axis,
                     const std::string& file) {
   const int idx = find_column(name, L.header, L.fields, file, option);
-  for (const ColumnPick& p : L.picks) {
-    if (p.index == idx) {
-      throw ImportError(file + ": " + option + " " + name + ": column " + std::to_string(idx + 1) + " ('" +
-                        column_name(L, idx) + "') is already read as another channel; name each column once");
-    }
+  const bool taken = idx == L.time_index || std::any_of(L.picks.begin(), L.picks.end(),
+                                                        [idx](const ColumnPick& p) { return p.index == idx; });
+  if (taken) {
+    throw ImportError(file + ": " + option + " " + name + ": column " + std::to_string(idx + 1) + " ('" +
+                      column_name(L, idx) + "') is already read as " + (idx == L.time_index ? "the time" : "another channel") +
+                      "; name each column once");
   }
   add_pick(L, idx, q, axis);
 }

@@ -41,6 +41,7 @@ expect 2 "driftless allan: --validate: expected a whole number 0 .. 10000, got '
 # a unit not in the unit table is a usage error, found when the options are read
 expect 2 "driftless convert: --units: expected deg/s, rad/s or lsb:" convert --in "$golden" --out "$t/c.csv" --units furlongs
 expect 2 "driftless allan: --time-units: expected s, ms, us or ns" allan --in "$golden" --out "$t/a" --time-units parsecs
+expect 2 "driftless convert: --ref-max-gap requires --ref" convert --in "$golden" --out "$t/c.csv" --ref-max-gap 1
 expect 2 "driftless check: --log is required" check
 expect 2 "driftless estimate: --mode" estimate --log "$golden" --out "$t/e" --mode sideways
 expect 2 "driftless check: --log: File does not exist" check --log "$t/none.csv"

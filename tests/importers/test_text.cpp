@@ -171,6 +171,9 @@ TEST(TextImport, AColumnNamedForTwoChannelsIsRefused) {
   accel_on_gyro.columns = {"gx", "gy", "gz"};
   accel_on_gyro.accel_columns = {"ax", "gz", "az"};
   refused(accel_on_gyro, "--accel-columns gz: column 4 ('gz') is already read");
+  ImportOptions gyro_on_time;
+  gyro_on_time.columns = {"t", "gy", "gz"};  // the detected time column
+  refused(gyro_on_time, "--columns t: column 1 ('t') is already read as the time");
   // AND each column named once is read
   ImportOptions ok;
   ok.columns = {"gz", "gy", "gx"};
