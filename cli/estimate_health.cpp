@@ -27,6 +27,7 @@ const char* cause_key(est::HealthCause c) {
     case est::HealthCause::kUnobservable: return "unobservable";
     case est::HealthCause::kRelocks: return "relocks";
     case est::HealthCause::kLateLock: return "late_lock";
+    case est::HealthCause::kSaturation: return "saturation";
   }
   return "?";
 }
@@ -114,6 +115,16 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
                          "the NIS against its band or to compare the attitude; record a longer log or more "
                          "flips after the lock",
                          f.value, f.suggested);
+    case est::HealthCause::kSaturation: {
+      const int c = f.components.empty() ? 0 : f.components.front();
+      return fmt::format("gyro{}_{} reads exactly +-{:.6g} deg/s, its largest value, in runs over {:.3g} % of the "
+                         "rows: the sensor clips there (its range), and every standstill or flip through those "
+                         "rows measures the rail, not the rate{}; record with a larger full scale (MPU6050: "
+                         "FS_SEL) or slower motion, and state the range as gyro_full_scale_dps in the log header",
+                         c / 3 + 1, "xyz"[c % 3], f.suggested, 100.0 * f.value,
+                         f.severity == est::HealthVerdict::kFailed ? ": the biases from this log cannot be trusted"
+                                                                   : "");
+    }
   }
   return "?";
 }

@@ -19,6 +19,24 @@ void add(HealthReport& h, HealthFinding f) {
 
 }  // namespace
 
+void add_saturation_findings(HealthReport& h, const std::vector<ClippedChannel>& clipped, std::uint64_t rows) {
+  if (clipped.empty() || rows == 0) return;
+  HealthReport first;
+  first.verdict = h.verdict;
+  for (const ClippedChannel& c : clipped) {
+    HealthFinding f;
+    f.cause = HealthCause::kSaturation;
+    f.value = double(c.samples) / double(rows);
+    f.suggested = c.level_dps;
+    f.components = {c.channel};
+    f.severity = f.value >= kSaturationFailedFraction ? HealthVerdict::kFailed : HealthVerdict::kDegraded;
+    add(first, std::move(f));
+  }
+  for (HealthFinding& f : h.findings) first.findings.push_back(std::move(f));
+  h.findings = std::move(first.findings);
+  h.verdict = first.verdict;
+}
+
 const char* to_string(HealthVerdict v) {
   switch (v) {
     case HealthVerdict::kOk: return "ok";

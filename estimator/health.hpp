@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "estimator/clip_detector.hpp"
 #include "estimator/filter.hpp"
 
 namespace driftless::est {
@@ -34,6 +35,7 @@ enum class HealthCause {
   kUnobservable,         // some bias components kept (most of) their prior sigma
   kRelocks,              // the gate lost lock and re-locked
   kLateLock,             // locked, but too few accepted updates after the lock to check the NIS
+  kSaturation,           // a gyro channel repeats its largest reading in runs: it clips there
 };
 
 /// One check that did not pass, with the numbers that describe() turns into text.
@@ -47,7 +49,9 @@ struct HealthFinding {
                               // kLateLock: the accepted updates after the lock (value: lock time, s)
   // kRejectionsAtPosition: the (plat1, plat2) angle pairs (deg) where most updates were rejected
   std::vector<std::array<double, 2>> positions_deg;
-  std::vector<int> components;  // kUnobservable: 0..5 = b1_x .. b2_z
+  std::vector<int> components;  // kUnobservable: 0..5 = b1_x .. b2_z; kSaturation: the channel
+                                // (0..5 = gyro1_x .. gyro2_z), value: the fraction of the rows
+                                // clipped, suggested: the level in deg/s
 };
 
 /// Limits of the verdict (docs/estimator.md section 6.1).
@@ -88,6 +92,15 @@ struct HealthReport {
   std::vector<int> unobservable;       // 0..5 = b1_x .. b2_z
   std::vector<HealthFinding> findings; // worst first
 };
+
+/// Limits of the saturation finding: clipped in at least this fraction of the rows is `failed`
+/// (the standstills and flips through those samples carry the rail, not the rate), below it
+/// `degraded`.
+inline constexpr double kSaturationFailedFraction = 0.01;
+
+/// Puts a `saturation` finding for each suspected clipped channel ahead of the other findings (it
+/// is their cause) and sets the verdict; `rows` is the log's row count.
+void add_saturation_findings(HealthReport& h, const std::vector<ClippedChannel>& clipped, std::uint64_t rows);
 
 /// Watches the updates of one pass and gives the verdict at the end.
 class HealthMonitor {

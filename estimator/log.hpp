@@ -15,6 +15,7 @@
 #include <utility>
 #include <vector>
 
+#include "estimator/clip_detector.hpp"
 #include "estimator/input_error.hpp"
 #include "estimator/output_file.hpp"
 #include "estimator/sample.hpp"
@@ -194,6 +195,9 @@ class LogReader {
   std::uint64_t rows_with_missing_gyro() const { return missing_gyro_rows_; }
   /// Rows with a gyro value at the stated full scale (|v| >= gyro_full_scale_dps; saturated).
   std::uint64_t rows_saturated() const { return saturated_rows_; }
+  /// Channels that repeat their largest |reading| in runs: suspected clipping, stated full scale
+  /// or not (estimator/clip_detector.hpp).
+  std::vector<est::ClippedChannel> suspected_clipping() const { return clip_.suspected(); }
   /// "file:line" for messages.
   std::string where() const;
   const std::filesystem::path& path() const { return path_; }
@@ -237,6 +241,7 @@ class LogReader {
   std::uint64_t rows_ = 0;
   std::uint64_t missing_gyro_rows_ = 0;
   std::uint64_t saturated_rows_ = 0;
+  est::ClipDetector clip_;
   double last_t_ = -std::numeric_limits<double>::infinity();
   bool dropped_truncated_ = false;
 };

@@ -295,6 +295,7 @@ void LogReader::check_row(const Sample& s) {
   bool missing = false, saturated = false;
   for (int i = 0; i < n; ++i) {
     const double v = i < 3 ? s.gyro1_dps[i] : s.gyro2_dps[i - 3];
+    clip_.push(i, v);
     if (std::isnan(v)) {
       missing = true;
       continue;

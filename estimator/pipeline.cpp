@@ -121,6 +121,10 @@ void add_reader_warnings(const log::LogReader& reader, EstimateSummary& sum) {
                            " rows had a missing or NaN gyro value and were skipped");
   }
   if (reader.dropped_truncated_row()) sum.warnings.push_back("the last row was cut off and dropped");
+  if (reader.rows_saturated() > 0) {
+    sum.warnings.push_back(std::to_string(reader.rows_saturated()) +
+                           " rows have a gyro value at the stated gyro_full_scale_dps (saturated)");
+  }
 }
 
 void add_filter_warnings(const DriftlessFilter& filter, EstimateSummary& sum) {
@@ -291,6 +295,7 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
   score.finish();
   if (use_window) window.finish(filter);
   sum.health = health.finish(filter, sum.rows > 0 ? sum.t_last_s - sum.t_first_s : 0.0);
+  if (reader != nullptr) add_saturation_findings(sum.health, reader->suspected_clipping(), reader->rows_read());
   return sum;
 }
 

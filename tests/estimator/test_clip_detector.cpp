@@ -1,0 +1,110 @@
+// Suspected clipping (estimator/clip_detector.hpp) and its health finding.
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "estimator/clip_detector.hpp"
+#include "estimator/health.hpp"
+
+namespace driftless::est {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// GIVEN a 100 Hz turning rate of amplitude `amp_dps` with white noise of `noise_dps`, read by a gyro
+// that clips at +-`fs_dps` and quantises to `lsb_dps` (0: none), on channel `ch`
+ClipDetector run(double amp_dps, double noise_dps, double fs_dps, double lsb_dps, int ch, std::uint64_t* clipped) {
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> n(0.0, noise_dps);
+  ClipDetector d;
+  *clipped = 0;
+  for (int k = 0; k < 60000; ++k) {
+    double v = amp_dps * std::sin(2.0 * kPi * 0.05 * k / 100.0) + n(rng);
+    if (lsb_dps > 0.0) v = lsb_dps * std::round(v / lsb_dps);
+    if (std::fabs(v) >= fs_dps) {
+      v = std::copysign(fs_dps, v);
+      ++*clipped;
+    }
+    d.push(ch, v);
+  }
+  return d;
+}
+
+TEST(ClipDetector, AGyroDrivenPastItsRangeIsNamedWithItsLevelAndTheClippedSamples) {
+  std::uint64_t clipped = 0;
+  // WHEN a 600 deg/s swing is read by a +-250 deg/s gyro (MPU6050 LSB 1/131 deg/s, 0.05 deg/s noise)
+  const ClipDetector d = run(600.0, 0.05, 250.0, 1.0 / 131.0, 5, &clipped);
+  const auto s = d.suspected();
+  // THEN channel 5 (gyro2_z) is named at 250 deg/s with every clipped sample (runs of thousands:
+  // only each run's first two samples are not counted, here 2 per half-swing)
+  ASSERT_EQ(s.size(), 1u);
+  EXPECT_EQ(s[0].channel, 5);
+  EXPECT_DOUBLE_EQ(s[0].level_dps, 250.0);
+  EXPECT_GT(clipped, 20000u);
+  EXPECT_LE(s[0].samples, clipped);
+  EXPECT_GE(s[0].samples + 2 * 6, clipped);
+}
+
+TEST(ClipDetector, ARateThatOnlyPassesThroughItsExtremeIsNotClipping) {
+  std::uint64_t clipped = 0;
+  // GIVEN the same swing inside the range, quantised (its peak holds one LSB value for ~0.1 s
+  // without noise, so the noise is what a real gyro adds: 0.05 deg/s = 6.5 LSB)
+  const ClipDetector d = run(200.0, 0.05, 250.0, 1.0 / 131.0, 0, &clipped);
+  EXPECT_EQ(clipped, 0u);
+  // THEN nothing is suspected: the largest value comes once, not in runs of three
+  EXPECT_TRUE(d.suspected().empty());
+}
+
+TEST(ClipDetector, AQuietStaticLogBelowAnyGyroRangeIsNotClipping) {
+  // GIVEN a noise-free simulated log holding one rate: every sample repeats its largest value
+  ClipDetector d;
+  for (int k = 0; k < 1000; ++k) d.push(2, 15.0);
+  // THEN it is below kMinLevelDps (no gyro's range is 15 deg/s): not reported
+  EXPECT_TRUE(d.suspected().empty());
+}
+
+TEST(ClipDetector, AMissingReadingEndsARunAndAHigherValueRestartsTheCount) {
+  ClipDetector d;
+  // runs of two at 300, split by NaN: never three in a row
+  for (int k = 0; k < 20; ++k) {
+    d.push(0, 300.0);
+    d.push(0, 300.0);
+    d.push(0, std::nan(""));
+  }
+  EXPECT_TRUE(d.suspected().empty());
+  // a run of 12 at 300 counts 12; a later single 310 makes 300 not the largest: the count restarts
+  for (int k = 0; k < 12; ++k) d.push(0, -300.0);
+  ASSERT_EQ(d.suspected().size(), 1u);
+  EXPECT_EQ(d.suspected()[0].samples, 12u);
+  d.push(0, 310.0);
+  EXPECT_TRUE(d.suspected().empty());
+}
+
+TEST(HealthSaturation, AClippedChannelLeadsTheFindingsAndFailsAboveOnePercent) {
+  // GIVEN a degraded report and two clipped channels, one in 5 % of 1000 rows, one in 0.5 %
+  HealthReport h;
+  h.verdict = HealthVerdict::kDegraded;
+  HealthFinding gate;
+  gate.cause = HealthCause::kRejections;
+  h.findings.push_back(gate);
+  add_saturation_findings(h, {{2, 250.0, 50}, {4, 2000.0, 5}}, 1000);
+  // THEN the saturation findings come first, the first fails the run, the second only degrades
+  EXPECT_EQ(h.verdict, HealthVerdict::kFailed);
+  ASSERT_EQ(h.findings.size(), 3u);
+  EXPECT_EQ(h.findings[0].cause, HealthCause::kSaturation);
+  EXPECT_EQ(h.findings[0].severity, HealthVerdict::kFailed);
+  EXPECT_DOUBLE_EQ(h.findings[0].value, 0.05);
+  EXPECT_DOUBLE_EQ(h.findings[0].suggested, 250.0);
+  EXPECT_EQ(h.findings[1].severity, HealthVerdict::kDegraded);
+  EXPECT_EQ(h.findings[1].components, std::vector<int>{4});
+  EXPECT_EQ(h.findings[2].cause, HealthCause::kRejections);
+  // AND with nothing clipped the report is unchanged
+  HealthReport ok;
+  add_saturation_findings(ok, {}, 1000);
+  EXPECT_EQ(ok.verdict, HealthVerdict::kOk);
+  EXPECT_TRUE(ok.findings.empty());
+}
+
+}  // namespace
+}  // namespace driftless::est
