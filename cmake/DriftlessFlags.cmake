@@ -12,9 +12,11 @@ if(DRIFTLESS_SANITIZE)
   # calls one by one (the suite under the sanitizers spent ~20 min of CPU at -O0), and compiles as
   # fast as -O0 (measured: estimator/filter.cpp 23 s against 25 s, diagnose/channel_fit.cpp 30 s
   # against 27 s; -O1 took 30 s and 39 s)
+  # -gz: the line tables compressed (zlib) in objects and programs (the sanitizer build took 4 GB);
+  # the sanitizers' symbolizer reads them as before
   target_compile_options(driftless_flags INTERFACE
-    -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer -g1 -Og)
-  target_link_options(driftless_flags INTERFACE -fsanitize=address,undefined)
+    -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer -g1 -Og -gz)
+  target_link_options(driftless_flags INTERFACE -fsanitize=address,undefined -gz)
 endif()
 
 # the repository root is the include root, so an include names its folder:
