@@ -106,6 +106,26 @@ struct TimePlan {
   std::vector<std::string> notes;
 };
 
+/// --time auto falls back on t = t0 + k / rate when the stamps repeat or go back. That is right
+/// when every sample is there (a logger that stamped one row twice); when samples are missing as
+/// well (gaps), it moves every row after a gap to an earlier time and hides the gap. Refused then:
+/// the last row's k / rate time against its stamp tells, whatever the mix of repeats and gaps.
+void refuse_shifting_uniform_time(const importers::StreamInfo& info, const importers::StampReport& st,
+                                  const TimePlan& p) {
+  if (st.rows < 2 || !std::isfinite(st.last_t_s) || !(p.rate_hz > 0.0)) return;
+  const double last_uniform_s = p.t0_s + static_cast<double>(st.rows - 1) / p.rate_hz;
+  const double shift_s = st.last_t_s - last_uniform_s;  // s, how far k / rate moves the last row
+  if (!(std::fabs(shift_s) > 0.5 / p.rate_hz)) return;
+  throw InputError(
+      info.source, 0, "--time",
+      fmt::format("the stamps cannot be the log's time ({}), and t = first stamp + k / {:.6g} Hz would move the "
+                  "last row {:.6g} s {} its stamp ({}): samples are missing, so a uniform time puts every row after "
+                  "a gap at the wrong time. Repair the stamps that repeat or go back (the rows keep their time "
+                  "then), or give --time uniform to accept the shift",
+                  fmt::join(st.describe("line"), "; "), p.rate_hz, std::fabs(shift_s),
+                  shift_s > 0 ? "before" : "after", fmt::format("{:.6f} s against {:.6f} s", last_uniform_s, st.last_t_s)));
+}
+
 TimePlan plan_time(const ConvertArgs& a, const importers::StreamInfo& info, const importers::StampReport& st) {
   TimePlan p;
   const TimeBase want = parse_time_base(a.time);
@@ -122,6 +142,7 @@ TimePlan plan_time(const ConvertArgs& a, const importers::StreamInfo& info, cons
                                  fmt::join(st.describe("line"), "; ")));
   }
   if (info.has_time) p.t0_s = st.first_t_s;
+  if (want == TimeBase::kAuto && p.uniform && info.has_time) refuse_shifting_uniform_time(info, st, p);
   if (info.has_time && info.epoch_s != 0) {
     p.notes.push_back(fmt::format("t counts from the epoch {} s (the first stamp floored to whole seconds): "
                                   "t = stamp - {} s, formed in integer ns", info.epoch_s, info.epoch_s));
