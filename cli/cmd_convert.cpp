@@ -243,6 +243,22 @@ std::string ref_summary(const RefJoin& j) {
                      j.before, j.after, j.in_gaps);
 }
 
+/// --full-scale states the gyro's range in the log; a reading beyond the margin the log's readers
+/// allow (log::kFullScaleMargin x FS) would make every reader refuse the log, so the range given
+/// is wrong: refused here, naming the input row, rather than writing a log nobody can read.
+void check_full_scale(const Sample& s, const ConvertArgs& a, const std::string& source, std::uint64_t loc) {
+  if (!(a.full_scale_dps > 0.0)) return;
+  for (int k = 0; k < 3; ++k) {
+    const double v = s.gyro1_dps[k];
+    if (!(std::fabs(v) > log::kFullScaleMargin * a.full_scale_dps)) continue;
+    throw InputError(source, static_cast<std::size_t>(loc), "--full-scale",
+                     fmt::format("gyro {} reads {:.6g} deg/s, beyond {:g} x the --full-scale {:g} deg/s: a gyro with "
+                                 "that range cannot give it, and every reader would refuse the log; give the sensor's "
+                                 "real range (or leave --full-scale out)",
+                                 "xyz"[k], v, log::kFullScaleMargin, a.full_scale_dps));
+  }
+}
+
 int run_convert(const ConvertArgs& a) {
   const auto opt = a.input.import_options();
   auto reader = importers::open_imu(a.input.in, opt);
@@ -274,6 +290,12 @@ int run_convert(const ConvertArgs& a) {
     for (std::size_t r = 0; r < block.rows(); ++r, ++k) {
       const double t = tp.uniform ? tp.t0_s + static_cast<double>(k) / tp.rate_hz : block.t_s[r];
       Sample s = sample_of(block, r, map, t);
+      try {
+        check_full_scale(s, a, info.source, block.loc.empty() ? k + 1 : block.loc[r]);
+      } catch (const InputError& e) {
+        writer.finish(false, e.what());  // the rows before stay; the log says why it stops there
+        throw;
+      }
       if (ref && !ref->attach(s)) continue;
       writer.write(s);
       last_t = t;
@@ -320,12 +342,13 @@ const bool registered = register_command(
                                                          "(MPU6050 default: 250)")
           ->check(positive_number("deg/s"));
       cmd->add_option("--source", a->source_name, "Text for the log's 'source' key (default: the file and its format)");
-      cmd->add_option("--ref", a->ref, "Ground truth to join into ref_q/ref_p (EuRoC state_groundtruth_estimate0 or "
+      auto* ref = cmd->add_option("--ref", a->ref, "Ground truth to join into ref_q/ref_p (EuRoC state_groundtruth_estimate0 or "
                                        "vicon0 data.csv: ns stamp, p x y z, q w x y z); rows outside its span are trimmed")
           ->check(CLI::ExistingFile);
       cmd->add_option("--ref-max-gap", a->ref_max_gap_s, "s: a longer step of the ground truth is a gap, rows in it get "
                                                          "no reference (default: 10 of its median steps)")
-          ->check(positive_number("s"));
+          ->check(positive_number("s"))
+          ->needs(ref);
       return [a] { return run_convert(*a); };
     },
     Interrupt::kPolls);

@@ -12,6 +12,7 @@
 #include "cli/command.hpp"
 #include "cli/hil_fdi.hpp"
 #include "estimator/filter.hpp"
+#include "estimator/health.hpp"
 #include "estimator/log.hpp"
 #include "estimator/log_metadata.hpp"
 #include "hil_bridge/cpu_latency.hpp"
@@ -129,6 +130,22 @@ void refuse_options_no_source_uses(const CLI::App& cmd, const HilOptions& o) {
   }
 }
 
+// the bias lines are the filter's start value until it locked (estimate's lock level): say so, and
+// why when the samples never had both triads
+void warn_if_never_locked(const est::DriftlessFilter& filter) {
+  const double lock_dps = est::HealthLimits{}.lock_sigma_dps;
+  const double sigma_dps = filter.correction_sigma_dps().maxCoeff();
+  if (sigma_dps < lock_dps) return;
+  const est::FilterCounters& c = filter.counters();
+  fmt::print(stderr,
+             "driftless hil: warning: the filter never locked (largest sigma {:.3g} deg/s, locked below {:g}; {} "
+             "update(s), {} rejected): the biases above are not estimates{}\n",
+             sigma_dps, lock_dps, c.updates, c.rejected,
+             c.invalid > 0 ? fmt::format("; {} of {} samples lacked a gyro value (an empty column: a dead axis or "
+                                         "a missing sensor?)", c.invalid, c.samples)
+                           : "");
+}
+
 int run_hil(const HilOptions& o) {
   std::filesystem::create_directories(o.out_dir);
 
@@ -236,6 +253,7 @@ int run_hil(const HilOptions& o) {
   fmt::print("filter: {} updates, {} rejected by the NIS gate, {} source switches\n", filter.counters().updates,
              filter.counters().rejected, filter.counters().source_switches);
   fmt::print("log: {}\n", log_path.string());
+  warn_if_never_locked(filter);
   if (!st.complete) throw std::runtime_error("hil: " + st.end_reason + "; the log so far is " + log_path.string() +
                                              " (complete: false)");
   if (switch_missed) {

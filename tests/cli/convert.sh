@@ -2,7 +2,8 @@
 # driftless convert: other people's recordings into the single-sensor log, which check and allan
 # then read. Real MPU6050 files (bursty stamps; raw counts without time), a regular-stamp EuRoC
 # file, and the refusals: two triads without --columns, stamps that step back with --time stamps,
-# a repeated stamp in a recording with a gap (a uniform time would move the rows after it).
+# a repeated stamp in a recording with a gap (a uniform time would move the rows after it), and a
+# --full-scale the readings exceed.
 set -euo pipefail
 bin=$1; src=$2
 real=$src/../shared/realdata/mpu6050-sunsided/unmoved-with-x-pointing-forward/mpu6050.csv
@@ -108,4 +109,13 @@ grep -q "gap_twice.csv: --time: .*would move the last row 2 s before its stamp.*
   fail "case 5: message for a repeated stamp with a gap: $out"
 [[ ! -e $t/gap_twice.log ]] || fail "case 5: a log was written although refused"
 "$bin" convert --in "$t/gap_twice.csv" --time uniform --out "$t/gap_twice.log" > /dev/null || fail "case 5: --time uniform refused"
+# 6. --full-scale below the readings: refused at the first row beyond 1.1 x FS (every reader would
+# refuse the log), naming the input line; the log so far says complete: false and why
+awk 'BEGIN { print "time,gx,gy,gz"; for (k = 0; k < 200; ++k) printf "%.2f,%.4f,0,0\n", k / 100, k / 2 }' > "$t/fast.csv"
+out=$("$bin" convert --in "$t/fast.csv" --full-scale 50 --out "$t/fast.log" 2>&1) && fail "case 6: readings beyond --full-scale accepted"
+grep -q "fast.csv:113: --full-scale: gyro x reads 55.5 deg/s, beyond 1.1 x the --full-scale 50 deg/s" <<< "$out" ||
+  fail "case 6: message: $out"
+[[ $(meta "$t/fast.log" complete) == false ]] || fail "case 6: the log does not say complete: false"
+"$bin" check --log "$t/fast.log" > /dev/null 2>&1 || fail "case 6: the rows before the refusal are not a readable log"
+"$bin" convert --in "$t/fast.csv" --full-scale 100 --out "$t/fast.log" > /dev/null || fail "case 6: --full-scale 100 refused"
 echo "convert: ok"

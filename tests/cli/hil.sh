@@ -141,4 +141,12 @@ grep -v '^# sample_rate_hz:' "$out/a/log.csv" > "$out/norate.csv"
 if "$bin" hil --source "replay:$out/norate.csv" --out "$out/nr" > /dev/null 2> "$out/nr.err"; then fail "a replay without a rate accepted"; fi
 grep -q "norate.csv has no sample_rate_hz in its metadata: add a line '# sample_rate_hz: <Hz>'" "$out/nr.err" ||
   fail "replay without a rate: $(cat "$out/nr.err")"
+# a replay whose gyro2_z is empty in every row (a dead axis) never locks: said, with the reason
+awk -F, 'BEGIN { OFS = "," } /^#/ { print; next } /^t,/ { for (i = 1; i <= NF; ++i) if ($i == "gyro2_z") c = i; print; next }
+  { $c = ""; print }' "$out/a/log.csv" > "$out/dead.csv"
+"$bin" hil --source "replay:$out/dead.csv" --out "$out/d" > /dev/null 2> "$out/d.err" || fail "dead axis: exit $?"
+grep -q "warning: the filter never locked (largest sigma 20 deg/s.*12000 of 12000 samples lacked a gyro value" "$out/d.err" ||
+  fail "dead axis: $(cat "$out/d.err")"
+"$bin" hil --source "replay:$out/a/log.csv" --out "$out/d2" > /dev/null 2> "$out/d2.err"
+if grep -q "never locked" "$out/d2.err"; then fail "a locked replay warns: $(cat "$out/d2.err")"; fi
 echo "hil: ok"
