@@ -12,9 +12,11 @@ if(DRIFTLESS_SANITIZE)
   # calls one by one (the suite under the sanitizers spent ~20 min of CPU at -O0), and compiles as
   # fast as -O0 (measured: estimator/filter.cpp 23 s against 25 s, diagnose/channel_fit.cpp 30 s
   # against 27 s; -O1 took 30 s and 39 s)
+  # -gz: the line tables compressed (zlib) in objects and programs (the sanitizer build took 4 GB);
+  # the sanitizers' symbolizer reads them as before
   target_compile_options(driftless_flags INTERFACE
-    -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer -g1 -Og)
-  target_link_options(driftless_flags INTERFACE -fsanitize=address,undefined)
+    -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer -g1 -Og -gz)
+  target_link_options(driftless_flags INTERFACE -fsanitize=address,undefined -gz)
 endif()
 
 # the repository root is the include root, so an include names its folder:
@@ -24,6 +26,10 @@ set(DRIFTLESS_SOURCE_ROOT ${PROJECT_SOURCE_DIR})
 # the tests' temporary folder (TMPDIR), one per build tree
 set(DRIFTLESS_TEST_TMPDIR ${PROJECT_BINARY_DIR}/tmp)
 file(MAKE_DIRECTORY ${DRIFTLESS_TEST_TMPDIR})
+# every test runs through this script: TMPDIR becomes a folder of the test's own under the one
+# above, removed when the test passes, so the files of passed tests do not pile up on the disk
+# (tests/run_in_scratch.sh)
+set(DRIFTLESS_TEST_RUNNER ${PROJECT_SOURCE_DIR}/tests/run_in_scratch.sh)
 
 # driftless_add_test(name SOURCES ... LIBS ...): one GoogleTest binary registered with CTest.
 function(driftless_add_test name)
@@ -34,6 +40,8 @@ function(driftless_add_test name)
   target_link_libraries(${name} PRIVATE ${ARG_LIBS} driftless_test_dirs GTest::gtest GTest::gtest_main
                         driftless::flags)
   set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR}/tests)
+  # gtest_discover_tests puts the 'emulator' in front of each test's command: the scratch runner
+  set_target_properties(${name} PROPERTIES CROSSCOMPILING_EMULATOR ${DRIFTLESS_TEST_RUNNER})
   # GoogleTest, Eigen and the standard library parsed once for every test (tests/CMakeLists.txt)
   target_precompile_headers(${name} REUSE_FROM driftless_test_pch)
   # with the standard library from a precompiled header, GCC 12 at -O2 inlines std::string's

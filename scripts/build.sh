@@ -8,6 +8,9 @@ jobs=$(nproc 2>/dev/null || echo 2)
 # ccache (when installed) keys on paths relative to the checkout, so a second clone or a second
 # build folder of the same sources reuses the objects instead of compiling them again
 export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$root} CCACHE_NOHASHDIR=${CCACHE_NOHASHDIR:-1}
+# the cache on a shared disk is bounded: a whole CI (Release, sanitizer and fuzz objects) stores
+# about 0.2 GB, so 1 GB keeps several states of the code warm (ccache's own default is 5 GB)
+export CCACHE_MAXSIZE=${CCACHE_MAXSIZE:-1G}
 # the tests share a precompiled header; ccache caches the files compiled with it only when told
 # that the header's definitions and time stamps do not change the result
 export CCACHE_SLOPPINESS=${CCACHE_SLOPPINESS:-pch_defines,time_macros,include_file_mtime,include_file_ctime}

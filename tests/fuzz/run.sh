@@ -17,6 +17,7 @@ esac
 if [[ $step != run ]]; then
   command -v clang++ >/dev/null || { echo "fuzz: clang++ not found (scripts/setup.sh installs clang)"; exit 1; }
   export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$root} CCACHE_NOHASHDIR=${CCACHE_NOHASHDIR:-1}
+  export CCACHE_MAXSIZE=${CCACHE_MAXSIZE:-1G}   # bounded, as in scripts/build.sh
   CC=clang CXX=clang++ cmake -S "$root/tests/fuzz" -B "$build" -DCMAKE_BUILD_TYPE=None >/dev/null
   cmake --build "$build" -j "$(nproc 2>/dev/null || echo 2)"
 fi
@@ -34,6 +35,8 @@ fuzz_one() {
   if "$build/fuzz_$name" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
        -artifact_prefix="$build/$name-" "$work" "$corpus" > "$log" 2>&1; then
     echo "fuzz $name: $(grep -m1 'stat::number_of_executed_units' "$log" | awk '{print $2}') runs, no finding"
+    # the inputs it made are not kept (CI's disk is shared; the committed corpus is what a run reads)
+    rm -rf "$work"
   else
     echo "fuzz $name: FINDING (full log: $log)"; tail -40 "$log"; return 1
   fi

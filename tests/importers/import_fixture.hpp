@@ -7,6 +7,7 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include "importers/imu_reader.hpp"
 
@@ -18,9 +19,11 @@ inline std::filesystem::path sunsided_10min() {
 }
 inline std::filesystem::path tomisuarez_static() { return realdata() / "mpu6050-tomisuarez2" / "imu_static_test.csv"; }
 
-/// A fresh folder under the build tree for one test.
+/// A fresh folder in the test's temporary folder (under CTest, one of the test's own that is removed
+/// when it passes: tests/run_in_scratch.sh; the pid keeps two processes apart without it).
 inline std::filesystem::path scratch(const std::string& name) {
-  const auto d = std::filesystem::path(DRIFTLESS_BINARY_DIR) / "tests" / "importers_scratch" / name;
+  const auto d = std::filesystem::temp_directory_path() /
+                 ("importers_" + name + "-" + std::to_string(::getpid()));
   std::filesystem::remove_all(d);
   std::filesystem::create_directories(d);
   return d;

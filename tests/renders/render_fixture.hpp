@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include <unistd.h>
+
 #include <Eigen/Geometry>
 #include <fmt/core.h>
 #include <mujoco/mujoco.h>
@@ -74,9 +76,11 @@ inline ModelPtr load_model(const std::string& xml = kBoxMjcf) {
   return m;
 }
 
-/// A scratch folder under the build tree, emptied first.
+/// A scratch folder in the test's temporary folder (under CTest, one of the test's own that is
+/// removed when it passes: tests/run_in_scratch.sh; the pid keeps two processes apart without it),
+/// emptied first.
 inline std::filesystem::path scratch_dir(const std::string& name) {
-  const auto dir = std::filesystem::path(DRIFTLESS_BINARY_DIR) / "test_out" / "renders" / name;
+  const auto dir = std::filesystem::temp_directory_path() / ("renders_" + name + "-" + std::to_string(::getpid()));
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;

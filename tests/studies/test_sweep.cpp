@@ -4,6 +4,8 @@
 #include <random>
 #include <sstream>
 
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 
 #include "estimator/input_error.hpp"
@@ -153,7 +155,7 @@ TEST(Sweep, ParallelTableIsIdenticalToSerialAndFailuresAreReported) {
   });
   EXPECT_EQ(calls, specs.size());
   const auto parallel = run_parallel(specs, all, job, 4);
-  const auto dir = std::filesystem::path(DRIFTLESS_BINARY_DIR) / "test_sweep_out";
+  const auto dir = std::filesystem::temp_directory_path() / ("test_sweep_out-" + std::to_string(::getpid()));
   std::filesystem::remove_all(dir);
   EXPECT_EQ(write_outputs(c, specs, serial, dir / "serial", false), 1u);
   // results split over two "ranks" and gathered as text give the same table

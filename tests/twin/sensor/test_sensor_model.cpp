@@ -8,6 +8,8 @@
 #include <set>
 #include <vector>
 
+#include <unistd.h>
+
 #include <Eigen/Geometry>
 
 #include "estimator/sample.hpp"
@@ -357,7 +359,7 @@ TEST(SensorModel, TemperatureCoefficientsAct) {
 
 TEST(SensorModel, TemperatureProfileIsInterpolated) {
   const std::filesystem::path file =
-      std::filesystem::path(DRIFTLESS_BINARY_DIR) / "tests" / "temperature_profile_test.csv";
+      std::filesystem::temp_directory_path() / ("temperature_profile_test-" + std::to_string(::getpid()) + ".csv");
   {
     std::ofstream out(file);
     out << "t_s,temp_degc\n0,20\n100,30\n# comment\n200,30\n";
