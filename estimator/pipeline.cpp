@@ -80,7 +80,8 @@ class WindowScore {
     sum2_ += e.squaredNorm();
     comp2_ += e.cwiseAbs2();
     max_ = std::max(max_, e.cwiseAbs().maxCoeff());
-    nees_ += nees(e, filter.covariance_dps2()) / 6.0;
+    // P carried to this sample (it refers to the last update's time; the bias wanders on)
+    nees_ += nees(e, filter.covariance_dps2_at(s.t_s)) / 6.0;
     last_ = e;
     ++n_;
   }
@@ -287,6 +288,9 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
     sum.scale_misalign_sigma_frac[static_cast<std::size_t>(i)] = filter.scale_misalign_sigma(i + 1);
   }
   sum.correction_sigma_dps = filter.correction_sigma_dps();
+  sum.stop_states = filter.has_stop_states();
+  sum.stop_angle_deg = filter.stop_angle_deg();
+  sum.stop_angle_sigma_deg = filter.stop_angle_sigma_deg();
   add_attitude_results(att, filter, opt, sum);
   score.finish();
   if (use_window) window.finish(filter);
