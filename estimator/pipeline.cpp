@@ -228,6 +228,7 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
   WindowScore window(sum.window, opt.eval_start_s);
   const bool use_window = have_truth && std::isfinite(opt.eval_start_s);
   HealthMonitor health(opt.health);
+  LagCheck lag(filter.geometry().sample_rate_hz);
 
   // the lock state changes only at updates (P shrinks there; a gate re-lock widens it)
   bool locked = false;
@@ -252,6 +253,7 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
     sum.t_last_s = s.t_s;
     const PushStatus st = filter.push(s);
     on_update(st, s);  // first: the row that made an update carries the state after it
+    lag.push(s, filter);
     sum.samples_locked += locked ? 1 : 0;
     if (sink != nullptr) sink->on_sample(s, filter.output(), locked);
     if (use_window) window.add(filter, s);
@@ -294,7 +296,7 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
   add_attitude_results(att, filter, opt, sum);
   score.finish();
   if (use_window) window.finish(filter);
-  sum.health = health.finish(filter, sum.rows > 0 ? sum.t_last_s - sum.t_first_s : 0.0);
+  sum.health = health.finish(filter, sum.rows > 0 ? sum.t_last_s - sum.t_first_s : 0.0, lag.finish());
   return sum;
 }
 
