@@ -14,6 +14,7 @@
 #include "estimator/box_geometry.hpp"
 #include "estimator/filter.hpp"
 #include "estimator/log.hpp"
+#include "importers/units.hpp"
 
 namespace driftless::cli::allan {
 
@@ -213,15 +214,38 @@ bool is_imported(const InputArgs& a) {
          (f != importers::Format::kAuto || importers::detect_format(a.in) != importers::Format::kDriftlessLog);
 }
 
+namespace {
+
+// a unit option checked when it is parsed (a usage error, exit 2), by the importers' own unit table
+CLI::Validator unit_option(importers::Unit (*parse)(const std::string&, std::string_view), const std::string& option) {
+  return CLI::Validator(
+      [parse, option](std::string& text) -> std::string {
+        try {
+          (void)parse(text, option);
+        } catch (const std::exception& e) {
+          std::string why = e.what();
+          const std::string prefix = option + ": ";
+          return why.rfind(prefix, 0) == 0 ? why.substr(prefix.size()) : why;
+        }
+        return {};
+      },
+      "UNIT");
+}
+
+}  // namespace
+
 void add_import_options(CLI::App* cmd, InputArgs& in) {
   cmd->add_option("--format", in.format, "Input format: auto, text, euroc, npy, bag")
       ->check(CLI::IsMember({"auto", "text", "euroc", "npy", "bag", "log"}));
   cmd->add_option("--columns", in.columns, "Rate channels: names or 1-based indices, comma-separated (log default: gyro1_x..gyro2_z)");
   cmd->add_option("--accel-columns", in.accel_columns, "Accelerometer channels (x,y,z), names or 1-based indices");
   cmd->add_option("--time-column", in.import.time_column, "Time column: name, 1-based index or none (default: detected)");
-  cmd->add_option("--units", in.import.units, "Rate units: deg/s, rad/s or lsb:<LSB per deg/s> (MPU6050 +-250: lsb:131)");
-  cmd->add_option("--accel-units", in.import.accel_units, "Acceleration units: m/s^2, g or lsb:<LSB per g>");
-  cmd->add_option("--time-units", in.import.time_units, "Time units: s, ms, us, ns (default: detected)");
+  cmd->add_option("--units", in.import.units, "Rate units: deg/s, rad/s or lsb:<LSB per deg/s> (MPU6050 +-250: lsb:131)")
+      ->check(unit_option(importers::parse_rate_unit, "--units"));
+  cmd->add_option("--accel-units", in.import.accel_units, "Acceleration units: m/s^2, g or lsb:<LSB per g>")
+      ->check(unit_option(importers::parse_accel_unit, "--accel-units"));
+  cmd->add_option("--time-units", in.import.time_units, "Time units: s, ms, us, ns (default: detected)")
+      ->check(unit_option(importers::parse_time_unit, "--time-units"));
   cmd->add_option("--separator", in.import.separator, "Text separator: one character, tab or space (default: detected)");
   cmd->add_flag("--no-header", in.import.no_header, "Text: the first row is data");
   cmd->add_option("--topic", in.import.topic, "Bag: the sensor_msgs/Imu topic (default: the only one)");

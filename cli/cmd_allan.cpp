@@ -207,7 +207,8 @@ const bool registered = register_command(40, [](CLI::App& app) {
   cmd->add_option("--inflate", a->exports.inflate, "Multiply exported noise densities and random walks by this (default 1)")
       ->check(CLI::Range(1.0, 1000.0));
   cmd->add_option("--export-topic", a->exports.topic, "rostopic written into the noise files (default /imu0)");
-  cmd->add_option("--validate", a->validate, "Simulate N records from the fit with the twin's sensor model; 95 % band and verdict");
+  cmd->add_option("--validate", a->validate, "Simulate N records from the fit with the twin's sensor model; 95 % band and verdict")
+      ->check(count_number(0, 10000));
   cmd->add_option("--seed", a->seed, "Seed of --validate, 0 .. 2^64-1 (default 1)")->check(seed_number());
   cmd->add_flag("--strict", a->strict, "Exit 1 when the record makes the figures wrong for the sensor (it is not at rest)");
   cmd->add_flag("--plot", a->plot, "Also write allan.png/svg and allan_<channel>.png/svg with their gnuplot scripts");

@@ -106,6 +106,26 @@ struct TimePlan {
   std::vector<std::string> notes;
 };
 
+/// --time auto falls back on t = t0 + k / rate when the stamps repeat or go back. That is right
+/// when every sample is there (a logger that stamped one row twice); when samples are missing as
+/// well (gaps), it moves every row after a gap to an earlier time and hides the gap. Refused then:
+/// the last row's k / rate time against its stamp tells, whatever the mix of repeats and gaps.
+void refuse_shifting_uniform_time(const importers::StreamInfo& info, const importers::StampReport& st,
+                                  const TimePlan& p) {
+  if (st.rows < 2 || !std::isfinite(st.last_t_s) || !(p.rate_hz > 0.0)) return;
+  const double last_uniform_s = p.t0_s + static_cast<double>(st.rows - 1) / p.rate_hz;
+  const double shift_s = st.last_t_s - last_uniform_s;  // s, how far k / rate moves the last row
+  if (!(std::fabs(shift_s) > 0.5 / p.rate_hz)) return;
+  throw InputError(
+      info.source, 0, "--time",
+      fmt::format("the stamps cannot be the log's time ({}), and t = first stamp + k / {:.6g} Hz would move the "
+                  "last row {:.6g} s {} its stamp ({}): samples are missing, so a uniform time puts every row after "
+                  "a gap at the wrong time. Repair the stamps that repeat or go back (the rows keep their time "
+                  "then), or give --time uniform to accept the shift",
+                  fmt::join(st.describe("line"), "; "), p.rate_hz, std::fabs(shift_s),
+                  shift_s > 0 ? "before" : "after", fmt::format("{:.6f} s against {:.6f} s", last_uniform_s, st.last_t_s)));
+}
+
 TimePlan plan_time(const ConvertArgs& a, const importers::StreamInfo& info, const importers::StampReport& st) {
   TimePlan p;
   const TimeBase want = parse_time_base(a.time);
@@ -122,6 +142,7 @@ TimePlan plan_time(const ConvertArgs& a, const importers::StreamInfo& info, cons
                                  fmt::join(st.describe("line"), "; ")));
   }
   if (info.has_time) p.t0_s = st.first_t_s;
+  if (want == TimeBase::kAuto && p.uniform && info.has_time) refuse_shifting_uniform_time(info, st, p);
   if (info.has_time && info.epoch_s != 0) {
     p.notes.push_back(fmt::format("t counts from the epoch {} s (the first stamp floored to whole seconds): "
                                   "t = stamp - {} s, formed in integer ns", info.epoch_s, info.epoch_s));
@@ -222,6 +243,22 @@ std::string ref_summary(const RefJoin& j) {
                      j.before, j.after, j.in_gaps);
 }
 
+/// --full-scale states the gyro's range in the log; a reading beyond the margin the log's readers
+/// allow (log::kFullScaleMargin x FS) would make every reader refuse the log, so the range given
+/// is wrong: refused here, naming the input row, rather than writing a log nobody can read.
+void check_full_scale(const Sample& s, const ConvertArgs& a, const std::string& source, std::uint64_t loc) {
+  if (!(a.full_scale_dps > 0.0)) return;
+  for (int k = 0; k < 3; ++k) {
+    const double v = s.gyro1_dps[k];
+    if (!(std::fabs(v) > log::kFullScaleMargin * a.full_scale_dps)) continue;
+    throw InputError(source, static_cast<std::size_t>(loc), "--full-scale",
+                     fmt::format("gyro {} reads {:.6g} deg/s, beyond {:g} x the --full-scale {:g} deg/s: a gyro with "
+                                 "that range cannot give it, and every reader would refuse the log; give the sensor's "
+                                 "real range (or leave --full-scale out)",
+                                 "xyz"[k], v, log::kFullScaleMargin, a.full_scale_dps));
+  }
+}
+
 int run_convert(const ConvertArgs& a) {
   const auto opt = a.input.import_options();
   auto reader = importers::open_imu(a.input.in, opt);
@@ -253,6 +290,12 @@ int run_convert(const ConvertArgs& a) {
     for (std::size_t r = 0; r < block.rows(); ++r, ++k) {
       const double t = tp.uniform ? tp.t0_s + static_cast<double>(k) / tp.rate_hz : block.t_s[r];
       Sample s = sample_of(block, r, map, t);
+      try {
+        check_full_scale(s, a, info.source, block.loc.empty() ? k + 1 : block.loc[r]);
+      } catch (const InputError& e) {
+        writer.finish(false, e.what());  // the rows before stay; the log says why it stops there
+        throw;
+      }
       if (ref && !ref->attach(s)) continue;
       writer.write(s);
       last_t = t;
@@ -299,12 +342,13 @@ const bool registered = register_command(
                                                          "(MPU6050 default: 250)")
           ->check(positive_number("deg/s"));
       cmd->add_option("--source", a->source_name, "Text for the log's 'source' key (default: the file and its format)");
-      cmd->add_option("--ref", a->ref, "Ground truth to join into ref_q/ref_p (EuRoC state_groundtruth_estimate0 or "
+      auto* ref = cmd->add_option("--ref", a->ref, "Ground truth to join into ref_q/ref_p (EuRoC state_groundtruth_estimate0 or "
                                        "vicon0 data.csv: ns stamp, p x y z, q w x y z); rows outside its span are trimmed")
           ->check(CLI::ExistingFile);
       cmd->add_option("--ref-max-gap", a->ref_max_gap_s, "s: a longer step of the ground truth is a gap, rows in it get "
                                                          "no reference (default: 10 of its median steps)")
-          ->check(positive_number("s"));
+          ->check(positive_number("s"))
+          ->needs(ref);
       return [a] { return run_convert(*a); };
     },
     Interrupt::kPolls);

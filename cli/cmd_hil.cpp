@@ -12,6 +12,7 @@
 #include "cli/command.hpp"
 #include "cli/hil_fdi.hpp"
 #include "estimator/filter.hpp"
+#include "estimator/health.hpp"
 #include "estimator/log.hpp"
 #include "estimator/log_metadata.hpp"
 #include "hil_bridge/cpu_latency.hpp"
@@ -84,11 +85,68 @@ hil::RigOptions rig_options(const HilOptions& o) {
   return ro;
 }
 
-int run_hil(const HilOptions& o) {
-  if (!o.switch_to.empty() && std::isnan(o.at_s)) {
-    throw std::invalid_argument("hil: --switch-to needs --at T (session time of the switch, s)");
+// the source options, and the kinds of source each one sets something of
+struct SourceOption {
+  const char* name;
+  bool (*applies)(const std::string& spec, const HilOptions& o);
+  const char* sources;  // for the message
+};
+
+bool starts_with(const std::string& s, const char* p) { return s.rfind(p, 0) == 0; }
+bool is_device(const std::string& s) { return starts_with(s, "i2c:") || starts_with(s, "serial:"); }
+bool is_emulator(const std::string& s) { return s == "emu-i2c" || s == "emu-serial"; }
+bool is_serial(const std::string& s) { return starts_with(s, "serial:") || s == "emu-serial"; }
+
+constexpr SourceOption kSourceOptions[] = {
+    {"--rate", [](const std::string& s, const HilOptions&) { return is_device(s) || is_emulator(s); },
+     "i2c:, serial:, emu-i2c and emu-serial (a replay runs at its log's rate, the twin at its scenario's)"},
+    {"--baud", [](const std::string& s, const HilOptions&) { return is_serial(s); }, "serial: and emu-serial"},
+    {"--scenario", [](const std::string& s, const HilOptions&) { return s == "twin"; }, "twin"},
+    {"--emu-sensor", [](const std::string& s, const HilOptions&) { return is_emulator(s); }, "emu-i2c and emu-serial"},
+    {"--seed", [](const std::string& s, const HilOptions&) { return is_emulator(s) || s == "twin"; },
+     "emu-i2c, emu-serial and twin"},
+    {"--standstill",
+     [](const std::string& s, const HilOptions& o) {
+       return is_device(s) || is_emulator(s) || (s == "twin" && o.twin_flips == "bridge");
+     },
+     "i2c:, serial:, emu-i2c, emu-serial and twin with --twin-flips bridge (the bridge's flip schedule; a "
+     "replay's platforms flip as recorded)"},
+};
+
+// an option given for a source that does not use it would be ignored without a word: refused
+// (a usage error), e.g. --rate 1000 with a replay of a 10 Hz log
+void refuse_options_no_source_uses(const CLI::App& cmd, const HilOptions& o) {
+  for (const SourceOption& opt : kSourceOptions) {
+    if (cmd.count(opt.name) == 0) continue;
+    if (opt.applies(o.source, o) || (!o.switch_to.empty() && opt.applies(o.switch_to, o))) continue;
+    throw CLI::ValidationError(opt.name, fmt::format("{} is for {}; the session's source{} ({}{}) would ignore it: "
+                                                     "leave it out",
+                                                     opt.name, opt.sources, o.switch_to.empty() ? "" : "s", o.source,
+                                                     o.switch_to.empty() ? "" : ", " + o.switch_to));
   }
-  if (o.switch_to.empty() && !std::isnan(o.at_s)) throw std::invalid_argument("hil: --at needs --switch-to SOURCE");
+  if (!std::isnan(o.at_s) && !std::isnan(o.duration_s) && !(o.at_s < o.duration_s)) {
+    throw CLI::ValidationError("--at", fmt::format("the switch at {:g} s would come after the session's end at "
+                                                   "--duration {:g} s", o.at_s, o.duration_s));
+  }
+}
+
+// the bias lines are the filter's start value until it locked (estimate's lock level): say so, and
+// why when the samples never had both triads
+void warn_if_never_locked(const est::DriftlessFilter& filter) {
+  const double lock_dps = est::HealthLimits{}.lock_sigma_dps;
+  const double sigma_dps = filter.correction_sigma_dps().maxCoeff();
+  if (sigma_dps < lock_dps) return;
+  const est::FilterCounters& c = filter.counters();
+  fmt::print(stderr,
+             "driftless hil: warning: the filter never locked (largest sigma {:.3g} deg/s, locked below {:g}; {} "
+             "update(s), {} rejected): the biases above are not estimates{}\n",
+             sigma_dps, lock_dps, c.updates, c.rejected,
+             c.invalid > 0 ? fmt::format("; {} of {} samples lacked a gyro value (an empty column: a dead axis or "
+                                         "a missing sensor?)", c.invalid, c.samples)
+                           : "");
+}
+
+int run_hil(const HilOptions& o) {
   std::filesystem::create_directories(o.out_dir);
 
   const hil::RigOptions ro = rig_options(o);
@@ -179,6 +237,11 @@ int run_hil(const HilOptions& o) {
     }
     throw;
   }
+  const bool switch_missed = second && !st.switched && st.complete;
+  if (switch_missed) {
+    writer.event(st.t_last_s, fmt::format("switch: to {} at t={:g} s did not happen: {}", second->source->name(),
+                                          o.at_s, st.end_reason));
+  }
   writer.finish(st.complete, st.end_reason);
 
   const Eigen::Matrix<double, 6, 1> sig = filter.sigma_dps();
@@ -190,8 +253,16 @@ int run_hil(const HilOptions& o) {
   fmt::print("filter: {} updates, {} rejected by the NIS gate, {} source switches\n", filter.counters().updates,
              filter.counters().rejected, filter.counters().source_switches);
   fmt::print("log: {}\n", log_path.string());
+  warn_if_never_locked(filter);
   if (!st.complete) throw std::runtime_error("hil: " + st.end_reason + "; the log so far is " + log_path.string() +
                                              " (complete: false)");
+  if (switch_missed) {
+    // the session asked for did not run: the log holds the first source only
+    throw std::runtime_error(fmt::format("hil: the switch to {} at t={:g} s did not happen: {} at t={:.3f} s; {} holds "
+                                         "{} only (give an --at inside the first source's span)",
+                                         second->source->name(), o.at_s, st.end_reason, st.t_last_s,
+                                         log_path.string(), first->source->name()));
+  }
   if (!fdi) return 0;
   const std::filesystem::path fdi_json = std::filesystem::path(o.out_dir) / "fdi.json";
   write_fdi_json(fdi_json, *fdi);
@@ -204,8 +275,10 @@ const bool registered = register_command(60, [](CLI::App& app) {
              "their emulators; record a measurement log; switch sources mid-run (docs/hil.md)");
   auto o = std::make_shared<HilOptions>();
   cmd->add_option("--source", o->source, std::string("Source of samples: ") + hil::source_spec_help())->required();
-  cmd->add_option("--switch-to", o->switch_to, "Second source, taken over at --at (same spellings)");
-  cmd->add_option("--at", o->at_s, "Session time of the switch-over, s");
+  auto* switch_to = cmd->add_option("--switch-to", o->switch_to, "Second source, taken over at --at (same spellings)");
+  auto* at = cmd->add_option("--at", o->at_s, "Session time of the switch-over, s")->check(positive_number("s"));
+  switch_to->needs(at);
+  at->needs(switch_to);
   cmd->add_option("--out", o->out_dir, "Output directory (log.csv is written there)")->required();
   cmd->add_flag("--realtime", o->realtime,
                 "Pace the twin, replays and emu-i2c by the wall clock (default: as fast as possible; "
@@ -213,9 +286,14 @@ const bool registered = register_command(60, [](CLI::App& app) {
   cmd->add_flag("--allow-deep-idle", o->allow_deep_idle,
                 "Do not ask Linux to keep the CPUs out of deep idle states during a session paced by the wall "
                 "clock (saves power; wake-ups can then be tens of microseconds later)");
-  cmd->add_option("--duration", o->duration_s, "Session time to run, s (default: until the source ends)");
-  cmd->add_option("--rate", o->rate_hz, "Sample rate of i2c, serial and emulated sources, Hz")->default_val(100.0);
-  cmd->add_option("--standstill", o->standstill_s, "Flip schedule hold time at each position, s")->default_val(10.0);
+  cmd->add_option("--duration", o->duration_s, "Session time to run, s (default: until the source ends)")
+      ->check(positive_number("s"));
+  cmd->add_option("--rate", o->rate_hz, "Sample rate of i2c, serial and emulated sources, Hz")
+      ->check(positive_number("Hz"))
+      ->default_val(100.0);
+  cmd->add_option("--standstill", o->standstill_s, "Flip schedule hold time at each position, s")
+      ->check(positive_number("s"))
+      ->default_val(10.0);
   cmd->add_option("--baud", o->baud, "Serial link speed, bit/s")->default_val(921600);
   cmd->add_option("--scenario", o->scenario, "twin: scenario YAML file or built-in name (default: the built-in default)");
   cmd->add_option("--emu-sensor", o->emu_sensor,
@@ -235,7 +313,10 @@ const bool registered = register_command(60, [](CLI::App& app) {
       ->check(seed_number())
       ->default_val(1);
   cmd->add_option("--estimator-config", o->estimator_config, "Estimator configuration (key: value, docs/estimator.md)");
-  cmd->add_option("--print-every", o->print_every_s, "Terminal line every this much session time, s")->default_val(10.0);
+  cmd->add_option("--print-every", o->print_every_s, "Terminal line every this much session time, s")
+      ->check(positive_number("s"))
+      ->default_val(10.0);
+  cmd->parse_complete_callback([cmd, o] { refuse_options_no_source_uses(*cmd, *o); });
   return [o] { return run_hil(*o); };
 }, Interrupt::kPolls);
 

@@ -44,6 +44,8 @@ CLI::Validator positive_number(const std::string& unit);
 CLI::Validator non_negative_number(const std::string& unit);
 /// A seed: a whole number 0 .. 18446744073709551615 (a sign is refused, not wrapped around).
 CLI::Validator seed_number();
+/// A count: a whole number lo .. hi (a sign is refused, not wrapped around into an unsigned option).
+CLI::Validator count_number(std::uint64_t lo, std::uint64_t hi);
 
 /// Before a run writes about `bytes` under `dir`: a warning on stderr when the file system has
 /// less free space (the run would stop with "No space left on device"). Returns true if it warned.

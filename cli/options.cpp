@@ -65,6 +65,20 @@ CLI::Validator seed_number() {
       "SEED");
 }
 
+CLI::Validator count_number(std::uint64_t lo, std::uint64_t hi) {
+  const std::string expected = fmt::format("a whole number {} .. {}", lo, hi);
+  return CLI::Validator(
+      [expected, lo, hi](std::string& text) -> std::string {
+        if (text.empty() || text.size() > 19 || text.find_first_not_of("0123456789") != std::string::npos) {
+          return "expected " + expected + ", got '" + text + "'";
+        }
+        const std::uint64_t v = std::stoull(text);
+        if (v < lo || v > hi) return "expected " + expected + ", got '" + text + "'";
+        return {};
+      },
+      expected);
+}
+
 bool warn_if_disk_too_small(const std::string& command, const std::filesystem::path& dir, double bytes,
                             const std::string& what) {
   const std::int64_t free = io::free_bytes(dir);

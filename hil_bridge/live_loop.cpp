@@ -212,6 +212,9 @@ LiveStats LiveLoop::run_loop(SampleSource& first, SampleSource* second, const st
   }
   drain(*src);
   src->deactivate();
+  // the stream ended (whatever ended it): a standstill still open is good data, as at the end of a
+  // log in 'estimate' (DriftlessFilter::finish), so the session and 'estimate' on its log agree
+  if (filter_) filter_->finish();
   return stats_;
 }
 

@@ -15,8 +15,10 @@ ReplaySource::ReplaySource(Clock& clock, ReplayParams p) : clock_(clock), p_(std
 ReplaySource::~ReplaySource() = default;
 
 void ReplaySource::describe(log::Metadata& meta) const {
-  // the box is the one of the recording: keep its geometry and place
-  for (const char* key : {"latitude_deg", "hinge1_axis", "hinge2_axis"}) {
+  // the box and sensors are the recording's: keep its geometry, place, rest angles and gyro range
+  // (the session's filter takes its geometry from these keys, the log's readers the range)
+  for (const char* key : {"latitude_deg", "hinge1_axis", "hinge2_axis", "flip_angle_deg", "end_stop_deg",
+                          "gyro_full_scale_dps", "platform_readback", "sensor1_preset", "sensor2_preset"}) {
     if (auto v = meta_.get(key)) meta.set(key, *v);
   }
   meta.set("source", name());
@@ -38,7 +40,9 @@ Status ReplaySource::configure() {
   fields_ = reader_->fields();
   rate_hz_ = meta_.get_number("sample_rate_hz", kNaN);
   if (!(rate_hz_ > 0.0)) {
-    return Status::BadConfig("replay: " + p_.path + " has no sample_rate_hz in its metadata");
+    // the session's period, gap detection and the filter's noise per sample need the rate
+    return Status::BadConfig("replay: " + p_.path + " has no sample_rate_hz in its metadata: add a line "
+                             "'# sample_rate_hz: <Hz>' before its header row (docs/log-format.md)");
   }
   return Status::Ok();
 }

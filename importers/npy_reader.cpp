@@ -1,10 +1,10 @@
 // NumPy .npy arrays (format versions 1-3): a 1-D array (one channel) or a C-order 2-D array of
 // float32/float64 or integer counts, one sample per row (docs/import.md, npy).
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
-#include <algorithm>
 #include <cstring>
 #include <limits>
 #include <string>
@@ -135,7 +135,14 @@ NpyReader::NpyReader(const std::filesystem::path& path, const ImportOptions& opt
   info_.rows_estimate = h_.rows;
   if (time_col_ >= 0) time_scale_ = opt.time_units.empty() ? 1.0 : parse_time_unit(opt.time_units, "--time-units").scale;
   const Unit ru = opt.units.empty() ? Unit{1.0, "deg/s"} : parse_rate_unit(opt.units, "--units");
-  for (const auto& c : opt.columns) pick_.push_back(column_index(c, h_.cols, file, "--columns"));
+  for (const auto& c : opt.columns) {
+    const int idx = column_index(c, h_.cols, file, "--columns");
+    if (std::find(pick_.begin(), pick_.end(), idx) != pick_.end() || idx == time_col_) {
+      throw ImportError(file + ": --columns " + c + ": column " + std::to_string(idx + 1) +
+                        " is already read as another channel; name each column once");
+    }
+    pick_.push_back(idx);
+  }
   if (pick_.empty()) {
     for (std::size_t c = 0; c < h_.cols; ++c) {
       if (static_cast<int>(c) != time_col_) pick_.push_back(static_cast<int>(c));

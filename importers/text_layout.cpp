@@ -339,13 +339,28 @@ void say_datetime_time(TextLayout& L, std::string_view first_row) {
                           "'): read as UTC, to the ns (no zone given: UTC)");
 }
 
+// a column the options name: one channel only (--columns gyro_x,gyro_x,gyro_z would read one axis
+// twice and no other, and --temp-column acc_x would take an accelerometer axis for a temperature)
+void add_named_pick(TextLayout& L, const std::string& name, const char* option, Quantity q, int axis,
+                    const std::string& file) {
+  const int idx = find_column(name, L.header, L.fields, file, option);
+  const bool taken = idx == L.time_index || std::any_of(L.picks.begin(), L.picks.end(),
+                                                        [idx](const ColumnPick& p) { return p.index == idx; });
+  if (taken) {
+    throw ImportError(file + ": " + option + " " + name + ": column " + std::to_string(idx + 1) + " ('" +
+                      column_name(L, idx) + "') is already read as " + (idx == L.time_index ? "the time" : "another channel") +
+                      "; name each column once");
+  }
+  add_pick(L, idx, q, axis);
+}
+
 // rate (and accel) columns from the options, the header names, or the column count
 bool pick_channels(TextLayout& L, const ImportOptions& opt, const std::string& file) {
   const auto fields = L.fields;
   if (!opt.columns.empty()) {
     for (std::size_t k = 0; k < opt.columns.size(); ++k) {
-      add_pick(L, find_column(opt.columns[k], L.header, fields, file, "--columns"), Quantity::kRate,
-               opt.columns.size() == 3 ? static_cast<int>(k) : -1);
+      add_named_pick(L, opt.columns[k], "--columns", Quantity::kRate, opt.columns.size() == 3 ? static_cast<int>(k) : -1,
+                     file);
     }
   } else if (opt.all_columns) {
     for (std::size_t i = 0; i < fields; ++i) {
@@ -360,8 +375,8 @@ bool pick_channels(TextLayout& L, const ImportOptions& opt, const std::string& f
   }
   if (!opt.accel_columns.empty()) {
     for (std::size_t k = 0; k < opt.accel_columns.size(); ++k) {
-      add_pick(L, find_column(opt.accel_columns[k], L.header, fields, file, "--accel-columns"), Quantity::kAccel,
-               opt.accel_columns.size() == 3 ? static_cast<int>(k) : -1);
+      add_named_pick(L, opt.accel_columns[k], "--accel-columns", Quantity::kAccel,
+                     opt.accel_columns.size() == 3 ? static_cast<int>(k) : -1, file);
     }
   } else if (opt.columns.empty() && !opt.all_columns) {
     for (std::size_t i = 0; i < L.header.size(); ++i) {
@@ -371,7 +386,7 @@ bool pick_channels(TextLayout& L, const ImportOptions& opt, const std::string& f
     }
   }
   if (!opt.temp_column.empty()) {
-    add_pick(L, find_column(opt.temp_column, L.header, fields, file, "--temp-column"), Quantity::kTemperature, -1);
+    add_named_pick(L, opt.temp_column, "--temp-column", Quantity::kTemperature, -1, file);
   } else {
     for (std::size_t i = 0; i < L.header.size(); ++i) {
       if (in(kTempNames, normalise(L.header[i]))) add_pick(L, static_cast<int>(i), Quantity::kTemperature, -1);

@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # driftless convert: other people's recordings into the single-sensor log, which check and allan
 # then read. Real MPU6050 files (bursty stamps; raw counts without time), a regular-stamp EuRoC
-# file, and the refusals: two triads without --columns, stamps that step back with --time stamps.
+# file, and the refusals: two triads without --columns, stamps that step back with --time stamps,
+# a repeated stamp in a recording with a gap (a uniform time would move the rows after it), and a
+# --full-scale the readings exceed.
 set -euo pipefail
 bin=$1; src=$2
 real=$src/../shared/realdata/mpu6050-sunsided/unmoved-with-x-pointing-forward/mpu6050.csv
@@ -92,4 +94,28 @@ grep -q "back.csv.*--time uniform" <<< "$out" || fail "message for stamps steppi
 printf 't,g1x,g1y,g1z,g2x,g2y,g2z\n0.00,1,2,3,4,5,6\n0.01,1,2,3,4,5,6\n' > "$t/two.csv"
 out=$("$bin" convert --in "$t/two.csv" --out "$t/two.log" 2>&1) && fail "two triads accepted without --columns"
 grep -q "two.csv.*--columns" <<< "$out" || fail "message for two triads: $out"
+
+# 5. a repeated stamp (--time auto then uses t0 + k / rate): right when every sample is there,
+# refused when samples are missing too (a uniform time would move every row after the gap)
+awk 'BEGIN { print "time,gx,gy,gz"; for (k = 0; k < 1000; ++k) { s = (k == 500 ? k - 1 : k)
+  printf "%.2f,%.4f,0.5,-0.25\n", s / 100, sin(k / 10) } }' > "$t/twice.csv"   # row 500 stamped like row 499
+"$bin" convert --in "$t/twice.csv" --out "$t/twice.log" > "$t/twice.txt" || { cat "$t/twice.txt"; fail "case 5: one repeated stamp"; }
+[[ $(awk -F, '!/^#/ && !/^t,/ { l = $1 } END { print l }' "$t/twice.log") == 9.990000 ]] ||
+  fail "case 5: the last row is not at its stamp 9.99 s: $(tail -1 "$t/twice.log")"
+awk 'BEGIN { print "time,gx,gy,gz"; for (k = 0; k < 1000; ++k) { if (k >= 300 && k < 500) continue; s = (k == 700 ? k - 1 : k)
+  printf "%.2f,%.4f,0.5,-0.25\n", s / 100, sin(k / 10) } }' > "$t/gap_twice.csv"   # 2 s missing, then a repeat
+out=$("$bin" convert --in "$t/gap_twice.csv" --out "$t/gap_twice.log" 2>&1) && fail "case 5: a uniform time over a 2 s gap was accepted"
+grep -q "gap_twice.csv: --time: .*would move the last row 2 s before its stamp.*--time uniform" <<< "$out" ||
+  fail "case 5: message for a repeated stamp with a gap: $out"
+[[ ! -e $t/gap_twice.log ]] || fail "case 5: a log was written although refused"
+"$bin" convert --in "$t/gap_twice.csv" --time uniform --out "$t/gap_twice.log" > /dev/null || fail "case 5: --time uniform refused"
+# 6. --full-scale below the readings: refused at the first row beyond 1.1 x FS (every reader would
+# refuse the log), naming the input line; the log so far says complete: false and why
+awk 'BEGIN { print "time,gx,gy,gz"; for (k = 0; k < 200; ++k) printf "%.2f,%.4f,0,0\n", k / 100, k / 2 }' > "$t/fast.csv"
+out=$("$bin" convert --in "$t/fast.csv" --full-scale 50 --out "$t/fast.log" 2>&1) && fail "case 6: readings beyond --full-scale accepted"
+grep -q "fast.csv:113: --full-scale: gyro x reads 55.5 deg/s, beyond 1.1 x the --full-scale 50 deg/s" <<< "$out" ||
+  fail "case 6: message: $out"
+[[ $(meta "$t/fast.log" complete) == false ]] || fail "case 6: the log does not say complete: false"
+"$bin" check --log "$t/fast.log" > /dev/null 2>&1 || fail "case 6: the rows before the refusal are not a readable log"
+"$bin" convert --in "$t/fast.csv" --full-scale 100 --out "$t/fast.log" > /dev/null || fail "case 6: --full-scale 100 refused"
 echo "convert: ok"

@@ -35,6 +35,13 @@ expect 2 "driftless simulate: --duration: expected a number > 0 (s), got 'abc'" 
 expect 2 "driftless simulate: --seed: expected a whole number 0 .. 18446744073709551615, got '-1'" \
   simulate --out "$t/s" --seed -1
 expect 2 "driftless hil: --seed: expected a whole number" hil --source emu-i2c --out "$t/h" --seed -3
+# a count given as a negative number is refused, not wrapped around into 2^64 - 1 (which ran forever)
+expect 2 "driftless allan: --validate: expected a whole number 0 .. 10000, got '-1'" \
+  allan --log "$golden" --out "$t/a" --validate -1
+# a unit not in the unit table is a usage error, found when the options are read
+expect 2 "driftless convert: --units: expected deg/s, rad/s or lsb:" convert --in "$golden" --out "$t/c.csv" --units furlongs
+expect 2 "driftless allan: --time-units: expected s, ms, us or ns" allan --in "$golden" --out "$t/a" --time-units parsecs
+expect 2 "driftless convert: --ref-max-gap requires --ref" convert --in "$golden" --out "$t/c.csv" --ref-max-gap 1
 expect 2 "driftless check: --log is required" check
 expect 2 "driftless estimate: --mode" estimate --log "$golden" --out "$t/e" --mode sideways
 expect 2 "driftless check: --log: File does not exist" check --log "$t/none.csv"

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # driftless hil end to end: emulated I2C run, a switch-over from a replayed log to emulated I2C,
-# the emulated serial link over a pty, and one clear error for a missing device.
+# the emulated serial link over a pty, one clear error for a missing device, options no source uses
+# refused, and a switch-over that never happened reported as a failure.
 # usage: bash hil.sh <path-to-driftless> <source-dir>
 set -euo pipefail
 bin=$1
@@ -122,4 +123,30 @@ if "$bin" hil --source twin --emu-fault stuck:1:x@1 --out "$out/t" --duration 1 
 grep -q "needs --source (or --switch-to) emu-i2c" "$out/t.err" || fail "--emu-fault on the twin: $(cat "$out/t.err")"
 if "$bin" hil --source emu-i2c --emu-fault stuck:3:x@1 --out "$out/u" --duration 1 2> "$out/u.err"; then fail "--emu-fault sensor 3 accepted"; fi
 grep -q "sensor '3' is not 1 or 2" "$out/u.err" || fail "--emu-fault sensor 3: $(cat "$out/u.err")"
+# options the chosen sources do not use are refused (usage error, exit 2), not silently ignored
+rc=0; "$bin" hil --source "replay:$out/a/log.csv" --rate 1000 --out "$out/r" 2> "$out/r.err" || rc=$?
+[[ $rc -eq 2 ]] || fail "--rate with a replay: exit $rc, expected 2"
+grep -q -- "--rate is for i2c:.*replay:.*would ignore it" "$out/r.err" || fail "--rate with a replay: $(cat "$out/r.err")"
+rc=0; "$bin" hil --source "replay:$out/a/log.csv" --switch-to emu-i2c --at 60 --seed 4 --duration 70 --out "$out/r2" > /dev/null || rc=$?
+[[ $rc -eq 0 ]] || fail "--seed for the emulated second source refused: exit $rc"
+rc=0; "$bin" hil --source emu-i2c --duration -5 --out "$out/r3" 2> "$out/r3.err" || rc=$?
+[[ $rc -eq 2 ]] || fail "--duration -5: exit $rc, expected 2"
+# a switch-over that never happens (the replay ends first) is not a success
+rc=0; "$bin" hil --source "replay:$out/a/log.csv" --switch-to emu-i2c --at 200 --duration 300 --out "$out/w" > /dev/null 2> "$out/w.err" || rc=$?
+[[ $rc -eq 1 ]] || fail "a switch after the replay's end: exit $rc, expected 1"
+grep -q "switch to emu-i2c at t=200 s did not happen: replay:.* ended at t=119.990 s" "$out/w.err" || fail "missed switch: $(cat "$out/w.err")"
+grep -q "^# event: t=119.990000 switch: to emu-i2c at t=200 s did not happen" "$out/w/log.csv" || fail "missed switch: no event line"
+# a replayed log without sample_rate_hz: refused, saying what to add
+grep -v '^# sample_rate_hz:' "$out/a/log.csv" > "$out/norate.csv"
+if "$bin" hil --source "replay:$out/norate.csv" --out "$out/nr" > /dev/null 2> "$out/nr.err"; then fail "a replay without a rate accepted"; fi
+grep -q "norate.csv has no sample_rate_hz in its metadata: add a line '# sample_rate_hz: <Hz>'" "$out/nr.err" ||
+  fail "replay without a rate: $(cat "$out/nr.err")"
+# a replay whose gyro2_z is empty in every row (a dead axis) never locks: said, with the reason
+awk -F, 'BEGIN { OFS = "," } /^#/ { print; next } /^t,/ { for (i = 1; i <= NF; ++i) if ($i == "gyro2_z") c = i; print; next }
+  { $c = ""; print }' "$out/a/log.csv" > "$out/dead.csv"
+"$bin" hil --source "replay:$out/dead.csv" --out "$out/d" > /dev/null 2> "$out/d.err" || fail "dead axis: exit $?"
+grep -q "warning: the filter never locked (largest sigma 20 deg/s.*12000 of 12000 samples lacked a gyro value" "$out/d.err" ||
+  fail "dead axis: $(cat "$out/d.err")"
+"$bin" hil --source "replay:$out/a/log.csv" --out "$out/d2" > /dev/null 2> "$out/d2.err"
+if grep -q "never locked" "$out/d2.err"; then fail "a locked replay warns: $(cat "$out/d2.err")"; fi
 echo "hil: ok"

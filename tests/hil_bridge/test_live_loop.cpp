@@ -8,12 +8,14 @@
 #include <array>
 #include <atomic>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <string>
 #include <vector>
 
+#include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
 #include "estimator/filter.hpp"
@@ -191,6 +193,75 @@ TEST(LiveLoop, SwitchOverKeepsTheEstimatorAndLosesNoSample) {
   EXPECT_TRUE(before.isApprox(after)) << before.transpose() << "\n" << after.transpose();
   EXPECT_GT(filter.counters().updates, updates_before);
   EXPECT_EQ(filter.counters().source_switches, 1u);
+  fs::remove(rec);
+  fs::remove(path);
+}
+
+std::string fmt_row(double t_s, const Eigen::Vector3d& y1_dps, const Eigen::Vector3d& y2_dps, double p1_deg,
+                    double p2_deg) {
+  char b[256];
+  std::snprintf(b, sizeof b, "%.6f,%.9f,%.9f,%.9f,%.9f,%.9f,%.9f,%.6f,%.6f\n", t_s, y1_dps[0], y1_dps[1], y1_dps[2],
+                y2_dps[0], y2_dps[1], y2_dps[2], p1_deg, p2_deg);
+  return b;
+}
+
+// A log written here, apart from the twin and the emulators: a box at rest on the equator (the Earth
+// rate along box y), platforms about z and x resting at +-85 deg and stepping between them every
+// 10 s in eq. (5)'s order, noise-free sensors with constant biases; it ends 5 s into its 7th
+// standstill. Its metadata states the rest angle and the gyro range.
+void write_stepping_log(const fs::path& path, const Eigen::Vector3d& b1, const Eigen::Vector3d& b2) {
+  std::ofstream f(path);
+  f << "# format: driftless-log 1\n# complete: true\n# sample_rate_hz: 100\n# latitude_deg: 0\n"
+       "# hinge1_axis: 0 0 1\n# hinge2_axis: 1 0 0\n# gyro_full_scale_dps: 500\n# flip_angle_deg: 85\n"
+       "t,gyro1_x,gyro1_y,gyro1_z,gyro2_x,gyro2_y,gyro2_z,plat1_deg,plat2_deg\n";
+  const Eigen::Vector3d w_body_dps(0.0, 7.292115e-5 * 180.0 / M_PI, 0.0);
+  const int sides[4][2] = {{1, 1}, {1, -1}, {-1, -1}, {-1, 1}};
+  for (int k = 0; k < 6500; ++k) {
+    const int* side = sides[(k / 1000) % 4];
+    const double a1 = 85.0 * side[0], a2 = 85.0 * side[1];
+    const Eigen::Matrix3d R1 = Eigen::AngleAxisd(a1 * M_PI / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    const Eigen::Matrix3d R2 = Eigen::AngleAxisd(a2 * M_PI / 180.0, Eigen::Vector3d::UnitX()).toRotationMatrix();
+    const Eigen::Vector3d y1 = R1.transpose() * w_body_dps + b1, y2 = R2.transpose() * w_body_dps + b2;
+    f << fmt_row(k * 0.01, y1, y2, a1, a2);
+  }
+}
+
+TEST(LiveLoop, AReplayUsesItsLastStandstillAndKeepsTheRecordingsBoxAndRange) {
+  // GIVEN a log that ends at rest and states its rest angle (85 deg) and gyro range (500 deg/s)
+  const fs::path rec = temp_file("stepping.csv");
+  const Eigen::Vector3d b1(0.5, -0.3, 0.8), b2(-0.6, 0.4, 0.2);
+  write_stepping_log(rec, b1, b2);
+  VirtualClock clock;
+  ReplaySource replay(clock, {rec.string(), false, 1.0});
+  ASSERT_TRUE(replay.configure().ok());
+  log::Metadata meta;
+  replay.describe(meta);
+  const fs::path path = temp_file("stepping-session.csv");
+  est::DriftlessFilter filter(est::EstimatorConfig{}, est::box_geometry_from_metadata(meta));
+
+  // WHEN it is replayed into a session to its end
+  {
+    log::LogWriter writer(path, meta, replay.fields());
+    LiveLoop loop(LiveParams{}, clock, &writer, &filter);
+    std::atomic<bool> stop{false};
+    const LiveStats st = loop.run(replay, nullptr, stop);
+    writer.finish(st.complete, st.end_reason);
+    EXPECT_TRUE(st.complete) << st.end_reason;
+    EXPECT_EQ(st.samples, 6500u);
+  }
+
+  // THEN all 7 standstills are updates, the last one too (as 'estimate' uses it at the end of a log)
+  EXPECT_EQ(filter.counters().updates, 7u);
+  EXPECT_EQ(filter.counters().rejected, 0u);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(filter.bias1_dps()[i], b1[i], 1e-4) << "axis " << i;
+    EXPECT_NEAR(filter.bias2_dps()[i], b2[i], 1e-4) << "axis " << i;
+  }
+  // AND the session's log and filter keep the recording's rest angle and gyro range
+  EXPECT_NEAR(est::box_geometry_from_metadata(meta).flip_angle_deg, 85.0, 0.0);
+  const Result r = read_back(path, {});
+  EXPECT_EQ(r.meta.get("flip_angle_deg").value_or("(none)"), "85");
+  EXPECT_EQ(r.meta.get("gyro_full_scale_dps").value_or("(none)"), "500");
   fs::remove(rec);
   fs::remove(path);
 }

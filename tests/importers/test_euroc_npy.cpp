@@ -139,6 +139,19 @@ TEST(NpyImport, DamagedArraysAreRefusedWithTheRow) {
   ImportOptions o;
   o.columns = {"gx"};  // no names in an array
   EXPECT_THROW(open_imu(dir / "ok.npy", o), ImportError);
+  // a column given twice, or the time column given as a channel, is refused, naming it
+  for (const auto& [cols, time] : {std::pair<std::vector<std::string>, std::string>{{"1", "1"}, ""},
+                                   std::pair<std::vector<std::string>, std::string>{{"1", "2"}, "2"}}) {
+    ImportOptions twice;
+    twice.columns = cols;
+    twice.time_column = time;
+    try {
+      open_imu(dir / "ok.npy", twice);
+      ADD_FAILURE() << "a column read twice was accepted";
+    } catch (const ImportError& e) {
+      EXPECT_NE(std::string(e.what()).find("is already read as another channel"), std::string::npos) << e.what();
+    }
+  }
 }
 
 }  // namespace

@@ -143,6 +143,45 @@ TEST(TextImport, ColumnsByIndexSeparatorAndTimeUnitsFromTheStep) {
   for (std::size_t i = 1; i < tb.t.size(); ++i) EXPECT_NEAR(tb.t[i] - tb.t[i - 1], 0.005, 1e-9) << i;
 }
 
+TEST(TextImport, AColumnNamedForTwoChannelsIsRefused) {
+  // GIVEN a recording with a gyro triad, an accelerometer triad and a temperature
+  const auto dir = scratch("twice");
+  std::string s = "t,gx,gy,gz,ax,ay,az,temp\n";
+  for (int i = 0; i < 50; ++i) s += std::to_string(0.01 * i) + ",0.1,0.2,0.3,0,0,9.81,25\n";
+  write_text(dir / "a.csv", s);
+  const auto refused = [&](ImportOptions o, const std::string& expected) {
+    try {
+      open_imu(dir / "a.csv", o);
+      ADD_FAILURE() << "accepted: " << expected;
+    } catch (const ImportError& e) {
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+    }
+  };
+  // WHEN an option names a column another channel already reads, THEN it is refused, naming both
+  ImportOptions twice;
+  twice.columns = {"gx", "gx", "gz"};  // one axis read twice, gy never
+  refused(twice, "a.csv: --columns gx: column 2 ('gx') is already read as another channel");
+  ImportOptions by_index;
+  by_index.columns = {"2", "3", "gy"};
+  refused(by_index, "--columns gy: column 3 ('gy') is already read");
+  ImportOptions temp_on_accel;
+  temp_on_accel.temp_column = "ax";  // the detected accelerometer's x
+  refused(temp_on_accel, "--temp-column ax: column 5 ('ax') is already read");
+  ImportOptions accel_on_gyro;
+  accel_on_gyro.columns = {"gx", "gy", "gz"};
+  accel_on_gyro.accel_columns = {"ax", "gz", "az"};
+  refused(accel_on_gyro, "--accel-columns gz: column 4 ('gz') is already read");
+  ImportOptions gyro_on_time;
+  gyro_on_time.columns = {"t", "gy", "gz"};  // the detected time column
+  refused(gyro_on_time, "--columns t: column 1 ('t') is already read as the time");
+  // AND each column named once is read
+  ImportOptions ok;
+  ok.columns = {"gz", "gy", "gx"};
+  ok.accel_columns = {"ax", "ay", "az"};
+  ok.temp_column = "temp";
+  EXPECT_NO_THROW(open_imu(dir / "a.csv", ok));
+}
+
 TEST(TextImport, MissingValuesAreNaNAndBadRowsNameFileAndLine) {
   const auto dir = scratch("bad");
   write_text(dir / "ok.csv", "t,gx,gy,gz\n0,1,2,3\n0.01,,2,3\n0.02,nan,2,3\n0.03,1,2,3\n0.04,1,2,3\n0.05,1,2,3\n0.06,1,2,3\n");
