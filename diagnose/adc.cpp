@@ -26,15 +26,19 @@ FittedParam param(Param p, int channel, double new_value, double sigma, double m
   return fp;
 }
 
-// lattice strength |mean exp(2 pi i y / step)|: near 1 when every output sits on the grid
-double lattice(const std::vector<double>& y, double step) {
+// lattice strength |mean exp(2 pi i y / step)|: near 1 when every output sits on the grid. Only
+// a strength above `cut` is used: the sum stops (returning 0) once even all remaining samples on
+// the grid could not lift it above (an off-grid step is dropped after ~(1 - cut) of the samples)
+double lattice(const std::vector<double>& y, double step, double cut) {
   double cr = 0, si = 0;
-  for (double v : y) {
-    const double ph = 2.0 * kPi * v / step;
+  const double n = std::max<double>(1.0, static_cast<double>(y.size()));
+  for (std::size_t k = 0; k < y.size(); ++k) {
+    const double ph = 2.0 * kPi * y[k] / step;
     cr += std::cos(ph);
     si += std::sin(ph);
+    if (k % 4096 == 4095 && std::hypot(cr, si) + static_cast<double>(y.size() - k - 1) <= cut * n) return 0.0;
   }
-  return std::hypot(cr, si) / std::max<double>(1.0, static_cast<double>(y.size()));
+  return std::hypot(cr, si) / n;
 }
 
 // the coarsest LSB the outputs lie on: the model's, the common MPU6050 ranges, the data's step
@@ -53,9 +57,11 @@ double data_lsb(const std::vector<double>& y, const twin::SensorParams& p, doubl
   }
   double best = 0.0;
   *strength = 0.0;
+  std::vector<double> tried;
   for (double st : steps) {
-    if (!(st > 1e-6)) continue;
-    const double R = lattice(y, st);
+    if (!(st > 1e-6) || std::find(tried.begin(), tried.end(), st) != tried.end()) continue;  // a step twice: once
+    tried.push_back(st);
+    const double R = lattice(y, st, 0.9);
     if (R > 0.9 && st > best) best = st, *strength = R;
   }
   return best;
@@ -151,7 +157,7 @@ ChannelAdc channel_adc(const Replay& r, const Residual& res, const twin::SensorP
   if (lsb > 0 && (model_lsb == 0.0 || std::abs(lsb - model_lsb) > 1e-3 * model_lsb)) {
     ev_q = std::min(2.0 * ny * R * R, 2.0 * ny) - 2 * log_m;
   } else if (lsb == 0.0 && model_lsb > 0.0) {
-    const double Rm = lattice(y, model_lsb);  // the model quantises, the data lie on no lattice
+    const double Rm = lattice(y, model_lsb, -1.0);  // the model quantises, the data lie on no lattice (the whole sum)
     ev_q = (Rm < 0.5 ? 2.0 * ny * (1.0 - Rm) * 0.01 : 0.0) - log_m;
   }
   if (ev_q > 0) {

@@ -57,7 +57,7 @@ void write_param(CompareModel& m, const ParamRef& p, double v) {
       return;
     }
     case Param::kStopErrorDeg: stop_errors(m, p.sensor)[k] = v; return;
-    case Param::kLatitudeErrorDeg: m.latitude_deg = v; return;
+    case Param::kLatitudeDeg: m.latitude_deg = v; return;
     case Param::kLowpassDelayS:
       for (int s = 0; s < 2; ++s)
         if (p.sensor < 0 || p.sensor == s) m.sensor[static_cast<std::size_t>(s)] = with_lowpass_delay(m.sensor[static_cast<std::size_t>(s)], v);
@@ -117,7 +117,7 @@ double model_value(const CompareModel& m, const ParamRef& p) {
     case Param::kNonlinCubicPctFs: return sensor_of(m, p).adc_nonlinearity.enabled ? sensor_of(m, p).adc_nonlinearity.cubic_pct_fs : 0.0;
     case Param::kMountingDeg: return sensor_of(m, p).mounting_misalignment.enabled ? sensor_of(m, p).mounting_misalignment.angles_deg[j] : 0.0;
     case Param::kStopErrorDeg: return (p.sensor == 0 ? m.box.stop1_error_deg : m.box.stop2_error_deg)[k];
-    case Param::kLatitudeErrorDeg: return std::isfinite(m.latitude_deg) ? m.latitude_deg : 0.0;
+    case Param::kLatitudeDeg: return std::isfinite(m.latitude_deg) ? m.latitude_deg : 0.0;
     case Param::kLowpassDelayS: return lowpass_delay_s(m.sensor[p.sensor < 0 ? 0 : static_cast<std::size_t>(p.sensor)]);
     case Param::kSampleDelayS: return sensor_of(m, p).sample_delay.enabled ? sensor_of(m, p).sample_delay.delay_s : 0.0;
     case Param::kTimeOffsetS: return m.time_offset_s;

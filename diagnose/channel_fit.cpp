@@ -67,8 +67,12 @@ Partial partial_out(const ChannelData& c, const std::vector<int>& xs, const std:
   return {C.topLeftCorner(p, p) / c.sigma2, C.col(p).head(p) / c.sigma2, C(p, p) / c.sigma2};
 }
 
-// pseudo-inverse of a symmetric positive semi-definite matrix (eigenvalues below 1e-9 of the
-// largest are not identified) and its rank
+// pseudo-inverse of a symmetric positive semi-definite matrix and its rank. What is identified
+// is decided on H scaled to unit diagonal (D H D, D = diag(H)^-1/2): eigenvalues below 1e-9 of
+// the largest there are collinear directions. Unscaled, the test compared parameters in their
+// own units: a delay's curvature per s^2 is ~1e9 times a scale's per %^2, so a scale fitted
+// beside a free sample delay was "not identified" and never selected (a 3 % scale on a wobble
+// with one sensor late went to the temperature coefficient it resembles)
 struct PseudoInverse {
   Eigen::MatrixXd inv;
   int rank = 0;
@@ -78,16 +82,30 @@ PseudoInverse pseudo_inverse(const Eigen::MatrixXd& H) {
   PseudoInverse out;
   out.inv = Eigen::MatrixXd::Zero(p, p);
   if (p == 0) return out;
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(H);
+  // a parameter the data barely touch stays unidentified: curvature below 1e-12 per unit^2 (a
+  // sigma above 1e6 file units; its column's variation is the float block means' rounding)
+  Eigen::VectorXd d(p);
+  for (int i = 0; i < p; ++i) d[i] = H(i, i) > 1e-12 ? 1.0 / std::sqrt(H(i, i)) : 0.0;
+  const Eigen::MatrixXd Hs = d.asDiagonal() * H * d.asDiagonal();
+  // a well-conditioned Hs (the usual case: every free parameter identified) by Cholesky, a tenth
+  // of an eigendecomposition's cost; its reciprocal condition estimate (1-norm, an upper bound
+  // that is rarely 10x off) far above the 1e-9 cut-off below means full rank there too
+  const Eigen::LLT<Eigen::MatrixXd> llt(Hs);
+  if ((d.array() > 0.0).all() && llt.info() == Eigen::Success && llt.rcond() > 1e-6) {
+    out.inv = d.asDiagonal() * llt.solve(Eigen::MatrixXd::Identity(p, p)) * d.asDiagonal();
+    out.rank = p;
+    return out;
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(Hs);
   const double top = std::max(es.eigenvalues().maxCoeff(), 1e-300);
-  Eigen::VectorXd d = Eigen::VectorXd::Zero(p);
+  Eigen::VectorXd e = Eigen::VectorXd::Zero(p);
   for (int i = 0; i < p; ++i) {
     if (es.eigenvalues()[i] > 1e-9 * top && es.eigenvalues()[i] > 1e-12) {
-      d[i] = 1.0 / es.eigenvalues()[i];
+      e[i] = 1.0 / es.eigenvalues()[i];
       ++out.rank;
     }
   }
-  out.inv = es.eigenvectors() * d.asDiagonal() * es.eigenvectors().transpose();
+  out.inv = d.asDiagonal() * (es.eigenvectors() * e.asDiagonal() * es.eigenvectors().transpose()) * d.asDiagonal();
   return out;
 }
 
@@ -175,28 +193,50 @@ void set_variance(ChannelData& c, const Eigen::VectorXd& coef) {
 
 namespace {
 
-// block means of every excited column of channel (s, j)
+// block means of every excited column of channel (s, j): all columns in one sweep over the
+// samples (each column's sums in the same order as block_means_of), kept as float in place and
+// the unexcited ones dropped (a double copy per column was 7 MB per worker on a 1 h log)
 void fill_columns(const ColumnInputs& in, const Residual& res, ChannelData& c) {
   const std::size_t mb = res.blocks;
-  std::vector<double> bm;
-  std::vector<std::vector<double>> kept;
-  for (int col = 0; col < kNumCols; ++col) {
-    if ((col == kTempBias || col == kTempScale) && res.temp_span_c < 0.2) continue;
-    block_means_of(res, [&](std::size_t k) { return column_value(in, c.s, c.j, col, k); }, bm);
-    double ss = 0.0;
-    for (std::size_t b = 0; b < mb; ++b) ss += res.block_series.count[b] ? bm[b] * bm[b] : 0.0;
-    if (ss < 1e-20) continue;  // not excited by this log
+  std::vector<int> tried;
+  for (int col = 0; col < kNumCols; ++col)
+    if (!((col == kTempBias || col == kTempScale) && res.temp_span_c < 0.2)) tried.push_back(col);
+  const std::size_t nc = tried.size();
+  Eigen::MatrixXf means(static_cast<Eigen::Index>(mb), static_cast<Eigen::Index>(nc));
+  std::vector<double> acc(nc), ss(nc, 0.0);
+  std::vector<int> cnt(nc);
+  ColumnSweep sweep(in, c.s, c.j);
+  for (std::size_t b = 0; b < mb; ++b) {
+    std::fill(acc.begin(), acc.end(), 0.0);
+    std::fill(cnt.begin(), cnt.end(), 0);
+    const std::size_t a = b * res.block_len, e = std::min(res.n, a + res.block_len);
+    for (std::size_t k = a; k < e; ++k) {
+      if (!res.bmask[k]) continue;
+      for (std::size_t i = 0; i < nc; ++i) {
+        const double v = sweep.value(tried[i], k);
+        if (std::isfinite(v)) acc[i] += v, ++cnt[i];
+      }
+    }
+    for (std::size_t i = 0; i < nc; ++i) {
+      const double m = cnt[i] > 0 ? acc[i] / cnt[i] : 0.0;
+      means(static_cast<Eigen::Index>(b), static_cast<Eigen::Index>(i)) = static_cast<float>(m);
+      if (res.block_series.count[b]) ss[i] += m * m;
+    }
+  }
+  Eigen::Index kept = 0;
+  for (std::size_t i = 0; i < nc; ++i) {
+    if (ss[i] < 1e-20) continue;  // not excited by this log
+    const int col = tried[i];
     c.cols.push_back(col);
     c.prior.push_back(prior_sigma(in.params[c.s], c.j, col, res.fs_hz));
     // a latitude the log does not state: the Earth rate is a nuisance (kEarth is only excited then)
     if (in.r.latitude_assumed && col == kLat) c.prior.back() = kAssumedLatitudeSigmaDeg;
     if (col == kEarth) c.prior.back() = kAssumedEarthScaleSigma;
-    kept.push_back(bm);
+    if (kept != static_cast<Eigen::Index>(i)) means.col(kept) = means.col(static_cast<Eigen::Index>(i));
+    ++kept;
   }
-  c.block_cols.resize(static_cast<Eigen::Index>(mb), static_cast<Eigen::Index>(kept.size()));
-  for (std::size_t i = 0; i < kept.size(); ++i)
-    for (std::size_t b = 0; b < mb; ++b)
-      c.block_cols(static_cast<Eigen::Index>(b), static_cast<Eigen::Index>(i)) = static_cast<float>(kept[i][b]);
+  means.conservativeResize(Eigen::NoChange, kept);
+  c.block_cols = std::move(means);
 }
 
 }  // namespace

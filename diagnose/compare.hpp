@@ -104,7 +104,8 @@ struct ChannelSummary {
 /// The residual of one regime (standstill pair, flips, rate band, ...).
 struct RegimeSummary {
   std::string group, name;
-  std::size_t samples = 0;
+  std::size_t samples = 0;         // usable samples of the regime
+  std::size_t samples_in_fit = 0;  // ... of which the fits use (0 for the flips: left out)
   std::array<double, 6> mean_dps{}, rms_dps{};
 };
 

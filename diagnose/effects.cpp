@@ -56,7 +56,7 @@ const ParamInfo kParams[] = {
     {Param::kNonlinCubicPctFs, "cubic_pct_fs", "% FS", Effect::kAdcNonlinearity, 5.0},
     {Param::kMountingDeg, "angles_deg", "deg", Effect::kMountingMisalignment, 10.0},
     {Param::kStopErrorDeg, "stop_deg", "deg", Effect::kEndStopError, 5.0},
-    {Param::kLatitudeErrorDeg, "latitude_error_deg", "deg", Effect::kEarthRate, 10.0},
+    {Param::kLatitudeDeg, "latitude_deg", "deg", Effect::kEarthRate, 10.0},  // limit: on the change
     {Param::kFlipTransientDps, "dps", "deg/s", Effect::kFlipTransient, 5.0},
     {Param::kLowpassDelayS, "delay_s", "s", Effect::kLowpass, 0.1},
     {Param::kSampleDelayS, "delay_s", "s", Effect::kSampleDelay, 0.2},
@@ -157,7 +157,7 @@ std::vector<ColumnUse> columns_of(const ParamRef& p) {
     case Param::kNonlinCubicPctFs: return {{s * 3 + j, kNonlin3}};
     case Param::kMountingDeg: return on_sensor(s, kMount0 + j);
     case Param::kStopErrorDeg: return on_sensor(s, p.col == 1 ? kEndPlus : kEndMinus);
-    case Param::kLatitudeErrorDeg: return on_both(kLat);
+    case Param::kLatitudeDeg: return on_both(kLat);
     case Param::kFlipTransientDps: return {{s * 3 + j, kFlip0 + p.col}};
     case Param::kLowpassDelayS: return s < 0 ? on_both(kDelay) : on_sensor(s, kDelay);  // -1: both sensors' filter
     case Param::kSampleDelayS: return on_sensor(s, kDelay);
@@ -167,6 +167,15 @@ std::vector<ColumnUse> columns_of(const ParamRef& p) {
     default: return {};
   }
 }
+
+namespace {
+// the Earth-rate columns of axis j from the box-axes series turned into the sensor's axes
+// (Rt = R_i^T at sample k): its latitude sensitivity (per deg) and its part of y_j
+double earth_column(const Replay& r, const Eigen::Matrix3d& Rt, int j, int col, std::size_t k) {
+  if (col == kLat) return Rt.row(j).dot(r.dw_dlat_box_radps[k].cast<double>()) * kDegPerRad * kRadPerDeg;
+  return r.earth_box_radps.empty() ? 0.0 : Rt.row(j).dot(r.earth_box_radps[k].cast<double>()) * kDegPerRad;
+}
+}  // namespace
 
 double column_value(const ColumnInputs& in, int s, int j, int col, std::size_t k) {
   const Replay& r = in.r;
@@ -202,13 +211,48 @@ double column_value(const ColumnInputs& in, int s, int j, int col, std::size_t k
       if (r.rest_side[s][k] != (col == kEndPlus ? 1 : -1)) return 0.0;
       return -r.hinge_axis[s].cross(w)[j] * kDegPerRad * kRadPerDeg;
     }
-    case kLat: return static_cast<double>(r.dw_dlat_radps[s][k][j]) * kDegPerRad * kRadPerDeg;
-    case kEarth: return r.earth_radps[s].empty() ? 0.0 : static_cast<double>(r.earth_radps[s][k][j]) * kDegPerRad;
+    case kLat: case kEarth: return earth_column(r, r.sensor_from_box(s, k), j, col, k);
     default: {  // flip bins
       const auto b = static_cast<std::size_t>(col - kFlip0);
       const double since = r.since_flip_s[s][k];
       if (!(since >= kFlipBinsS[b] && since < kFlipBinsS[b + 1])) return 0.0;
       return static_cast<double>(r.last_flip_dir[s][k]);
+    }
+  }
+}
+
+void ColumnSweep::move_to(std::size_t k) {
+  if (k == k_) return;
+  const Replay& r = in_.r;
+  if (k == k_ + 1) {
+    dw_[0] = dw_[1], dw_[1] = dw_[2];
+  } else {
+    dw_[0] = r.dw_axis_radps2(s_, k - 1, j_), dw_[1] = r.dw_axis_radps2(s_, k, j_);
+  }
+  dw_[2] = r.dw_axis_radps2(s_, k + 1, j_);
+  k_ = k;
+}
+
+// the delay columns as column_value forms them, from the kept stencil values (the ends, where
+// column_value's one-sided forms apply, and every other column go to column_value)
+double ColumnSweep::value(int col, std::size_t k) {
+  const Replay& r = in_.r;
+  if (col == kLat || col == kEarth) {  // the platform's rotation, turned again only when its angle changes
+    const double ang = r.plat_deg[s_][k];
+    if (!(ang == rt_angle_deg_)) Rt_ = r.sensor_from_box(s_, k), rt_angle_deg_ = ang;
+    return earth_column(r, Rt_, j_, col, k);
+  }
+  if ((col != kDelay && col != kDelay2 && col != kDelay3) || k == 0 || k + 1 >= r.size()) {
+    return column_value(in_, s_, j_, col, k);
+  }
+  move_to(k);
+  switch (col) {
+    case kDelay: return -dw_[1] * kDegPerRad;
+    case kDelay2: return (dw_[2] - dw_[0]) / (r.t_s[k + 1] - r.t_s[k - 1]) * kDegPerRad;
+    default: {
+      const double h = 0.5 * (r.t_s[k + 1] - r.t_s[k - 1]);
+      const double d = dw_[2] - 2.0 * dw_[1] + dw_[0];
+      return -d / (h * h) * kDegPerRad;
     }
   }
 }

@@ -58,7 +58,7 @@ enum class Param : std::uint8_t {
   kNonlinCubicPctFs,   // sensor.adc_nonlinearity.cubic_pct_fs (fitted on axis row)
   kMountingDeg,        // sensor.mounting_misalignment.angles_deg[row], deg
   kStopErrorDeg,       // box.stop<s>_error_deg[col: 0 at -stop, 1 at +stop], deg
-  kLatitudeErrorDeg,   // scenario latitude_deg, deg
+  kLatitudeDeg,        // scenario latitude_deg, deg (fitted as a change; plausibility on the change)
   kFlipTransientDps,   // deg/s on axis row in bin col after a flip (not writable)
   kLowpassDelayS,      // sensor.lowpass_latency.delay_s (0 = no filter), s; sensor -1: both sensors
   kSampleDelayS,       // sensor.sample_delay.delay_s, s
@@ -130,6 +130,24 @@ struct ColumnInputs {
 };
 /// Value of column `col` for channel (sensor s, axis j) at sample k.
 double column_value(const ColumnInputs& in, int s, int j, int col, std::size_t k);
+/// Every column of channel (sensor s, axis j), sample by sample: the angular acceleration's
+/// stencil is evaluated once per sample and kept for its neighbours (a column at a time needed it
+/// six times: kDelay once, kDelay2 twice, kDelay3 three times). The same numbers as column_value.
+class ColumnSweep {
+ public:
+  ColumnSweep(const ColumnInputs& in, int s, int j) : in_(in), s_(s), j_(j) {}
+  /// Value of column `col` at sample k. Fastest when k moves forward one sample at a time.
+  double value(int col, std::size_t k);
+
+ private:
+  void move_to(std::size_t k);
+  const ColumnInputs& in_;
+  int s_, j_;
+  std::size_t k_ = static_cast<std::size_t>(-1);
+  std::array<double, 3> dw_{};  // d(w_j)/dt at k - 1, k, k + 1, rad/s^2
+  double rt_angle_deg_ = kNaN;  // the platform angle Rt_ was made for
+  Eigen::Matrix3d Rt_ = Eigen::Matrix3d::Identity();  // box to sensor axes there
+};
 /// Prior 1-sigma (file units) of a column's coefficient under the model: the run-to-run spread
 /// of an effect the model switches on; 0 = not a nuisance (the model says "exactly"). The signal
 /// chain's second-order term (kDelay2) spreads with the filter's unknown shape at rate fs_hz.

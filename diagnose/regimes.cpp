@@ -17,8 +17,11 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 using Selector = std::function<bool(std::size_t)>;
 
-void add_regime(const Replay& r, const AfterFit& a, const std::string& group, const std::string& name,
+// a regime's rows: the residual over its usable samples, and how many of them the fits use (the
+// flips and the samples around them are left out of the fits: their rows say so)
+void add_regime(const Residual& res, const AfterFit& a, const std::string& group, const std::string& name,
                 const Selector& sel, CompareResult& out) {
+  const Replay& r = *res.replay;
   RegimeSummary rs;
   rs.group = group;
   rs.name = name;
@@ -31,6 +34,7 @@ void add_regime(const Replay& r, const AfterFit& a, const std::string& group, co
     for (int c = 0; c < nc; ++c) e[c] = a.e(c, k), ok = ok && std::isfinite(e[c]);
     if (!ok) continue;
     ++rs.samples;
+    rs.samples_in_fit += res.mask[k];
     for (int c = 0; c < nc; ++c) s1[c] += e[c], s2[c] += static_cast<double>(e[c]) * e[c];
   }
   if (rs.samples == 0) return;
@@ -44,12 +48,13 @@ void add_regime(const Replay& r, const AfterFit& a, const std::string& group, co
 }
 
 // bands [edges[i], edges[i+1]) of a per-sample value, outside flips
-void add_bands(const Replay& r, const AfterFit& a, const std::string& group, const std::vector<double>& edges,
+void add_bands(const Residual& res, const AfterFit& a, const std::string& group, const std::vector<double>& edges,
                const char* unit, const std::function<double(std::size_t)>& value, CompareResult& out) {
+  const Replay& r = *res.replay;
   for (std::size_t i = 0; i + 1 < edges.size(); ++i) {
     const double lo = edges[i], hi = edges[i + 1];
     const std::string name = std::isinf(hi) ? fmt::format(">= {:g} {}", lo, unit) : fmt::format("{:g}-{:g} {}", lo, hi, unit);
-    add_regime(r, a, group, name, [&, lo, hi](std::size_t k) {
+    add_regime(res, a, group, name, [&, lo, hi](std::size_t k) {
       const double v = value(k);
       return !r.flipping[k] && v >= lo && v < hi;
     }, out);
@@ -68,7 +73,7 @@ void temperature_quartiles(const Replay& r, const Residual& res, const AfterFit&
   edges.push_back(kInf);
   for (std::size_t i = 0; i + 1 < edges.size(); ++i) {
     const double lo = edges[i], hi = edges[i + 1];
-    add_regime(r, a, "temperature",
+    add_regime(res, a, "temperature",
                fmt::format("temp1 {}..{} degC", std::isinf(lo) ? std::string("min") : fmt::format("{:.2f}", lo),
                            std::isinf(hi) ? std::string("max") : fmt::format("{:.2f}", hi)),
                [&, lo, hi](std::size_t k) { return !r.flipping[k] && r.temp_c[0][k] >= lo && r.temp_c[0][k] < hi; }, out);
@@ -78,17 +83,17 @@ void temperature_quartiles(const Replay& r, const Residual& res, const AfterFit&
 void regimes(const Replay& r, const Residual& res, const AfterFit& a, CompareResult& out) {
   for (int p1 : {1, -1})
     for (int p2 : {1, -1})
-      add_regime(r, a, "standstill", fmt::format("plat1 {}, plat2 {}", p1 > 0 ? "+" : "-", p2 > 0 ? "+" : "-"),
+      add_regime(res, a, "standstill", fmt::format("plat1 {}, plat2 {}", p1 > 0 ? "+" : "-", p2 > 0 ? "+" : "-"),
                  [&, p1, p2](std::size_t k) { return !r.flipping[k] && r.rest_side[0][k] == p1 && r.rest_side[1][k] == p2; },
                  out);
-  add_regime(r, a, "flip", "during flips", [&](std::size_t k) { return r.flipping[k] != 0; }, out);
-  add_regime(r, a, "flip", "0-2 s after a flip", [&](std::size_t k) {
+  add_regime(res, a, "flip", "during flips", [&](std::size_t k) { return r.flipping[k] != 0; }, out);
+  add_regime(res, a, "flip", "0-2 s after a flip", [&](std::size_t k) {
     return !r.flipping[k] && (r.since_flip_s[0][k] < 2.0f || r.since_flip_s[1][k] < 2.0f);
   }, out);
   const double we = kEarthRateRadps * kDegPerRad;
-  add_bands(r, a, "base rate", {0.0, 1.0, 10.0, 30.0, kInf}, "deg/s",
+  add_bands(res, a, "base rate", {0.0, 1.0, 10.0, 30.0, kInf}, "deg/s",
             [&](std::size_t k) { return std::max(0.0, r.w_body_radps[k].norm() * kDegPerRad - we); }, out);
-  add_bands(r, a, "acceleration", {0.0, 0.5, 2.0, kInf}, "m/s^2",
+  add_bands(res, a, "acceleration", {0.0, 0.5, 2.0, kInf}, "m/s^2",
             [&](std::size_t k) { return std::abs(static_cast<double>(r.f_body_mps2[k].norm()) - kStandardGravityMps2); }, out);
   temperature_quartiles(r, res, a, out);
 }

@@ -269,7 +269,7 @@ void mark_kinks(const std::vector<double>& d2, std::size_t fir_half, const Repla
 // included (rotation vectors of interval increments lose the coning term: a false 0.02 % scale
 // on a 1.5 Hz two-axis wobble at 100 Hz). Near the ends, central differences. The Earth rate is
 // added in body axes; the transport rate (v/R) is neglected.
-void body_rate(Raw& raw, const Eigen::Vector3d& earth_enu, const ReplayOptions& opt, Replay& out) {
+std::vector<Eigen::Vector3d> body_rate(Raw& raw, const Eigen::Vector3d& earth_enu, const ReplayOptions& opt, Replay& out) {
   const std::size_t n = raw.size();
   out.t_s = std::move(raw.t);
   // one hemisphere: q and -q are one rotation (in place: every later use rotates with q, which
@@ -279,7 +279,7 @@ void body_rate(Raw& raw, const Eigen::Vector3d& earth_enu, const ReplayOptions& 
     if (q[k].dot(q[k - 1]) < 0) q[k] = -q[k];
   const std::vector<double> d = central_differentiator(8);
   const auto M = d.size();
-  out.w_body_radps.resize(n);
+  std::vector<Eigen::Vector3d> w_body(n);
   for (std::size_t k = 0; k < n; ++k) {
     Eigen::Vector4d dq = Eigen::Vector4d::Zero();
     if (k >= M && k + M < n) {
@@ -292,7 +292,7 @@ void body_rate(Raw& raw, const Eigen::Vector3d& earth_enu, const ReplayOptions& 
     }
     const Eigen::Quaterniond qk(q[k][0], q[k][1], q[k][2], q[k][3]), dqk(dq[0], dq[1], dq[2], dq[3]);
     const Eigen::Vector3d w_eb = 2.0 * (qk.conjugate() * dqk).vec();
-    out.w_body_radps[k] = w_eb + qk.conjugate() * earth_enu;
+    w_body[k] = w_eb + qk.conjugate() * earth_enu;
   }
   // kinks from the second differences of the interval mean rates (three kept at a time)
   std::vector<double> d2(n, 0.0);
@@ -310,6 +310,7 @@ void body_rate(Raw& raw, const Eigen::Vector3d& earth_enu, const ReplayOptions& 
   mark_kinks(d2, M, opt, out);
   // the first and last M samples have no full differentiator stencil: left out like a kink
   for (std::size_t k = 0; k < std::min(n, M); ++k) out.rough[k] = out.rough[n - 1 - k] = 1;
+  return w_body;
 }
 
 // specific force in body axes: second differences of ref_p, else gravity only (double here: the
@@ -355,10 +356,11 @@ PlatformMotion platform_motion(Raw& raw, const ReplayOptions& opt, Replay& out) 
     std::vector<double>& rate = pm.rate_dps[s];
     rate.resize(n);
     if (out.has_temp) {
-      out.temp_c[s] = std::move(raw.temp[s]);
+      out.temp_c[s].assign(raw.temp[s].begin(), raw.temp[s].end());
     } else {
-      out.temp_c[s].assign(n, kNaN), raw.temp[s] = std::vector<double>();
+      out.temp_c[s].assign(n, std::numeric_limits<float>::quiet_NaN());
     }
+    raw.temp[s] = std::vector<double>();
     pm.moving[s].assign(n, 0);
     for (std::size_t k = 0; k < n; ++k) {
       const std::size_t a = k == 0 ? 0 : k - 1, b = k + 1 < n ? k + 1 : n - 1;
@@ -410,15 +412,22 @@ void flip_history(const Raw& raw, const std::array<std::vector<std::uint8_t>, 2>
 }
 
 // each sensor's ideal output (docs/log-format.md): y_i = R_i^T w_body + thetadot_i a_i
-void sensor_truth(Raw& raw, const std::vector<Eigen::Vector3d>& f_body, const PlatformMotion& pm,
-                  const Eigen::Vector3d& earth_enu, const Eigen::Vector3d& dearth_dlat_enu, Replay& out) {
+void sensor_truth(Raw& raw, const std::vector<Eigen::Vector3d>& w_body, const std::vector<Eigen::Vector3d>& f_body,
+                  const PlatformMotion& pm, const Eigen::Vector3d& earth_enu, const Eigen::Vector3d& dearth_dlat_enu,
+                  Replay& out) {
   const std::size_t n = raw.size();
   out.usable.assign(n, 1);
+  // the Earth rate's parts in box axes (the sensors' follow with their platform angles)
+  out.dw_dlat_box_radps.resize(n);
+  if (out.latitude_assumed) out.earth_box_radps.resize(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const Eigen::Quaterniond qc = quat(raw.q[k]).conjugate();
+    out.dw_dlat_box_radps[k] = (qc * dearth_dlat_enu).cast<float>();
+    if (out.latitude_assumed) out.earth_box_radps[k] = (qc * earth_enu).cast<float>();
+  }
   const Eigen::Vector3f nan3 = Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN());
   for (int s = 0; s < 2; ++s) {
     out.w_radps[s].resize(n);
-    out.dw_dlat_radps[s].resize(n);
-    if (out.latitude_assumed) out.earth_radps[s].assign(n, Eigen::Vector3f::Zero());
     // the log's accel columns are the specific force where they are finite
     std::vector<Eigen::Vector3f>& f = out.f_mps2[s];
     f.resize(n);
@@ -428,22 +437,20 @@ void sensor_truth(Raw& raw, const std::vector<Eigen::Vector3d>& f_body, const Pl
       if (!std::isfinite(ang)) {
         out.w_radps[s][k].setConstant(kNaN);
         f[k] = nan3;
-        out.dw_dlat_radps[s][k] = nan3;
         out.usable[k] = 0;
         continue;
       }
       const Eigen::Matrix3d Rt = geo::rot_about_axis_deg(axis, ang).transpose();
       const double rate = pm.rate_dps[s][k];
-      out.w_radps[s][k] = Rt * out.w_body_radps[k] + (std::isfinite(rate) ? rate : 0.0) * kRadPerDeg * axis;
+      out.w_radps[s][k] = Rt * w_body[k] + (std::isfinite(rate) ? rate : 0.0) * kRadPerDeg * axis;
       const bool logged = out.has_accel && raw.a[s][k].allFinite();
       f[k] = (logged ? raw.a[s][k] : Eigen::Vector3d(Rt * f_body[k])).cast<float>();
-      out.dw_dlat_radps[s][k] = (Rt * (quat(raw.q[k]).conjugate() * dearth_dlat_enu)).cast<float>();
-      if (out.latitude_assumed) out.earth_radps[s][k] = (Rt * (quat(raw.q[k]).conjugate() * earth_enu)).cast<float>();
       if (s < out.sensors && !raw.g[s][k].allFinite()) out.usable[k] = 0;
     }
     raw.a[s] = std::vector<Eigen::Vector3d>();
     out.gyro_dps[s] = std::move(raw.g[s]);
-    out.plat_deg[s] = std::move(raw.plat[s]);
+    out.plat_deg[s].assign(raw.plat[s].begin(), raw.plat[s].end());
+    raw.plat[s] = std::vector<double>();
   }
   out.rows_missing_gyro = static_cast<std::size_t>(std::count(out.usable.begin(), out.usable.end(), 0));
 }
@@ -469,11 +476,13 @@ Replay build(Raw raw, const log::Metadata& meta, std::uint32_t fields, const Rep
   check_attitude(raw, opt, out);
   const Eigen::Vector3d earth_enu = geo::earth_rate_enu_radps(lat);
   const Eigen::Vector3d dearth_dlat_enu = geo::earth_rate_enu_dlat_radps_per_rad(lat);
-  body_rate(raw, earth_enu, opt, out);
+  const std::vector<Eigen::Vector3d> w_body = body_rate(raw, earth_enu, opt, out);
   const std::vector<Eigen::Vector3d> f_body = specific_force(raw, out);
   const PlatformMotion pm = platform_motion(raw, opt, out);
   flip_history(raw, pm.moving, out);
-  sensor_truth(raw, f_body, pm, earth_enu, dearth_dlat_enu, out);
+  sensor_truth(raw, w_body, f_body, pm, earth_enu, dearth_dlat_enu, out);
+  out.w_body_radps.resize(w_body.size());
+  for (std::size_t k = 0; k < w_body.size(); ++k) out.w_body_radps[k] = w_body[k].cast<float>();
   return out;
 }
 
@@ -510,6 +519,12 @@ double Replay::dw_axis_radps2(int s, std::size_t k, int j) const {
   const std::size_t a = k == 0 ? 0 : k - 1, b = k + 1 < n ? k + 1 : n - 1;
   const double d = (w[b][j] - w[a][j]) / (t_s[b] - t_s[a]);
   return std::isfinite(d) ? d : 0.0;
+}
+
+Eigen::Matrix3d Replay::sensor_from_box(int s, std::size_t k) const {
+  const double ang = plat_deg[s][k];
+  if (!std::isfinite(ang)) return Eigen::Matrix3d::Constant(kNaN);
+  return geo::rot_about_axis_deg(hinge_axis[s], ang).transpose();
 }
 
 void ReplayOptions::validate() const {

@@ -48,15 +48,23 @@ struct Replay {
   // the slowly varying or small series below are stored as float (7 significant digits: 1e-6
   // m/s^2 of a specific force, 1e-12 rad/s of the latitude sensitivity), half the memory of double
   std::array<std::vector<Eigen::Vector3f>, 2> f_mps2;    // specific force, sensor axes
-  // d(y_i)/d(latitude) per rad of latitude: the Earth-rate part's sensitivity, sensor axes
-  std::array<std::vector<Eigen::Vector3f>, 2> dw_dlat_radps;
-  // the Earth-rate part of y_i, sensor axes, rad/s: kept only where the latitude is assumed (the
+  // d(w_body)/d(latitude) per rad of latitude: the Earth-rate part's sensitivity, box axes (a
+  // sensor's is R_i^T of it: sensor_from_box; one box series instead of one per sensor)
+  std::vector<Eigen::Vector3f> dw_dlat_box_radps;
+  // the Earth-rate part of w_body, box axes, rad/s: kept only where the latitude is assumed (the
   // log states none: whether its reference frame turns with the Earth is then unknown too)
-  std::array<std::vector<Eigen::Vector3f>, 2> earth_radps;
-  std::vector<Eigen::Vector3d> w_body_radps;             // box inertial rate, box axes
+  std::vector<Eigen::Vector3f> earth_box_radps;
+  // box inertial rate, box axes, as float (the regimes and correlations use it; the sensors'
+  // rates w_radps were formed from the double)
+  std::vector<Eigen::Vector3f> w_body_radps;
+  /// R_i^T: box axes to sensor s's axes at sample k (the platform at its logged angle); NaN
+  /// where the angle is unknown.
+  Eigen::Matrix3d sensor_from_box(int s, std::size_t k) const;
   std::vector<Eigen::Vector3f> f_body_mps2;              // box specific force, box axes
-  std::array<std::vector<double>, 2> plat_deg;           // as logged; NaN when unknown
-  std::array<std::vector<double>, 2> temp_c;             // logged die temperature, NaN if absent
+  // as float (7 digits: 1e-5 deg of an angle, 4e-6 degC of a temperature; the sensors' series
+  // were made from the logged doubles)
+  std::array<std::vector<float>, 2> plat_deg;            // as logged; NaN when unknown
+  std::array<std::vector<float>, 2> temp_c;              // logged die temperature, NaN if absent
   std::vector<std::uint8_t> usable;    // gyro finite and the truth is known
   std::vector<std::uint8_t> flipping;  // a platform moves, or its angle is unknown
   std::vector<std::uint8_t> rough;     // the rate cannot be rebuilt from ref_q here (a kink)

@@ -2,6 +2,7 @@
 // changes, the unsupported candidates greyed, per-channel and per-regime tables, plots.
 #include "diagnose/report.hpp"
 
+#include <cmath>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -34,7 +35,10 @@ const char* verdict_class(Verdict v) {
 }
 
 std::string param_cell(const FittedParam& p) {
-  std::string s = fmt::format("{} = {:.5g} ± {:.2g} {}", html_escape(p.name()), p.new_value(), p.sigma, html_escape(p.unit()));
+  // a parameter the data do not pin down has no finite sigma: said so, not "± inf"
+  const std::string sigma = std::isfinite(p.sigma) ? fmt::format(" ± {:.2g}", p.sigma) : std::string();
+  std::string s = fmt::format("{} = {:.5g}{} {}{}", html_escape(p.name()), p.new_value(), sigma, html_escape(p.unit()),
+                              std::isfinite(p.sigma) ? "" : " (σ not identified)");
   if (p.model_value != 0.0) s += fmt::format(" (model {:.5g}, change {:+.4g})", p.model_value, p.value);
   return p.absurd ? "<span class=absurd>" + s + " IMPLAUSIBLE</span>" : s;
 }
@@ -106,11 +110,14 @@ void where_tables(std::ostringstream& h, const CompareResult& r) {
   for (const auto& w : r.worst_windows)
     h << fmt::format("<tr><td>{:.1f}</td><td>{:.1f}</td><td class=l>{}</td><td>{:.2f}</td></tr>", w.t0_s, w.t1_s,
                      channel_name(w.worst_channel), w.worst_ratio);
-  h << "</table>\n<h2>By regime</h2><table><tr><th>regime</th><th>samples</th>";
+  h << "</table>\n<h2>By regime</h2><table><tr><th>regime</th><th>samples</th><th>in the fits</th>";
   for (int c = 0; c < 3 * r.sensors; ++c) h << "<th>" << channel_name(c) << " rms</th>";
   h << "</tr>";
   for (const auto& g : r.regimes) {
-    h << "<tr><td class=l>" << html_escape(g.group + ": " + g.name) << "</td><td>" << g.samples << "</td>";
+    // a regime the fits leave out (the flips) is shown greyed and says so
+    const bool out_of_fit = g.samples_in_fit == 0;
+    h << (out_of_fit ? "<tr class=grey>" : "<tr>") << "<td class=l>" << html_escape(g.group + ": " + g.name)
+      << (out_of_fit ? " (left out of the fits)" : "") << "</td><td>" << g.samples << "</td><td>" << g.samples_in_fit << "</td>";
     for (int c = 0; c < 3 * r.sensors; ++c) h << fmt::format("<td>{:.5f}</td>", g.rms_dps[c]);
     h << "</tr>";
   }

@@ -89,7 +89,8 @@ void regimes_json(std::ostringstream& o, const CompareResult& r, const ReportExt
   o << "  \"regimes\": [\n";
   for (std::size_t i = 0; i < r.regimes.size(); ++i) {
     const auto& g = r.regimes[i];
-    o << "    {\"group\": " << q(g.group) << ", \"name\": " << q(g.name) << ", \"samples\": " << g.samples << ", \"rms_dps\": ";
+    o << "    {\"group\": " << q(g.group) << ", \"name\": " << q(g.name) << ", \"samples\": " << g.samples
+      << ", \"samples_in_fit\": " << g.samples_in_fit << ", \"rms_dps\": ";
     six(o, g.rms_dps);
     o << ", \"mean_dps\": ";
     six(o, g.mean_dps);

@@ -75,15 +75,10 @@ std::vector<ParamRef> make_universe(const Channels& ch) {
   // both sensors' filter at once (one chip configuration); with one sensor it is sensor 1's, and
   // that sensor's sample delay is the box time offset: the same signals, one is tested
   if (!single) add(Param::kLowpassDelayS, -1, -1, -1);
-  add(Param::kLatitudeErrorDeg, -1, -1, -1);
+  add(Param::kLatitudeDeg, -1, -1, -1);
   add(Param::kTimeOffsetS, -1, -1, -1);
   return u;
 }
-
-// a signal chain's second- and third-order terms, s^2 and s^3
-struct ChainTerms {
-  double c2 = 0.0, c3 = 0.0;
-};
 
 // the evaluation of one parameter given the selection
 struct Eval {
@@ -130,6 +125,8 @@ class Selector {
   std::vector<Candidate> make_not_supported(const Terms& S, double base) const;
   FittedParam fitted(const ParamRef& ref, double value, double sigma) const;
   void add_lowpass(Candidate& c, const Term& t, const Terms& S) const;
+  /// 1-sigma of low-pass term t's delay in selection S (which holds t), from the objective's curvature
+  double delay_sigma(const Terms& S, const Term& t) const;
 
   SelectionInput& in_;
   double log_m_;
@@ -157,11 +154,8 @@ FitSpec Selector::spec_of(const Terms& S) const {
   return spec;
 }
 
-// the higher-order coefficients of sensor s's signal chain (delays change the signal by
-// -c1 dw/dt + c2 d2w/dt2 - c3 d3w/dt3, c_n = E[t^n]/n! of the chain's impulse response): a
-// low-pass of group delay D with pole time T (an exponential of mean T after a pure delay D - T),
-// then a pure delay d, has c1 = D + d, c2 = (D^2 + T^2)/2 + d D + d^2/2 and, with a = D - T + d,
-// c3 = (6 T^3 + 6 a T^2 + 3 a^2 T + a^3)/6
+// the higher-order coefficients of sensor s's signal chain: its low-pass's pole time from the
+// filter the model designs at the log's rate (chain_moments, signal_chain.hpp)
 ChainTerms Selector::chain_terms(int s, double lowpass_delay_s, double extra_delay_s) const {
   const twin::SensorParams p = with_lowpass_delay(in_.model.sensor[static_cast<std::size_t>(s)], lowpass_delay_s);
   double T = 0.0;
@@ -170,8 +164,7 @@ ChainTerms Selector::chain_terms(int s, double lowpass_delay_s, double extra_del
     const double a = twin::design_lowpass(set.gyro_bandwidth_hz, set.gyro_delay_s, in_.res.fs_hz).pole;
     T = a / (1.0 - a) / in_.res.fs_hz;
   }
-  const double D = lowpass_delay_s, d = extra_delay_s, a = D - T + d;
-  return {0.5 * (D * D + T * T) + d * D + 0.5 * d * d, (6.0 * T * T * T + 6.0 * a * T * T + 3.0 * a * a * T + a * a * a) / 6.0};
+  return chain_moments(lowpass_delay_s, T, extra_delay_s);
 }
 
 // the MAP fit of a selection; when it changes a signal chain, the chains' second- and third-order terms
@@ -463,15 +456,24 @@ Selection Selector::run() {
 
 // a selected low-pass: its delay with sigma from the curvature of the objective (-2 ln L) at
 // the optimum, and per sensor the measured noise colour against the new filter's
-void Selector::add_lowpass(Candidate& c, const Term& t, const Terms& S) const {
+double Selector::delay_sigma(const Terms& S, const Term& t) const {
   const double h = 2e-4;
-  Terms up = S, dn = S;
-  for (auto* v : {&up, &dn})
-    for (Term& u : *v)
-      if (u.ref == t.ref) u.delay_s = std::max(0.0, t.delay_s + (v == &up ? h : -h));
-  const double curv = (2.0 * total(S) - total(up) - total(dn)) / (h * h);
+  // central second difference; within h of the "no filter" boundary (a delay cannot be
+  // negative) about h instead (0, h, 2h), not about a clamped point that repeats the centre
+  const double c = std::max(t.delay_s, h);
+  auto at = [&](double d) {
+    Terms v = S;
+    for (Term& u : v)
+      if (u.ref == t.ref) u.delay_s = d;
+    return total(v);
+  };
+  const double curv = (2.0 * at(c) - at(c + h) - at(c - h)) / (h * h);
+  return curv > 0 ? std::sqrt(2.0 / curv) : kInf;
+}
+
+void Selector::add_lowpass(Candidate& c, const Term& t, const Terms& S) const {
   const auto s0 = static_cast<std::size_t>(t.ref.sensor < 0 ? 0 : t.ref.sensor);
-  c.params.push_back(fitted(t.ref, t.delay_s - model_delay_[s0], curv > 0 ? std::sqrt(2.0 / curv) : kInf));
+  c.params.push_back(fitted(t.ref, t.delay_s - model_delay_[s0], delay_sigma(S, t)));
   for (int k = 0; k < 2; ++k) {
     if (!lowpass_on(t.ref, k)) continue;
     const auto& mc = in_.colour[static_cast<std::size_t>(k)];
@@ -491,8 +493,8 @@ FittedParam Selector::fitted(const ParamRef& ref, double value, double sigma) co
   fp.ref = ref;
   fp.value = value;
   fp.sigma = sigma;
-  fp.model_value = ref.param == Param::kLatitudeErrorDeg ? in_.r.latitude_deg : model_value(in_.model, ref);
-  const double shown = ref.param == Param::kLatitudeErrorDeg ? value : fp.new_value();
+  fp.model_value = ref.param == Param::kLatitudeDeg ? in_.r.latitude_deg : model_value(in_.model, ref);
+  const double shown = ref.param == Param::kLatitudeDeg ? value : fp.new_value();
   fp.absurd = std::abs(shown) > plausible_limit(ref.param);
   return fp;
 }
@@ -553,7 +555,13 @@ std::vector<Candidate> Selector::make_not_supported(const Terms& S, double base)
       c.chi2 = std::max(0.0, best->ev + log_m_);
       c.dof = 1;
       c.p_value = 1.0 - est::chi2_cdf(c.chi2, 1);
-      c.params.push_back(fitted(best->ref, best->value, best->sigma));
+      double sigma = best->sigma;
+      if (is_lowpass(best->ref) && std::isfinite(best->ev)) {  // a delay's sigma from the curvature at its optimum
+        Terms with = S;
+        with.push_back(Term{best->ref, 0, best->delay_s});
+        sigma = delay_sigma(with, with.back());
+      }
+      c.params.push_back(fitted(best->ref, best->value, sigma));
     }
     out.push_back(c);
   }

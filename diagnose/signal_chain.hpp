@@ -24,6 +24,16 @@ struct NoiseColour {
   bool usable() const { return pairs >= 500.0; }
 };
 
+/// A signal chain's second- and third-order terms, s^2 and s^3: delays change the signal by
+/// -c1 dw/dt + c2 d2w/dt2 - c3 d3w/dt3, with c_n = E[t^n]/n! of the chain's impulse response.
+struct ChainTerms {
+  double c2 = 0.0, c3 = 0.0;
+};
+/// The terms of a low-pass of group delay D (s) with pole time T (s; an exponential of mean T
+/// after a pure delay D - T), followed by a pure delay d (s): c1 = D + d,
+/// c2 = (D^2 + T^2)/2 + d D + d^2/2 and, with a = D - T + d, c3 = (6 T^3 + 6 a T^2 + 3 a^2 T + a^3)/6.
+ChainTerms chain_moments(double group_delay_s, double pole_time_s, double extra_delay_s);
+
 /// Measures both sensors' noise colour on windows of usable samples.
 std::array<NoiseColour, 2> measure_noise_colour(const Replay& r, const Residual& res);
 

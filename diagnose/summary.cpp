@@ -150,11 +150,12 @@ AfterFit residual_after(const Channels& ch, const ColumnInputs& in, const Residu
     if (detail == AfterDetail::kBlocks) return;
     if (keep) a.e_drift[c].resize(res.n);
     RunningMeanRms stats;
+    ColumnSweep sweep(in, C.s, C.j);
     for (std::size_t k = 0; k < res.n; ++k) {
       double v = res.e_dps(c, k);
       if (std::isfinite(v)) {
         for (int i = 0; i < static_cast<int>(C.cols.size()); ++i)
-          if (coef[i] != 0.0) v -= column_value(in, C.s, C.j, C.cols[i], k) * coef[i];
+          if (coef[i] != 0.0) v -= sweep.value(C.cols[i], k) * coef[i];
       }
       if (res.mask[k]) stats.add(static_cast<float>(v - a.bias_at(c, k)));
       if (keep) a.e_drift[c][k] = static_cast<float>(v);
