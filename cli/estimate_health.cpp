@@ -27,6 +27,7 @@ const char* cause_key(est::HealthCause c) {
     case est::HealthCause::kUnobservable: return "unobservable";
     case est::HealthCause::kRelocks: return "relocks";
     case est::HealthCause::kLateLock: return "late_lock";
+    case est::HealthCause::kSignalChainLag: return "signal_chain_lag";
     case est::HealthCause::kSaturation: return "saturation";
   }
   return "?";
@@ -115,6 +116,15 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
                          "the NIS against its band or to compare the attitude; record a longer log or more "
                          "flips after the lock",
                          f.value, f.suggested);
+    case est::HealthCause::kSignalChainLag:
+      return fmt::format("the residual follows the box's angular acceleration: sensor {} reads the rate {:.2f} ms "
+                         "(+-{:.2f}) later than sensor {}, which adds {:.2g}x the white noise's variance to the "
+                         "standstill updates. No noise density describes that (--tune auto would take it for noise): "
+                         "a signal-chain mismatch (a sample delay, or a slower low-pass filter on one sensor); "
+                         "align the two sensors' time stamps and filters, or run 'driftless diagnose' on this log "
+                         "to measure each sensor's chain",
+                         f.value > 0.0 ? 2 : 1, 1e3 * std::fabs(f.value), 1e3 * f.sigma, f.value > 0.0 ? 1 : 2,
+                         f.suggested);
     case est::HealthCause::kSaturation: {
       const int c = f.components.empty() ? 0 : f.components.front();
       return fmt::format("gyro{}_{} reads exactly +-{:.6g} deg/s, its largest value, in runs over {:.3g} % of the "
@@ -146,10 +156,14 @@ std::string health_json(const est::HealthReport& h, const est::EstimatorConfig& 
       "  \"health\": {{\"verdict\": \"{}\", \"locked\": {}, \"lock_t_s\": {}, \"updates\": {}, \"rejected\": {}, "
       "\"rejected_fraction\": {}, \"nis_updates\": {}, \"nis_dof_mean\": {}, \"nis_mean\": {}, "
       "\"nis_mean_band_95\": [{}, {}], \"nis_mean_degraded_above\": {}, \"relocks\": {}, \"unobservable\": {},\n"
+      "  \"signal_chain\": {{\"samples\": {}, \"lag_s\": {}, \"lag_sigma_s\": {}, \"update_excess\": {}, "
+      "\"significant\": {}}},\n"
       "  \"findings\": {}}}",
       est::to_string(h.verdict), h.locked ? "true" : "false", json_number(h.lock_t_s), h.updates, h.rejected,
       json_number(h.rejected_fraction), h.nis_updates, json_number(h.nis_dof_mean), json_number(h.nis_mean), json_number(h.nis_mean_band_lo),
-      json_number(h.nis_mean_band_hi), json_number(h.nis_mean_degraded_above), h.relocks, unobs, findings);
+      json_number(h.nis_mean_band_hi), json_number(h.nis_mean_degraded_above), h.relocks, unobs, h.signal_chain.samples,
+      json_number(h.signal_chain.lag_s), json_number(h.signal_chain.lag_sigma_s), json_number(h.signal_chain.update_excess),
+      h.signal_chain.significant ? "true" : "false", findings);
 }
 
 std::string tune_json(const est::TuneResult* t) {

@@ -207,11 +207,15 @@ void write_estimate_summary(const fs::path& path, const SummaryContext& ctx, con
   };
   add("  \"self_calibration\": {{\"enabled\": {}, \"correction_sigma_dps\": {}, "
       "\"g_sensitivity_dps_per_g\": [{}, {}], \"g_sensitivity_sigma_dps_per_g\": [{}, {}], "
-      "\"scale_misalign_states\": {}, \"scale_misalign_frac\": [{}, {}], \"scale_misalign_sigma_frac\": [{}, {}]}},\n",
+      "\"scale_misalign_states\": {}, \"scale_misalign_frac\": [{}, {}], \"scale_misalign_sigma_frac\": [{}, {}],\n"
+      "    \"end_stop_states\": {}, \"end_stop_deg\": [{}, {}, {}, {}], \"end_stop_sigma_deg\": [{}, {}, {}, {}]}},\n",
       s.gsens_states ? "true" : "false", json_vec(s.correction_sigma_dps), mat(s.gsens_dps_per_g[0]),
       mat(s.gsens_dps_per_g[1]), mat(s.gsens_sigma_dps_per_g[0]), mat(s.gsens_sigma_dps_per_g[1]),
       s.scale_states ? "true" : "false", mat(s.scale_misalign_frac[0]), mat(s.scale_misalign_frac[1]),
-      mat(s.scale_misalign_sigma_frac[0]), mat(s.scale_misalign_sigma_frac[1]));
+      mat(s.scale_misalign_sigma_frac[0]), mat(s.scale_misalign_sigma_frac[1]), s.stop_states ? "true" : "false",
+      json_number(s.stop_angle_deg[0]), json_number(s.stop_angle_deg[1]), json_number(s.stop_angle_deg[2]),
+      json_number(s.stop_angle_deg[3]), json_number(s.stop_angle_sigma_deg[0]), json_number(s.stop_angle_sigma_deg[1]),
+      json_number(s.stop_angle_sigma_deg[2]), json_number(s.stop_angle_sigma_deg[3]));
   add("  \"box_dwells\": {{\"updates\": {}, \"rejected\": {}}},\n", s.counters.box_dwell_updates,
       s.counters.box_dwell_rejected);
   const std::uint64_t flips_ok = s.counters.flip_updates - s.counters.flip_rejected;

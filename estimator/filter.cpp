@@ -192,6 +192,9 @@ DriftlessFilter::DriftlessFilter(const EstimatorConfig& cfg, const BoxGeometry& 
   if (has_scale_states()) {
     P_.diagonal().segment<18>(kScale1.start).setConstant(cfg_.scale_misalign_sigma_frac * cfg_.scale_misalign_sigma_frac);
   }
+  if (has_stop_states()) {
+    P_.diagonal().segment<4>(kStopAngle.start).setConstant(cfg_.flip_angle_sigma_deg * cfg_.flip_angle_sigma_deg);
+  }
   use_calibration_prior();
   gate1_ = cfg_.nis_gate_probability < 1.0 ? chi2_quantile(cfg_.nis_gate_probability, 1.0)
                                            : std::numeric_limits<double>::infinity();
@@ -524,7 +527,52 @@ void DriftlessFilter::residual_rows(const StandstillSegment& s, const Eigen::Mat
   // (its mean over the standstill scatters about its value at the midpoint)
   const double var = cfg_.sample_variance_dps2(rate_hz) / double(s.n) + q_rate_dps2_per_s_ * s.span_s() / 12.0;
   cur.R = var * (M1 * M1.transpose() + M2 * M2.transpose());
+  // the end-stop rows need the box rate, so the bias, known first (as for the flips and dwells): a
+  // rate from a bias not yet known would pass its error into the end-stop states; until then the
+  // rest-angle errors are noise
+  if (has_stop_states() && correction_sigma_dps().maxCoeff() < 0.1 * cfg_.box_dwell_rate_dps) stop_rows(s, M1, M2, cur);
+  else if (cfg_.mode == FilterMode::kGeneral) add_rest_angle_noise(s, M1, M2, cur.R);
   if (has_scale_states()) scale_rows(s, M1, M2, cur);
+}
+
+// the box rate over a standstill in box axes, at the current estimate of the biases
+Eigen::Vector3d DriftlessFilter::box_rate_dps(const StandstillSegment& s, const Eigen::Matrix3d& M1,
+                                              const Eigen::Matrix3d& M2) const {
+  return 0.5 * (M1 * (s.mean_gyro1_dps() - bias1_dps()) + M2 * (s.mean_gyro2_dps() - bias2_dps()));
+}
+
+// end-stop states: a rest angle off by d_i about a_i gives M_i y_i = w - d_i (a_i x w) + ..., so
+// r = M1 y1 - M2 y2 gains -d_1 (a_1 x w) + d_2 (a_2 x w) (d in rad; the states are in deg)
+void DriftlessFilter::stop_rows(const StandstillSegment& s, const Eigen::Matrix3d& M1, const Eigen::Matrix3d& M2,
+                                Residual3& cur) const {
+  const Eigen::Vector3d w = box_rate_dps(s, M1, M2);
+  if (!w.allFinite() || !std::isfinite(s.plat1_deg) || !std::isfinite(s.plat2_deg)) return;
+  cur.H.col(stop_index(1, s.plat1_deg)) = -kRadPerDeg * box_.hinge1_axis.normalized().cross(w);
+  cur.H.col(stop_index(2, s.plat2_deg)) = kRadPerDeg * box_.hinge2_axis.normalized().cross(w);
+}
+
+// each platform rests at an angle known to flip_angle_sigma_deg only (an end stop's error, a
+// reading's): sensor i off by d_i about its hinge a_i reads the box rate turned by d_i, so
+// M_i y_i gains d_i (a_i x w) (box axes, w the box rate over the standstill). The error is
+// fixed per end stop, but w changes from one standstill to the next: taken as noise, it adds
+// sigma^2 (a_i x w)(a_i x w)^T per sensor, w at the current estimate (its error, sigma_b, only
+// weakens the first update or two). A static box (w = the Earth rate) adds ~1e-5 deg/s; a box
+// turning at a few deg/s over a standstill, as much as the white noise. Calibrated matrices
+// (--calib) hold the true angles: no term for a sensor that has them
+void DriftlessFilter::add_rest_angle_noise(const StandstillSegment& s, const Eigen::Matrix3d& M1,
+                                           const Eigen::Matrix3d& M2, Eigen::Matrix3d& R) const {
+  const double sigma_rad = kRadPerDeg * cfg_.flip_angle_sigma_deg;
+  if (!(sigma_rad > 0.0)) return;
+  const Eigen::Vector3d w = box_rate_dps(s, M1, M2);
+  if (!w.allFinite()) return;
+  if (cfg_.calibration.sensor1.empty()) {
+    const Eigen::Vector3d c = sigma_rad * box_.hinge1_axis.normalized().cross(w);
+    R += c * c.transpose();
+  }
+  if (cfg_.calibration.sensor2.empty()) {
+    const Eigen::Vector3d c = sigma_rad * box_.hinge2_axis.normalized().cross(w);
+    R += c * c.transpose();
+  }
 }
 
 // self-calibration: y_i = (I + E_i) w_i + ..., so eq. (2) gains M1 E1 w1 - M2 E2 w2 with w_i the
@@ -597,16 +645,23 @@ void DriftlessFilter::fuse_rate(const Sample& s, const StandstillStep& st) {
                   fixed = Eigen::Vector3d::Zero();
   int n = 0;
   // a sensor on a moving platform also reads its hinge rate; only resting ones enter the fusion
+  // a rest angle off by d about the hinge a (end-stop states): the sensor's axes are turned by d,
+  // so in the axes M assumes it reads y + d (a x y) (first order); y1c/y2c stay in the axes read
+  const auto turned = [&](int i, double deg, const Eigen::Vector3d& y) -> Eigen::Vector3d {
+    if (!has_stop_states()) return y;
+    const Eigen::Vector3d& a = i == 1 ? box_.hinge1_axis : box_.hinge2_axis;
+    return y + kRadPerDeg * x(stop_index(i, deg)) * a.normalized().cross(y);
+  };
   if (st.plat1_rest && finite(st.plat1_deg)) {
     const Eigen::Matrix3d M1 = body_from_sensor(1, st.plat1_deg);
-    sum += M1 * out_.y1c_dps;
+    sum += M1 * turned(1, st.plat1_deg, out_.y1c_dps);
     raw += M1 * s.gyro1_dps;
     fixed += M1 * (s.gyro1_dps - fixed_bias_.segment<3>(kBias1.start));
     ++n;
   }
   if (st.plat2_rest && finite(st.plat2_deg)) {
     const Eigen::Matrix3d M2 = body_from_sensor(2, st.plat2_deg);
-    sum += M2 * out_.y2c_dps;
+    sum += M2 * turned(2, st.plat2_deg, out_.y2c_dps);
     raw += M2 * s.gyro2_dps;
     fixed += M2 * (s.gyro2_dps - fixed_bias_.segment<3>(kBias2.start));
     ++n;
@@ -802,13 +857,15 @@ void DriftlessFilter::use_flip() {
   fm.M_moving_start = body_from_sensor(m, flips_.start_deg());
   fm.M_rest = body_from_sensor(r, flips_.rest_deg());
   fm.hinge_box = (m == 1 ? box_.hinge1_axis : box_.hinge2_axis).normalized();
+  fm.hinge_rest_box = (m == 1 ? box_.hinge2_axis : box_.hinge1_axis).normalized();
   fm.moving = errors_of(m);
   fm.rest = errors_of(r);
   fm.use_g = has_gsens_states();
   const double n = double(flips_.samples().size());
   const double rate_hz = n / (flips_.t_end_s() - flips_.t_start_s());
   fm.sample_var_dps2 = cfg_.sample_variance_dps2(std::isfinite(box_.sample_rate_hz) ? box_.sample_rate_hz : rate_hz);
-  fm.angle_sigma_deg = cfg_.flip_angle_sigma_deg;
+  // with end-stop states the rest angles' errors are states, not noise
+  fm.angle_sigma_deg = has_stop_states() ? 0.0 : cfg_.flip_angle_sigma_deg;
   const FlipRows fr = flip_rows(flips_, fm);
   if (!fr.valid) return;
   const auto at = [](StateSlice first, int sensor, Eigen::Index width) { return first.start + width * (sensor - 1); };
@@ -821,6 +878,11 @@ void DriftlessFilter::use_flip() {
   }
   H.block<3, 9>(0, at(kScale1, m, 9)) = fr.H_E_moving;
   H.block<3, 9>(0, at(kScale1, r, 9)) = fr.H_E_rest;
+  if (has_stop_states()) {
+    H.col(stop_index(m, flips_.end_deg())) += fr.H_stop_end;
+    H.col(stop_index(m, flips_.start_deg())) += fr.H_stop_start;
+    H.col(stop_index(r, flips_.rest_deg())) += fr.H_stop_rest;
+  }
   // the regressors use the estimate: its error times E (3 terms per sensor, as in scale_rows)
   const double sb = std::sqrt(P_.diagonal().head<kStateDim>().maxCoeff());
   const double se = std::sqrt(P_.diagonal().segment<18>(kScale1.start).maxCoeff());

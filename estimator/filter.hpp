@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <deque>
 #include <iosfwd>
@@ -47,7 +48,13 @@ inline constexpr StateSlice kGSens2{21, 9};
 // 1c); frozen at 0 (P = 0) unless self_calibration is on and scale_misalign_sigma_frac > 0
 inline constexpr StateSlice kScale1{30, 9};
 inline constexpr StateSlice kScale2{39, 9};
-inline constexpr int kFullStateDim = 48;
+// self-calibrating mode with scale states: each platform's rest angle errors at its two end stops
+// (deg, about its hinge; [platform 1 at -, at +, platform 2 at -, at +], by the sign of the angle
+// read): a stop off by d turns that sensor's reading of the box rate by d (standstills) and makes
+// each flip d_end - d_start larger than the readings say (docs/estimator.md section 1g); prior
+// sigma flip_angle_sigma_deg, frozen at 0 unless has_stop_states()
+inline constexpr StateSlice kStopAngle{48, 4};
+inline constexpr int kFullStateDim = 52;
 using StateVector = Eigen::Matrix<double, kFullStateDim, 1>;
 using StateMatrix = Eigen::Matrix<double, kFullStateDim, kFullStateDim>;
 
@@ -196,6 +203,18 @@ class DriftlessFilter {
   /// Each flip of one platform measures the moving sensor's scale/misalignment (flip_updates,
   /// self-calibrating mode with scale states; docs/estimator.md section 1f)
   bool uses_flips() const { return has_scale_states() && cfg_.flip_updates; }
+  /// End-stop angle states (kStopAngle): general mode, a rest-angle sigma (flip_angle_sigma_deg
+  /// > 0) and no calibrated matrices (which hold the true angles)
+  bool has_stop_states() const {
+    return cfg_.mode == FilterMode::kGeneral && cfg_.flip_angle_sigma_deg > 0.0 && cfg_.calibration.empty();
+  }
+  /// The rest-angle errors [platform 1 at -, at +; platform 2 at -, at +] (deg) and their sigma.
+  Eigen::Vector4d stop_angle_deg() const { return x_.segment<4>(kStopAngle.start); }
+  Eigen::Vector4d stop_angle_sigma_deg() const { return P_.diagonal().segment<4>(kStopAngle.start).cwiseSqrt(); }
+  /// Index in the state of platform `platform`'s end stop at the angle read `plat_deg`.
+  static Eigen::Index stop_index(int platform, double plat_deg) {
+    return kStopAngle.start + 2 * (platform - 1) + (plat_deg < 0.0 ? 0 : 1);
+  }
   /// Sigma of the correction the filter applies, o_i = b_i + G_i f_i at the specific force of
   /// the last update (deg/s): what "locked" means. The bias sigma without self-calibration; with
   /// it, b_i alone may stay unobservable (a g-sensitivity along a fixed gravity looks like bias).
@@ -208,6 +227,13 @@ class DriftlessFilter {
   /// The latest update (has_update() false before the first).
   const UpdateRecord& last_update() const { return last_update_; }
   bool has_update() const { return counters_.updates > 0; }
+  /// The bias covariance (deg/s)^2 carried to time `t_s` by the random walk (P refers to the last
+  /// update's time; the bias wanders on between updates): what a per-sample error is checked against.
+  Matrix6d covariance_dps2_at(double t_s) const {
+    Matrix6d P = covariance_dps2();
+    if (std::isfinite(t_filter_s_) && t_s > t_filter_s_) P.diagonal().array() += q_rate_dps2_per_s_ * (t_s - t_filter_s_);
+    return P;
+  }
   /// Corrected outputs and fused body rate of the sample last pushed.
   const SampleOutput& output() const { return out_; }
   const FilterCounters& counters() const { return counters_; }
@@ -242,6 +268,10 @@ class DriftlessFilter {
               const Eigen::Matrix<double, D, D>& R, UpdateRecord& rec, bool may_relock = true);
   void emit_update(const UpdateRecord& rec, bool accepted);
   void fuse_rate(const Sample& s, const StandstillStep& st);
+  Eigen::Vector3d box_rate_dps(const StandstillSegment& s, const Eigen::Matrix3d& M1, const Eigen::Matrix3d& M2) const;
+  void stop_rows(const StandstillSegment& s, const Eigen::Matrix3d& M1, const Eigen::Matrix3d& M2, Residual3& cur) const;
+  void add_rest_angle_noise(const StandstillSegment& seg, const Eigen::Matrix3d& M1, const Eigen::Matrix3d& M2,
+                            Eigen::Matrix3d& R) const;
   void scale_rows(const StandstillSegment& seg, const Eigen::Matrix3d& M1, const Eigen::Matrix3d& M2,
                   Residual3& out);
   void skip_paper_step();

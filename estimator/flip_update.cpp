@@ -101,6 +101,7 @@ FlipRows flip_rows(const FlipWindow& w, const FlipModel& m) {
   const Eigen::Vector3d a = (m.M_moving_start.transpose() * m.hinge_box).normalized();  // moving sensor axes
   const double dtheta_deg = w.end_deg() - w.start_deg();
   const Eigen::Matrix3d C0 = m.M_moving_start.transpose() * m.M_rest;  // rest sensor -> moving sensor at start
+  const Eigen::Vector3d a_s = (m.M_rest.transpose() * m.hinge_rest_box).normalized();  // rest hinge, rest sensor axes
   const auto ym = [m1](const FlipSample& k) -> const Eigen::Vector3d& { return m1 ? k.gyro1_dps : k.gyro2_dps; };
   const auto ys = [m1](const FlipSample& k) -> const Eigen::Vector3d& { return m1 ? k.gyro2_dps : k.gyro1_dps; };
   const auto fm = [m1](const FlipSample& k) -> Eigen::Vector3d { return (m1 ? k.accel1_mps2 : k.accel2_mps2) / kStandardGravityMps2; };
@@ -135,11 +136,14 @@ FlipRows flip_rows(const FlipWindow& w, const FlipModel& m) {
       out.H_G_rest -= matrix_error_jacobian(C, fs(k)) * k.dt_s;
     }
     W_c += C * us * k.dt_s;
+    out.H_stop_rest += kRadPerDeg * (C * a_s.cross(us)) * k.dt_s;
     out.H_E_rest -= matrix_error_jacobian(C, us) * k.dt_s;
     span_s += k.dt_s;
     sum_dt2 += k.dt_s * k.dt_s;
   }
   out.z_deg -= dtheta_deg * a;
+  out.H_stop_end = a;
+  out.H_stop_start = -a - kRadPerDeg * a.cross(W_c);
   out.H_b_moving = span_s * Eigen::Matrix3d::Identity();
   out.H_b_rest = -S_b;
   if (m.use_g) out.H_G_moving = matrix_error_jacobian(Eigen::Matrix3d::Identity(), F_m);

@@ -81,6 +81,7 @@ struct FlipModel {
   Eigen::Matrix3d M_moving_start;  // body from moving sensor at its start angle
   Eigen::Matrix3d M_rest;          // body from the resting sensor
   Eigen::Vector3d hinge_box;       // the moving platform's hinge axis, box axes (unit)
+  Eigen::Vector3d hinge_rest_box = Eigen::Vector3d::UnitX();  // the resting platform's, box axes
   SensorErrors moving, rest;       // the estimate (the profile and the E regressor use it)
   bool use_g = false;              // g-sensitivity states: need the accel columns
   double sample_var_dps2 = 0.0;    // white-noise variance of one sample, per axis, (deg/s)^2
@@ -100,6 +101,11 @@ struct FlipRows {
   Eigen::Matrix<double, 3, 9> H_G_rest = Eigen::Matrix<double, 3, 9>::Zero();
   Eigen::Matrix<double, 3, 9> H_E_moving = Eigen::Matrix<double, 3, 9>::Zero();
   Eigen::Matrix<double, 3, 9> H_E_rest = Eigen::Matrix<double, 3, 9>::Zero();
+  // end-stop angle errors (deg per deg): the moving platform's stop at the end and at the start
+  // (the flip is d_end - d_start larger than read; the start frame turned by d_start turns the
+  // box rate seen meanwhile), and the resting platform's (its sensor's rate turned by it)
+  Eigen::Vector3d H_stop_end = Eigen::Vector3d::Zero(), H_stop_start = Eigen::Vector3d::Zero();
+  Eigen::Vector3d H_stop_rest = Eigen::Vector3d::Zero();
   Eigen::Matrix3d R_deg2 = Eigen::Matrix3d::Zero();
   double span_s = 0.0;  // s, the window's length T
 };

@@ -159,8 +159,9 @@ void HealthMonitor::add_lock_findings(HealthReport& h, const DriftlessFilter& fi
   }
 }
 
-HealthReport HealthMonitor::finish(const DriftlessFilter& filter, double duration_s) const {
+HealthReport HealthMonitor::finish(const DriftlessFilter& filter, double duration_s, const LagCheckResult& lag) const {
   HealthReport h;
+  h.signal_chain = lag;
   h.locked = locked_;
   h.lock_t_s = lock_t_s_;
   h.updates = updates_;
@@ -181,6 +182,15 @@ HealthReport HealthMonitor::finish(const DriftlessFilter& filter, double duratio
   add_lock_findings(h, filter, duration_s);
   add_gate_findings(h);
   add_nis_findings(h);
+  if (lag.significant) {
+    // no noise density describes it: --tune auto would take it for noise and say "ok"
+    HealthFinding f;
+    f.cause = HealthCause::kSignalChainLag;
+    f.value = lag.lag_s;
+    f.sigma = lag.lag_sigma_s;
+    f.suggested = lag.update_excess;
+    add(h, f);
+  }
   if (h.relocks > 0) {
     HealthFinding f;
     f.cause = HealthCause::kRelocks;

@@ -13,6 +13,7 @@
 
 #include "estimator/clip_detector.hpp"
 #include "estimator/filter.hpp"
+#include "estimator/lag_check.hpp"
 
 namespace driftless::est {
 
@@ -35,6 +36,7 @@ enum class HealthCause {
   kUnobservable,         // some bias components kept (most of) their prior sigma
   kRelocks,              // the gate lost lock and re-locked
   kLateLock,             // locked, but too few accepted updates after the lock to check the NIS
+  kSignalChainLag,       // the residual follows the box's angular acceleration: one sensor reads late
   kSaturation,           // a gyro channel repeats its largest reading in runs: it clips there
 };
 
@@ -46,7 +48,9 @@ struct HealthFinding {
   double suggested = kNaN;    // kNoiseUnder/Overstated: nis_mean / dof, the factor by which the
                               // innovation variance exceeds (or falls short of) what S predicts;
                               // kNeverLocked: the rejected fraction; kLoneRejection: its time, s;
-                              // kLateLock: the accepted updates after the lock (value: lock time, s)
+                              // kLateLock: the accepted updates after the lock (value: lock time, s);
+                              // kSignalChainLag: update_excess (value: the lag, s; sigma: its sigma)
+  double sigma = kNaN;
   // kRejectionsAtPosition: the (plat1, plat2) angle pairs (deg) where most updates were rejected
   std::vector<std::array<double, 2>> positions_deg;
   std::vector<int> components;  // kUnobservable: 0..5 = b1_x .. b2_z; kSaturation: the channel
@@ -91,6 +95,7 @@ struct HealthReport {
   std::uint64_t relocks = 0;
   std::vector<int> unobservable;       // 0..5 = b1_x .. b2_z
   std::vector<HealthFinding> findings; // worst first
+  LagCheckResult signal_chain;         // the residual against the angular acceleration (lag_check.hpp)
 };
 
 /// Limits of the saturation finding: clipped in at least this fraction of the rows is `failed`
@@ -108,8 +113,9 @@ class HealthMonitor {
   explicit HealthMonitor(const HealthLimits& limits = {}) : limits_(limits) {}
   /// Every update the filter made (accepted or rejected), with the filter after it.
   void on_update(const UpdateRecord& rec, const DriftlessFilter& filter);
-  /// The verdict after the pass: `filter` is the filter at the end, `duration_s` the log's span.
-  HealthReport finish(const DriftlessFilter& filter, double duration_s) const;
+  /// The verdict after the pass: `filter` is the filter at the end, `duration_s` the log's span,
+  /// `lag` what the signal-chain check found (none: not checked).
+  HealthReport finish(const DriftlessFilter& filter, double duration_s, const LagCheckResult& lag = {}) const;
 
  private:
   struct PositionCount {

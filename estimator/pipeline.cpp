@@ -80,7 +80,8 @@ class WindowScore {
     sum2_ += e.squaredNorm();
     comp2_ += e.cwiseAbs2();
     max_ = std::max(max_, e.cwiseAbs().maxCoeff());
-    nees_ += nees(e, filter.covariance_dps2()) / 6.0;
+    // P carried to this sample (it refers to the last update's time; the bias wanders on)
+    nees_ += nees(e, filter.covariance_dps2_at(s.t_s)) / 6.0;
     last_ = e;
     ++n_;
   }
@@ -231,6 +232,7 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
   WindowScore window(sum.window, opt.eval_start_s);
   const bool use_window = have_truth && std::isfinite(opt.eval_start_s);
   HealthMonitor health(opt.health);
+  LagCheck lag(filter.geometry().sample_rate_hz);
 
   // the lock state changes only at updates (P shrinks there; a gate re-lock widens it)
   bool locked = false;
@@ -255,6 +257,7 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
     sum.t_last_s = s.t_s;
     const PushStatus st = filter.push(s);
     on_update(st, s);  // first: the row that made an update carries the state after it
+    lag.push(s, filter);
     sum.samples_locked += locked ? 1 : 0;
     if (sink != nullptr) sink->on_sample(s, filter.output(), locked);
     if (use_window) window.add(filter, s);
@@ -291,10 +294,13 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
     sum.scale_misalign_sigma_frac[static_cast<std::size_t>(i)] = filter.scale_misalign_sigma(i + 1);
   }
   sum.correction_sigma_dps = filter.correction_sigma_dps();
+  sum.stop_states = filter.has_stop_states();
+  sum.stop_angle_deg = filter.stop_angle_deg();
+  sum.stop_angle_sigma_deg = filter.stop_angle_sigma_deg();
   add_attitude_results(att, filter, opt, sum);
   score.finish();
   if (use_window) window.finish(filter);
-  sum.health = health.finish(filter, sum.rows > 0 ? sum.t_last_s - sum.t_first_s : 0.0);
+  sum.health = health.finish(filter, sum.rows > 0 ? sum.t_last_s - sum.t_first_s : 0.0, lag.finish());
   if (reader != nullptr) add_saturation_findings(sum.health, reader->suspected_clipping(), reader->rows_read());
   return sum;
 }

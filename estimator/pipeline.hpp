@@ -122,6 +122,9 @@ struct EstimateSummary {
   bool scale_states = false;
   std::array<Eigen::Matrix3d, 2> scale_misalign_frac{Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero()};
   std::array<Eigen::Matrix3d, 2> scale_misalign_sigma_frac{Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero()};
+  // the end-stop angle errors (deg; platform 1 at -, at +, platform 2 at -, at +) and their sigma
+  bool stop_states = false;
+  Eigen::Vector4d stop_angle_deg = Eigen::Vector4d::Zero(), stop_angle_sigma_deg = Eigen::Vector4d::Zero();
   double t_first_s = kNaN, t_last_s = kNaN;
   bool attitude_available = false;   // the log has ref_q
   double drift_corrected_deg_per_h = kNaN;
