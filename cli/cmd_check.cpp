@@ -49,6 +49,11 @@ void print_findings(const log::LogReader& reader) {
     fmt::print("  warning: {} rows have a gyro value at the full scale of {} deg/s (saturated)\n",
                reader.rows_saturated(), reader.metadata().gyro_full_scale_dps());
   }
+  for (const est::ClippedChannel& c : reader.suspected_clipping()) {
+    fmt::print("  warning: gyro{}_{} repeats its largest value, +-{:g} deg/s, in runs ({} samples): it clips there "
+               "(the sensor's range)\n",
+               c.channel / 3 + 1, "xyz"[c.channel % 3], c.level_dps, c.samples);
+  }
   if (reader.rows_with_missing_gyro() > 0) {
     fmt::print("  warning: {} rows have a missing or NaN gyro value\n", reader.rows_with_missing_gyro());
   }

@@ -42,6 +42,35 @@ TEST(PipelineTest, CorrectionCutsAttitudeDriftOnAPanTiltRun) {
   EXPECT_TRUE(s.warnings.empty()) << s.warnings.front();
 }
 
+TEST(PipelineTest, AGyroThatClipsFailsTheRunAndIsNamedFirst) {
+  // GIVEN a box that spins about z up to 600 deg/s, read by a sensor 1 of range +-250 deg/s, in a
+  // log that states no gyro_full_scale_dps (as most logs from elsewhere)
+  test::SynthParams p;
+  p.duration_s = 300.0;
+  p.noise_sigma_dps = 0.05;
+  p.body_rate_dps = [](double t) { return Eigen::Vector3d(0.0, 0.0, 600.0 * std::sin(0.05 * t)); };
+  const auto clean_path = temp_path("spin.csv");
+  test::synth_log(p, clean_path);
+  p.before_quantise = [](Sample& s) { s.gyro1_dps = s.gyro1_dps.cwiseMax(-250.0).cwiseMin(250.0); };
+  const auto clipped_path = temp_path("spin_clipped.csv");
+  test::synth_log(p, clipped_path);
+  // WHEN estimate runs over each
+  log::LogReader clean_reader(clean_path), clipped_reader(clipped_path);
+  const auto clean = run_estimate(clean_reader, EstimatorConfig{}, nullptr);
+  const auto clipped = run_estimate(clipped_reader, EstimatorConfig{}, nullptr);
+  // THEN the clipped log fails, its first finding names a sensor-1 channel at 250 deg/s
+  EXPECT_EQ(clipped.health.verdict, HealthVerdict::kFailed);
+  ASSERT_FALSE(clipped.health.findings.empty());
+  const HealthFinding& f = clipped.health.findings.front();
+  EXPECT_EQ(f.cause, HealthCause::kSaturation);
+  ASSERT_EQ(f.components.size(), 1u);
+  EXPECT_LT(f.components[0], 3);
+  EXPECT_NEAR(f.suggested, 250.0, 0.01);
+  EXPECT_GT(f.value, 0.01);
+  // AND the same spin within range has no saturation finding
+  for (const HealthFinding& g : clean.health.findings) EXPECT_NE(g.cause, HealthCause::kSaturation);
+}
+
 TEST(PipelineTest, ComparisonStartsWhenLockedAndAFixedBiasThenDoesNotDrift) {
   // GIVEN a noise-free moving run with constant biases (the estimate is exact once locked)
   test::SynthParams p;
