@@ -128,12 +128,16 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
     case est::HealthCause::kSaturation: {
       const int c = f.components.empty() ? 0 : f.components.front();
       return fmt::format("gyro{}_{} reads exactly +-{:.6g} deg/s, its largest value, in runs over {:.3g} % of the "
-                         "rows: the sensor clips there (its range), and every standstill or flip through those "
-                         "rows measures the rail, not the rate{}; record with a larger full scale (MPU6050: "
+                         "rows: the sensor clips there (its range){}; record with a larger full scale (MPU6050: "
                          "FS_SEL) or slower motion, and state the range as gyro_full_scale_dps in the log header",
                          c / 3 + 1, "xyz"[c % 3], f.suggested, 100.0 * f.value,
-                         f.severity == est::HealthVerdict::kFailed ? ": the biases from this log cannot be trusted"
-                                                                   : "");
+                         f.severity == est::HealthVerdict::kOk
+                             ? ", only while a platform turns: the standstills that the bias updates average are "
+                               "untouched, a flip's measured turn falls short (flip updates)"
+                         : f.severity == est::HealthVerdict::kFailed
+                             ? ", also while the platforms rest: those standstills measure the rail, not the rate, "
+                               "and the biases from this log cannot be trusted"
+                             : ", also in a few standstills, which measure the rail there");
     }
   }
   return "?";

@@ -4,10 +4,10 @@
 
 namespace driftless::est {
 
-void ClipDetector::push(int channel, double v_dps) {
+void ClipDetector::push(int channel, double v_dps, bool platforms_resting) {
   Channel& c = ch_[static_cast<std::size_t>(channel)];
   if (std::isnan(v_dps)) {
-    c.run = 0;
+    c.run = c.run_at_rest = 0;
     c.run_value_dps = v_dps;
     return;
   }
@@ -15,13 +15,21 @@ void ClipDetector::push(int channel, double v_dps) {
   // a new largest reading: the plateau counted so far was below the channel's range
   if (a > c.max_abs_dps) {
     c.max_abs_dps = a;
-    c.plateau = 0;
+    c.plateau = c.plateau_at_rest = 0;
   }
-  c.run = v_dps == c.run_value_dps ? c.run + 1 : 1;
+  const bool same = v_dps == c.run_value_dps;
+  c.run = same ? c.run + 1 : 1;
+  c.run_at_rest = (same ? c.run_at_rest : 0) + (platforms_resting ? 1 : 0);
   c.run_value_dps = v_dps;
-  if (a != c.max_abs_dps) return;
-  if (c.run == kMinRun) c.plateau += static_cast<std::uint64_t>(kMinRun);
-  else if (c.run > kMinRun) ++c.plateau;
+  if (a != c.max_abs_dps || c.run < kMinRun) return;
+  // the run's first kMinRun samples count once it is long enough, then each one as it comes
+  if (c.run == kMinRun) {
+    c.plateau += static_cast<std::uint64_t>(kMinRun);
+    c.plateau_at_rest += static_cast<std::uint64_t>(c.run_at_rest);
+  } else {
+    ++c.plateau;
+    c.plateau_at_rest += platforms_resting ? 1 : 0;
+  }
 }
 
 std::vector<ClippedChannel> ClipDetector::suspected() const {
@@ -29,7 +37,7 @@ std::vector<ClippedChannel> ClipDetector::suspected() const {
   for (std::size_t i = 0; i < ch_.size(); ++i) {
     const Channel& c = ch_[i];
     if (c.max_abs_dps >= kMinLevelDps && c.plateau >= kMinSamples) {
-      out.push_back(ClippedChannel{static_cast<int>(i), c.max_abs_dps, c.plateau});
+      out.push_back(ClippedChannel{static_cast<int>(i), c.max_abs_dps, c.plateau, c.plateau_at_rest});
     }
   }
   return out;

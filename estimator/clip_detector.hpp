@@ -17,6 +17,7 @@ struct ClippedChannel {
   int channel = 0;               // 0..5 = gyro1_x .. gyro2_z
   double level_dps = 0.0;        // deg/s, the repeated |reading|
   std::uint64_t samples = 0;     // samples in runs of at least kMinRun at that level
+  std::uint64_t samples_at_rest = 0;  // of those, while both platforms rested (or unknown)
 };
 
 /// Watches the six gyro channels sample by sample (constant memory, a few compares a sample).
@@ -31,8 +32,10 @@ class ClipDetector {
   /// Plateau samples a channel needs before it is reported.
   static constexpr std::uint64_t kMinSamples = 10;
 
-  /// One reading of channel 0..5 in deg/s (NaN: missing, ends a run).
-  void push(int channel, double v_dps);
+  /// One reading of channel 0..5 in deg/s (NaN: missing, ends a run); `platforms_resting`: both
+  /// platforms at rest in this row (true when the log does not say), so a clip inside a
+  /// standstill, which the bias updates average, is told from one during a flip.
+  void push(int channel, double v_dps, bool platforms_resting);
   /// The channels whose largest |reading| came in runs, in channel order.
   std::vector<ClippedChannel> suspected() const;
 
@@ -42,6 +45,8 @@ class ClipDetector {
     double run_value_dps = std::numeric_limits<double>::quiet_NaN();
     int run = 0;
     std::uint64_t plateau = 0;  // samples in runs >= kMinRun at max_abs_dps
+    std::uint64_t plateau_at_rest = 0;
+    int run_at_rest = 0;        // of the current run, samples with the platforms at rest
   };
   std::array<Channel, 6> ch_{};
 };

@@ -29,7 +29,12 @@ void add_saturation_findings(HealthReport& h, const std::vector<ClippedChannel>&
     f.value = double(c.samples) / double(rows);
     f.suggested = c.level_dps;
     f.components = {c.channel};
-    f.severity = f.value >= kSaturationFailedFraction ? HealthVerdict::kFailed : HealthVerdict::kDegraded;
+    // a clip while a platform turns (a fast flip) leaves the standstills, which the bias updates
+    // average, untouched: a note; inside them the rail enters the biases
+    const double at_rest = double(c.samples_at_rest) / double(rows);
+    f.severity = c.samples_at_rest < ClipDetector::kMinSamples ? HealthVerdict::kOk
+                 : at_rest >= kSaturationFailedFraction       ? HealthVerdict::kFailed
+                                                              : HealthVerdict::kDegraded;
     add(first, std::move(f));
   }
   for (HealthFinding& f : h.findings) first.findings.push_back(std::move(f));

@@ -98,9 +98,9 @@ struct HealthReport {
   LagCheckResult signal_chain;         // the residual against the angular acceleration (lag_check.hpp)
 };
 
-/// Limits of the saturation finding: clipped in at least this fraction of the rows is `failed`
-/// (the standstills and flips through those samples carry the rail, not the rate), below it
-/// `degraded`.
+/// Limits of the saturation finding: clipped while both platforms rest in at least this fraction
+/// of the rows is `failed` (the standstills through those samples carry the rail, not the rate),
+/// in fewer `degraded`; clipped only while a platform turns (a fast flip) is a note.
 inline constexpr double kSaturationFailedFraction = 0.01;
 
 /// Puts a `saturation` finding for each suspected clipped channel ahead of the other findings (it

@@ -4,6 +4,7 @@
 // every command that reads a log (check included) refuses and reports the same things.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <limits>
@@ -213,6 +214,7 @@ class LogReader {
   void map_columns();
   bool split_row(std::string_view line, std::string& problem);
   void check_row(const Sample& s);
+  bool platforms_resting(const Sample& s);
 
   std::filesystem::path path_;
   ReaderOptions opts_;
@@ -242,6 +244,8 @@ class LogReader {
   std::uint64_t missing_gyro_rows_ = 0;
   std::uint64_t saturated_rows_ = 0;
   est::ClipDetector clip_;
+  std::array<double, 2> last_plat_deg_{kNaN, kNaN};  // deg, the last row's platform angles
+  bool angles_seen_ = false;                         // a row has given both platform angles
   double last_t_ = -std::numeric_limits<double>::infinity();
   bool dropped_truncated_ = false;
 };

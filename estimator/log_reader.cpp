@@ -273,6 +273,16 @@ bool LogReader::split_row(std::string_view line, std::string& problem) {
 }
 
 // the per-row checks: time, gaps, gyro plausibility against the full scale
+// both platforms at rest in this row: their angles read and unchanged since the last row. A log
+// that has given no angle yet (no angle columns, an end-stop box) does not say: taken as resting
+bool LogReader::platforms_resting(const Sample& s) {
+  const bool read = std::isfinite(s.plat1_deg) && std::isfinite(s.plat2_deg);
+  const bool resting = read ? s.plat1_deg == last_plat_deg_[0] && s.plat2_deg == last_plat_deg_[1] : !angles_seen_;
+  angles_seen_ = angles_seen_ || read;
+  last_plat_deg_ = {s.plat1_deg, s.plat2_deg};
+  return resting;
+}
+
 void LogReader::check_row(const Sample& s) {
   if (!std::isfinite(s.t_s)) fail("column 't': expected a time in seconds, got an empty or non-finite value");
   if (!(s.t_s > last_t_)) {
@@ -292,10 +302,11 @@ void LogReader::check_row(const Sample& s) {
     }
   }
   const int n = sensors() == 1 ? 3 : 6;
+  const bool resting = platforms_resting(s);
   bool missing = false, saturated = false;
   for (int i = 0; i < n; ++i) {
     const double v = i < 3 ? s.gyro1_dps[i] : s.gyro2_dps[i - 3];
-    clip_.push(i, v);
+    clip_.push(i, v, resting);
     if (std::isnan(v)) {
       missing = true;
       continue;

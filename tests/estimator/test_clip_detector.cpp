@@ -26,7 +26,7 @@ ClipDetector run(double amp_dps, double noise_dps, double fs_dps, double lsb_dps
       v = std::copysign(fs_dps, v);
       ++*clipped;
     }
-    d.push(ch, v);
+    d.push(ch, v, true);
   }
   return d;
 }
@@ -59,7 +59,7 @@ TEST(ClipDetector, ARateThatOnlyPassesThroughItsExtremeIsNotClipping) {
 TEST(ClipDetector, AQuietStaticLogBelowAnyGyroRangeIsNotClipping) {
   // GIVEN a noise-free simulated log holding one rate: every sample repeats its largest value
   ClipDetector d;
-  for (int k = 0; k < 1000; ++k) d.push(2, 15.0);
+  for (int k = 0; k < 1000; ++k) d.push(2, 15.0, true);
   // THEN it is below kMinLevelDps (no gyro's range is 15 deg/s): not reported
   EXPECT_TRUE(d.suspected().empty());
 }
@@ -68,37 +68,56 @@ TEST(ClipDetector, AMissingReadingEndsARunAndAHigherValueRestartsTheCount) {
   ClipDetector d;
   // runs of two at 300, split by NaN: never three in a row
   for (int k = 0; k < 20; ++k) {
-    d.push(0, 300.0);
-    d.push(0, 300.0);
-    d.push(0, std::nan(""));
+    d.push(0, 300.0, true);
+    d.push(0, 300.0, true);
+    d.push(0, std::nan(""), true);
   }
   EXPECT_TRUE(d.suspected().empty());
   // a run of 12 at 300 counts 12; a later single 310 makes 300 not the largest: the count restarts
-  for (int k = 0; k < 12; ++k) d.push(0, -300.0);
+  for (int k = 0; k < 12; ++k) d.push(0, -300.0, true);
   ASSERT_EQ(d.suspected().size(), 1u);
   EXPECT_EQ(d.suspected()[0].samples, 12u);
-  d.push(0, 310.0);
+  d.push(0, 310.0, true);
   EXPECT_TRUE(d.suspected().empty());
 }
 
-TEST(HealthSaturation, AClippedChannelLeadsTheFindingsAndFailsAboveOnePercent) {
-  // GIVEN a degraded report and two clipped channels, one in 5 % of 1000 rows, one in 0.5 %
+TEST(ClipDetector, ClippedSamplesAreSplitIntoAtRestAndWhileAPlatformTurns) {
+  ClipDetector d;
+  // a run of 10 at the rail during a flip, then one of 6 while the platforms rest: the at-rest
+  // samples of a run count from its start once it is kMinRun long
+  for (int k = 0; k < 10; ++k) d.push(1, 250.0, false);
+  d.push(1, 12.0, true);
+  for (int k = 0; k < 6; ++k) d.push(1, -250.0, true);
+  ASSERT_EQ(d.suspected().size(), 1u);
+  EXPECT_EQ(d.suspected()[0].samples, 16u);
+  EXPECT_EQ(d.suspected()[0].samples_at_rest, 6u);
+}
+
+TEST(HealthSaturation, AClipInsideTheStandstillsLeadsTheFindingsAndOneDuringFlipsIsANote) {
+  // GIVEN a degraded report and three clipped channels over 2000 rows: 5 % of the rows at rest,
+  // 0.75 % at rest, and 2 % but only 5 samples at rest (a fast flip)
   HealthReport h;
   h.verdict = HealthVerdict::kDegraded;
   HealthFinding gate;
   gate.cause = HealthCause::kRejections;
   h.findings.push_back(gate);
-  add_saturation_findings(h, {{2, 250.0, 50}, {4, 2000.0, 5}}, 1000);
-  // THEN the saturation findings come first, the first fails the run, the second only degrades
+  add_saturation_findings(h, {{2, 250.0, 100, 100}, {3, 250.0, 30, 15}, {4, 2000.0, 40, 5}}, 2000);
+  // THEN the saturation findings come first: failed, degraded, a note; the run fails
   EXPECT_EQ(h.verdict, HealthVerdict::kFailed);
-  ASSERT_EQ(h.findings.size(), 3u);
+  ASSERT_EQ(h.findings.size(), 4u);
   EXPECT_EQ(h.findings[0].cause, HealthCause::kSaturation);
   EXPECT_EQ(h.findings[0].severity, HealthVerdict::kFailed);
   EXPECT_DOUBLE_EQ(h.findings[0].value, 0.05);
   EXPECT_DOUBLE_EQ(h.findings[0].suggested, 250.0);
   EXPECT_EQ(h.findings[1].severity, HealthVerdict::kDegraded);
-  EXPECT_EQ(h.findings[1].components, std::vector<int>{4});
-  EXPECT_EQ(h.findings[2].cause, HealthCause::kRejections);
+  EXPECT_EQ(h.findings[1].components, std::vector<int>{3});
+  EXPECT_EQ(h.findings[2].severity, HealthVerdict::kOk);
+  EXPECT_EQ(h.findings[3].cause, HealthCause::kRejections);
+  // AND a clip only during flips leaves an ok verdict ok
+  HealthReport flips;
+  add_saturation_findings(flips, {{0, 250.0, 500, 0}}, 2000);
+  EXPECT_EQ(flips.verdict, HealthVerdict::kOk);
+  ASSERT_EQ(flips.findings.size(), 1u);
   // AND with nothing clipped the report is unchanged
   HealthReport ok;
   add_saturation_findings(ok, {}, 1000);
