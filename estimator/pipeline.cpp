@@ -298,6 +298,15 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
   sum.stop_angle_deg = filter.stop_angle_deg();
   sum.stop_angle_sigma_deg = filter.stop_angle_sigma_deg();
   add_attitude_results(att, filter, opt, sum);
+  if (cfg.standstill == StandstillSource::kGyroSignal && sum.attitude_available) {
+    // the flip's positions come from the detector, which sees a flip only once it is under way
+    // and snaps its end: the part of the hinge turn it misses enters the fused body rate
+    sum.warnings.emplace_back(
+        "attitude with 'standstill: gyro': during a flip the sensors' positions come from the gyro-signal "
+        "detector, not from angle read-back, so part of each hinge turn can enter the attitude (degrees per "
+        "flip seen at 1 kHz and on a turning box); the biases are not affected. For attitude, log the "
+        "platform angles (plat1_deg, plat2_deg) and use 'standstill: platform'");
+  }
   score.finish();
   if (use_window) window.finish(filter);
   sum.health = health.finish(filter, sum.rows > 0 ? sum.t_last_s - sum.t_first_s : 0.0, lag.finish());

@@ -71,6 +71,30 @@ TEST(PipelineTest, AGyroThatClipsFailsTheRunAndIsNamedFirst) {
   for (const HealthFinding& g : clean.health.findings) EXPECT_NE(g.cause, HealthCause::kSaturation);
 }
 
+TEST(PipelineTest, AttitudeFromGyroOnlyStandstillsComesWithAWarning) {
+  // GIVEN a log with a reference attitude, estimated once with the platform angles and once with
+  // 'standstill: gyro' (the angles unused)
+  test::SynthParams p;
+  p.duration_s = 120.0;
+  p.noise_sigma_dps = 0.05;
+  const auto path = temp_path("gyro_standstill.csv");
+  test::synth_log(p, path);
+  EstimatorConfig gyro;
+  gyro.standstill = StandstillSource::kGyroSignal;
+  log::LogReader r1(path), r2(path);
+  const auto with_angles = run_estimate(r1, EstimatorConfig{}, nullptr);
+  const auto gyro_only = run_estimate(r2, gyro, nullptr);
+  // THEN only the gyro-only run warns that its attitude is not to be trusted, and says the fix
+  const auto warns = [](const EstimateSummary& s) {
+    for (const auto& w : s.warnings)
+      if (w.find("attitude with 'standstill: gyro'") != std::string::npos) return true;
+    return false;
+  };
+  ASSERT_TRUE(gyro_only.attitude_available);
+  EXPECT_TRUE(warns(gyro_only));
+  EXPECT_FALSE(warns(with_angles));
+}
+
 TEST(PipelineTest, ComparisonStartsWhenLockedAndAFixedBiasThenDoesNotDrift) {
   // GIVEN a noise-free moving run with constant biases (the estimate is exact once locked)
   test::SynthParams p;
