@@ -50,9 +50,9 @@ void print_findings(const log::LogReader& reader) {
                reader.rows_saturated(), reader.metadata().gyro_full_scale_dps());
   }
   for (const est::ClippedChannel& c : reader.suspected_clipping()) {
-    fmt::print("  warning: gyro{}_{} repeats its largest value, +-{:g} deg/s, in runs ({} samples): it clips there "
+    fmt::print("  warning: {} repeats its largest value, +-{:g} deg/s, in runs ({} samples): it clips there "
                "(the sensor's range)\n",
-               c.channel / 3 + 1, "xyz"[c.channel % 3], c.level_dps, c.samples);
+               log::gyro_column_name(c.channel), c.level_dps, c.samples);
   }
   if (reader.rows_with_missing_gyro() > 0) {
     fmt::print("  warning: {} rows have a missing or NaN gyro value\n", reader.rows_with_missing_gyro());

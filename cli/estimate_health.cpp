@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include "estimator/log.hpp"
 #include "report/json.hpp"
 
 namespace driftless::cli {
@@ -127,10 +128,10 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
                          f.suggested);
     case est::HealthCause::kSaturation: {
       const int c = f.components.empty() ? 0 : f.components.front();
-      return fmt::format("gyro{}_{} reads exactly +-{:.6g} deg/s, its largest value, in runs over {:.3g} % of the "
+      return fmt::format("{} reads exactly +-{:.6g} deg/s, its largest value, in runs over {:.3g} % of the "
                          "rows: the sensor clips there (its range){}; record with a larger full scale (MPU6050: "
                          "FS_SEL) or slower motion, and state the range as gyro_full_scale_dps in the log header",
-                         c / 3 + 1, "xyz"[c % 3], f.suggested, 100.0 * f.value,
+                         log::gyro_column_name(c), f.suggested, 100.0 * f.value,
                          f.severity == est::HealthVerdict::kOk
                              ? ", only while a platform turns: the standstills that the bias updates average are "
                                "untouched, a flip's measured turn falls short (flip updates)"

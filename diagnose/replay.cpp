@@ -570,9 +570,9 @@ Replay replay_log(const std::filesystem::path& path, const ReplayOptions& opt) {
   for (const est::ClippedChannel& c : reader.suspected_clipping()) {
     const bool at_rest = c.samples_at_rest >= est::ClipDetector::kMinSamples;
     r.notes.insert(r.notes.begin(),
-                   fmt::format("gyro{}_{} repeats its largest value, +-{:g} deg/s, in runs ({} samples, {} with the "
+                   fmt::format("{} repeats its largest value, +-{:g} deg/s, in runs ({} samples, {} with the "
                                "platforms at rest): the sensor clips there{}",
-                               c.channel / 3 + 1, "xyz"[c.channel % 3], c.level_dps, c.samples, c.samples_at_rest,
+                               log::gyro_column_name(c.channel), c.level_dps, c.samples, c.samples_at_rest,
                                at_rest ? "; effects fitted on that channel (and the residual it shares) are not to "
                                          "be trusted: record with a larger full scale or slower motion"
                                        : ", only while a platform turns (the flips, which the fits leave out)"));

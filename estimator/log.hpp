@@ -96,6 +96,9 @@ struct Gap {
 /// (kLayoutSingleSensor: the single-sensor form, without gyro2_*, plat2_deg and sensor-2 columns).
 std::vector<std::string> column_names(std::uint32_t fields);
 
+/// The column of gyro channel 0..5 (gyro1_x .. gyro2_z), from the same table.
+std::string_view gyro_column_name(int channel);
+
 /// Bytes a row of a log with these fields takes, about (the written decimals plus sign, integer
 /// digits, point and comma per column); for the free-space check before a run.
 double estimated_row_bytes(std::uint32_t fields);

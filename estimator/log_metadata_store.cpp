@@ -189,6 +189,11 @@ std::vector<std::string> column_names(std::uint32_t fields) {
   return names;
 }
 
+std::string_view gyro_column_name(int channel) {
+  // the six gyro columns follow t in the table
+  return detail::kColumns[1 + static_cast<std::size_t>(channel)].name;
+}
+
 double estimated_row_bytes(std::uint32_t fields) {
   double bytes = 0.0;
   for (std::size_t i = 0; i < detail::kColumns.size(); ++i) {

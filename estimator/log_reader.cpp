@@ -313,7 +313,7 @@ void LogReader::check_row(const Sample& s) {
     }
     const double a = std::fabs(v);
     if (!(a <= gyro_limit_dps_)) {
-      fail(std::string("column '") + (i < 3 ? "gyro1_" : "gyro2_") + "xyz"[i % 3] + "': " + number_text(v) +
+      fail(std::string("column '") + std::string(gyro_column_name(i)) + "': " + number_text(v) +
            " deg/s is beyond " + number_text(kFullScaleMargin) + " x the gyro full scale of " +
            number_text(meta_.gyro_full_scale_dps()) + " deg/s" +
            (meta_.has("gyro_full_scale_dps") ? " stated in gyro_full_scale_dps"
