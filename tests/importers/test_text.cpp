@@ -182,6 +182,35 @@ TEST(TextImport, AColumnNamedForTwoChannelsIsRefused) {
   EXPECT_NO_THROW(open_imu(dir / "a.csv", ok));
 }
 
+TEST(TextImport, OptionsForAnotherFormatAreRefusedNotIgnored) {
+  // GIVEN a delimited-text recording and a .npy array
+  const auto dir = scratch("otherformat");
+  std::string s = "t,gx,gy,gz\n";
+  for (int i = 0; i < 50; ++i) s += std::to_string(0.01 * i) + ",0.1,0.2,0.3\n";
+  write_text(dir / "a.csv", s);
+  const auto refused = [&](ImportOptions o, const std::string& expected) {
+    try {
+      open_imu(dir / "a.csv", o);
+      ADD_FAILURE() << "accepted: " << expected;
+    } catch (const ImportError& e) {
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+    }
+  };
+  // WHEN a bag's --topic is given for the text file, THEN it is refused, naming the detected format
+  ImportOptions topic;
+  topic.topic = "/imu0";
+  refused(topic, "a.csv: --topic applies to ROS bags, but this file is text (delimited text)");
+  // AND a text option given with another --format is refused too
+  ImportOptions sep;
+  sep.format = Format::kNpy;
+  sep.separator = ";";
+  refused(sep, "--separator applies to delimited text, but this file is npy (as given (--format))");
+  // AND the text options on the text file are taken
+  ImportOptions ok;
+  ok.separator = ",";
+  EXPECT_NO_THROW(open_imu(dir / "a.csv", ok));
+}
+
 TEST(TextImport, MissingValuesAreNaNAndBadRowsNameFileAndLine) {
   const auto dir = scratch("bad");
   write_text(dir / "ok.csv", "t,gx,gy,gz\n0,1,2,3\n0.01,,2,3\n0.02,nan,2,3\n0.03,1,2,3\n0.04,1,2,3\n0.05,1,2,3\n0.06,1,2,3\n");
