@@ -11,6 +11,9 @@
 
 namespace driftless::diagnose {
 
+/// A fitted low-pass delay at or below this is "no low-pass" (the chain's boundary), s.
+inline constexpr double kNoLowpassDelayS = 1e-4;
+
 /// The residual of every channel after a fit (nuisance and the fit's effects taken out).
 struct AfterFit {
   std::array<std::vector<double>, 6> z;       // block means

@@ -23,7 +23,7 @@ std::string effect_text(const Candidate& c) {
   if (c.effect == Effect::kLowpass) {
     // say "no filter" where the fitted delay is zero
     for (const auto& p : c.params)
-      if (p.new_value() <= 1e-4) ps += p.ref.sensor < 0 ? std::string(": no low-pass") : fmt::format("; sensor {}: no low-pass", p.ref.sensor + 1);
+      if (p.new_value() <= kNoLowpassDelayS) ps += p.ref.sensor < 0 ? std::string(": no low-pass") : fmt::format("; sensor {}: no low-pass", p.ref.sensor + 1);
   }
   const std::string where = sensor_text(c) == "-" ? "box" : "sensor " + sensor_text(c);
   return fmt::format("{} on {} ({}){}: {}", effect_id(c.effect), where, axis_text(c), c.absurd ? " [IMPLAUSIBLE]" : "", ps);
