@@ -11,6 +11,7 @@
 
 #include "diagnose/report_plots.hpp"
 #include "diagnose/report_text.hpp"
+#include "diagnose/summary.hpp"
 #include "estimator/output_file.hpp"
 #include "report/html.hpp"
 
@@ -34,7 +35,8 @@ const char* verdict_class(Verdict v) {
   return "bad";
 }
 
-std::string param_cell(const FittedParam& p) {
+std::string param_cell(const FittedParam& p, Effect e) {
+  if (removes_model_effect(p)) return html_escape(removal_text(e, p));
   // a parameter the data do not pin down has no finite sigma: said so, not "± inf"
   const std::string sigma = std::isfinite(p.sigma) ? fmt::format(" ± {:.2g}", p.sigma) : std::string();
   std::string s = fmt::format("{} = {:.5g}{} {}{}", html_escape(p.name()), p.new_value(), sigma, html_escape(p.unit()),
@@ -46,7 +48,7 @@ std::string param_cell(const FittedParam& p) {
 std::string params_cell(const Candidate& c) {
   if (!c.testable) return html_escape(c.note);
   std::string s;
-  for (const auto& p : c.params) s += (s.empty() ? "" : "<br>") + param_cell(p);
+  for (const auto& p : c.params) s += (s.empty() ? "" : "<br>") + param_cell(p, c.effect);
   for (const auto& p : c.diagnostics) s += fmt::format("<br><i>{} = {:.3f}</i>", html_escape(p.name()), p.new_value());
   if (!c.codes.empty()) s += fmt::format("<br>{} missing codes", c.codes.size());
   if (!c.note.empty()) s += "<br><small>" + html_escape(c.note) + "</small>";
