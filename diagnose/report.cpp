@@ -144,7 +144,7 @@ std::string html(const CompareResult& r, const ReportExtras& x, const std::vecto
     << fmt::format("an effect is selected when its evidence exceeds <b>{:g}</b>", r.threshold)
     << (r.resampled ? "; <b>resampled</b>" : "") << "</p>\n";
   if (x.after) before_after(h, r, x);
-  h << "<h2>Missing effects (forward selection, in order)</h2>";
+  h << "<h2>Missing effects, and the model's effects the data lack (forward selection, in order)</h2>";
   if (r.selected.empty()) h << "<p>none: no physical, box, signal-chain or ADC effect is supported by the data.</p>\n";
   else candidate_table(h, r.selected, false, "evidence added");
   h << "<h2>Noise model changes (judged after the effects above)</h2>";
