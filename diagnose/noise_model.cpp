@@ -57,10 +57,21 @@ std::string aliasing_note(const twin::SensorParams& p, double fs_hz, double n_ou
       n_out * std::sqrt(fs_hz), bw, fs_hz, n_out * std::sqrt(fs_hz / (2.0 * bw)), n_out, 0.5 * fs_hz);
 }
 
+// the sensor's parameters the noise is referred to: a low-pass whose delay is at the chain's
+// "no low-pass" boundary is none (a fitted 8.5 us filter, 1.6 sigma from zero, would take its
+// bandwidth from the datasheet relation, tens of kHz, and the density read 10x low)
+twin::SensorParams noise_reference(twin::SensorParams p) {
+  if (p.lowpass_latency.enabled && p.lowpass_latency.delay_s > 0.0 && p.lowpass_latency.delay_s <= kNoLowpassDelayS)
+    p.lowpass_latency.enabled = false;
+  return p;
+}
+
 // white noise: the fitted density (long-tau, DLPF's block variance taken out) against the model's
+// with the selected effects (compare.cpp): a selected "no low-pass" refers it to fs/2 (F13: read
+// against the model's DLPF, a 20 Hz log without one showed 0.49x its density, 50 Hz 0.77x)
 PerChannel white_noise(const Residual& res, const ChannelData& C, int c, const CompareModel& m,
                        const std::vector<double>& z, double log_m) {
-  const twin::SensorParams& p = m.sensor[C.s];
+  const twin::SensorParams p = noise_reference(m.sensor[C.s]);
   const double ratio = block_mean_variance_ratio(deterministic_part(p), res.fs_hz, res.block_len);
   ChannelNoise fit = C.noise, mod = C.noise;
   fit.white_dps_rthz = fit_white_density(C, res.block_series, z);
