@@ -50,11 +50,10 @@ std::string aliasing_note(const twin::SensorParams& p, double fs_hz, double n_ou
   const double bw = twin::lowpass_setting(p.lowpass_latency).gyro_bandwidth_hz;
   if (!(2.0 * bw > fs_hz)) return {};
   return fmt::format(
-      "per-sample sigma {:.4g} deg/s. Assumed, as the model's chain: its {:.3g} Hz low-pass is sampled at {:.4g} Hz "
-      "without averaging (an MPU6050's sample-rate divider), sigma = N sqrt(2B): N = {:.4g} deg/s/rtHz. If the "
-      "sensor's filter follows the output rate (sigma = N sqrt(fs), most IMUs), N = {:.4g} deg/s/rtHz and the change "
-      "is the model's low-pass instead (a bandwidth at or below {:.3g} Hz)",
-      n_out * std::sqrt(fs_hz), bw, fs_hz, n_out * std::sqrt(fs_hz / (2.0 * bw)), n_out, 0.5 * fs_hz);
+      "per-sample sigma {:.3g} deg/s; N = {:.3g} assumes the model's {:.3g} Hz low-pass sampled at {:.3g} Hz without "
+      "averaging (an MPU6050: sigma = N sqrt(2B)); if the sensor's filter follows the output rate (sigma = N sqrt(fs), "
+      "most IMUs) N = {:.3g}, and the change is the model's low-pass instead (a bandwidth of {:.3g} Hz or less)",
+      n_out * std::sqrt(fs_hz), n_out * std::sqrt(fs_hz / (2.0 * bw)), bw, fs_hz, n_out, 0.5 * fs_hz);
 }
 
 // the sensor's parameters the noise is referred to: a low-pass whose delay is at the chain's
