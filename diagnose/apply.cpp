@@ -70,7 +70,14 @@ void write_param(CompareModel& m, const ParamRef& p, double v) {
     }
     case Param::kSampleDelayS: sensor_of(m, p).sample_delay.enabled = v > 0.0, sensor_of(m, p).sample_delay.delay_s = v; return;
     case Param::kTimeOffsetS: m.time_offset_s = v; return;
-    case Param::kQuantLsbPerDps: sensor_of(m, p).quantization.enabled = true, sensor_of(m, p).quantization.sensitivity_lsb_per_dps = v; return;
+    case Param::kQuantLsbPerDps: {
+      // 0: the outputs lie on no lattice, the model's quantisation is removed (writing 0 LSB per
+      // deg/s was refused by the model's own check: --apply failed on every log without an ADC)
+      auto& q = sensor_of(m, p).quantization;
+      q.enabled = v > 0.0;
+      if (v > 0.0) q.sensitivity_lsb_per_dps = v;
+      return;
+    }
     case Param::kFullScaleDps: sensor_of(m, p).saturation.enabled = true, sensor_of(m, p).saturation.full_scale_dps = v; return;
     case Param::kConstantBiasDps: {
       auto& e = sensor_of(m, p).constant_bias;
@@ -108,6 +115,7 @@ void average_nonlinearity(std::vector<FittedParam>& params) {
 std::string written_line(const Candidate& c, const FittedParam& fp) {
   if (fp.ref.param == Param::kLowpassDelayS && fp.new_value() <= kNoLowpassDelayS)
     return fmt::format("{}: {}: no low-pass (enabled: false)", effect_id(c.effect), fp.name());
+  if (removes_model_effect(fp)) return fmt::format("{}: {}: removed (enabled: false)", effect_id(c.effect), fp.name());
   return fmt::format("{}: {} = {:.6g} {}", effect_id(c.effect), fp.name(), fp.new_value(), fp.unit());
 }
 

@@ -30,6 +30,8 @@ std::string effect_text(const Candidate& c) {
       ps += (i ? ", " : "") + (removes_model_effect(c.params[i]) ? removal_text(c.effect, c.params[i]) : value_text(c.params[i]));
     if (c.params.size() > 4) ps += fmt::format(", ... ({} more)", c.params.size() - 4);
   }
+  // the white density's bandwidth assumption, where the data cannot tell it (docs/compare.md 3)
+  if (c.effect == Effect::kWhiteNoise && !c.note.empty()) ps += " (" + c.note + ")";
   const std::string where = sensor_text(c) == "-" ? "box" : "sensor " + sensor_text(c);
   return fmt::format("{} on {} ({}){}: {}", effect_id(c.effect), where, axis_text(c), c.absurd ? " [IMPLAUSIBLE]" : "", ps);
 }
