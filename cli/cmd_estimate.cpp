@@ -112,7 +112,9 @@ int report_health(const EstimateArgs& a, const est::EstimatorConfig& cfg, const 
   const bool bad = h.verdict != est::HealthVerdict::kOk;
   for (const auto& l : lines) fmt::print(bad ? stderr : stdout, "{}{}\n", bad ? "driftless estimate: " : "  ", l);
   if (h.verdict == est::HealthVerdict::kFailed) {
-    fmt::print(stderr, "driftless estimate: the filter never locked: the estimates are not usable (exit 1)\n");
+    // the first finding is the cause (never locked, clipping, a schedule paper mode does not fit, ...)
+    fmt::print(stderr, "driftless estimate: health failed{}: the estimates are not usable (exit 1)\n",
+               h.locked ? "" : ", the filter never locked");
     return kExitFailed;
   }
   if (h.verdict == est::HealthVerdict::kDegraded && a.strict) {

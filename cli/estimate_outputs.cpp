@@ -191,8 +191,10 @@ void write_estimate_summary(const fs::path& path, const SummaryContext& ctx, con
   add("  \"rows\": {},\n  \"rows_missing_gyro\": {},\n", s.rows, s.rows_missing_gyro);
   add("  \"log_complete\": {},\n", s.log_complete ? "true" : "false");
   add("  \"t_first_s\": {}, \"t_last_s\": {},\n", json_number(s.t_first_s), json_number(s.t_last_s));
-  add("  \"updates\": {}, \"rejected\": {}, \"standstills_too_short\": {}, \"schedule_mismatches\": {},\n",
-      s.counters.updates, s.counters.rejected, s.counters.standstills_too_short, s.counters.schedule_mismatches);
+  add("  \"updates\": {}, \"rejected\": {}, \"standstills_too_short\": {}, \"schedule_mismatches\": {}, "
+      "\"rest_angle_mismatches\": {},\n",
+      s.counters.updates, s.counters.rejected, s.counters.standstills_too_short, s.counters.schedule_mismatches,
+      s.counters.rest_angle_mismatches);
   add("  \"final_bias_dps\": {},\n", json_vec(s.bias_dps));
   add("  \"final_sigma_dps\": {},\n", json_vec(s.sigma_dps));
   add("  \"temperature_states\": {{\"enabled\": {}, \"reference_degc\": [{}, {}], \"coef_dps_per_degc\": {}, "
