@@ -221,8 +221,9 @@ void write_estimate_summary(const fs::path& path, const SummaryContext& ctx, con
   add("  \"box_dwells\": {{\"updates\": {}, \"rejected\": {}}},\n", s.counters.box_dwell_updates,
       s.counters.box_dwell_rejected);
   const std::uint64_t flips_ok = s.counters.flip_updates - s.counters.flip_rejected;
-  add("  \"flips\": {{\"updates\": {}, \"rejected\": {}, \"nis_mean\": {}}},\n", s.counters.flip_updates,
-      s.counters.flip_rejected, json_number(flips_ok > 0 ? s.counters.flip_nis_sum / double(flips_ok) : kNaN));
+  add("  \"flips\": {{\"updates\": {}, \"rejected\": {}, \"nis_mean\": {}, \"skipped_clipped\": {}}},\n",
+      s.counters.flip_updates, s.counters.flip_rejected,
+      json_number(flips_ok > 0 ? s.counters.flip_nis_sum / double(flips_ok) : kNaN), s.counters.flip_clipped);
   add("  \"locked_from_t_s\": {}, \"rows_locked\": {},\n", json_number(s.locked_from_t_s), s.samples_locked);
   add("  \"attitude_start_s\": {},\n", json_number(s.attitude_start_s));
   add("  \"attitude_drift_deg_per_h\": {{\"with_driftless\": {}, \"bias_fixed_at_start\": {}, "

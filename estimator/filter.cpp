@@ -867,6 +867,11 @@ void DriftlessFilter::use_flip() {
   // the profile and the E regressor use the corrected rates: only once the correction is known
   // (as for the box dwells); before, a flip would pass the bias error into E
   if (!(correction_sigma_dps().maxCoeff() < 0.1 * cfg_.box_dwell_rate_dps)) return;
+  // a gyro that clipped in the flip integrates a turn short of it: that is no measurement of E
+  if (flip_clipped(flips_)) {
+    ++counters_.flip_clipped;
+    return;
+  }
   const int m = flips_.moving(), r = 3 - m;
   FlipModel fm;
   fm.M_moving_start = body_from_sensor(m, flips_.start_deg());

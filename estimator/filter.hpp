@@ -133,6 +133,7 @@ struct FilterCounters {
   std::uint64_t flip_updates = 0;
   std::uint64_t flip_rejected = 0;
   double flip_nis_sum = 0.0;  // sum of the accepted flip updates' NIS (3 dof each)
+  std::uint64_t flip_clipped = 0;  // flips skipped because a gyro clipped in them (flip_clipped())
 };
 
 /// What an accepted update changed (for an offline smoother: estimator/smoother.hpp). The pointers
