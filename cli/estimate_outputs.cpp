@@ -186,6 +186,8 @@ void write_estimate_summary(const fs::path& path, const SummaryContext& ctx, con
   };
   add("  \"complete\": {},\n", ctx.complete ? "true" : "false");
   add("  \"stopped_at_t_s\": {},\n", ctx.complete ? "null" : json_number(ctx.stopped_at_t_s));
+  // corrected.csv from the smoother (--smooth) to the end: true; asked for but stopped: false
+  add("  \"smoothed\": {},\n", ctx.smooth_requested ? (ctx.smoothed ? "true" : "false") : "null");
   add("  \"log\": {},\n", json_string(ctx.log_path));
   add("  \"mode\": \"{}\",\n", ctx.mode == est::FilterMode::kPaper ? "paper" : "general");
   add("  \"rows\": {},\n  \"rows_missing_gyro\": {},\n", s.rows, s.rows_missing_gyro);
