@@ -110,6 +110,11 @@ struct FlipRows {
   double span_s = 0.0;  // s, the window's length T
 };
 
+/// Whether a gyro clipped inside the flip window: a channel whose largest |reading| in it comes in
+/// runs of identical values (the test of estimator/clip_detector.hpp, applied to the window). Its
+/// integrated turn then falls short of the flip, so the flip is no measurement of E.
+bool flip_clipped(const FlipWindow& w);
+
 /// Builds the flip measurement; invalid when the window is not a clean flip (accel missing with
 /// `use_g`, the gyro-integrated turn more than 20 % off the angle change or of the other sign).
 FlipRows flip_rows(const FlipWindow& w, const FlipModel& m);

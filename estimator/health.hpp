@@ -38,6 +38,8 @@ enum class HealthCause {
   kLateLock,             // locked, but too few accepted updates after the lock to check the NIS
   kSignalChainLag,       // the residual follows the box's angular acceleration: one sensor reads late
   kSaturation,           // a gyro channel repeats its largest reading in runs: it clips there
+  kPaperRestAngles,      // paper mode: the platforms rest away from +-flip_angle_deg (eq. (5)'s H)
+  kPaperSchedule,        // paper mode: the positions did not follow eq. (5)'s sequence
 };
 
 /// One check that did not pass, with the numbers that describe() turns into text.
@@ -56,6 +58,9 @@ struct HealthFinding {
   std::vector<int> components;  // kUnobservable: 0..5 = b1_x .. b2_z; kSaturation: the channel
                                 // (0..5 = gyro1_x .. gyro2_z), value: the fraction of the rows
                                 // clipped, suggested: the level in deg/s
+  // kPaperRestAngles: value = the standstills off, suggested = a rest angle read (deg), sigma =
+  // flip_angle_deg; kPaperSchedule: value = the standstills off; both: count = paper standstills
+  std::uint64_t count = 0;
 };
 
 /// Limits of the verdict (docs/estimator.md section 6.1).
@@ -106,6 +111,12 @@ inline constexpr double kSaturationFailedFraction = 0.01;
 /// Puts a `saturation` finding for each suspected clipped channel ahead of the other findings (it
 /// is their cause) and sets the verdict; `rows` is the log's row count.
 void add_saturation_findings(HealthReport& h, const std::vector<ClippedChannel>& clipped, std::uint64_t rows);
+
+/// Paper mode builds H from eq. (5)'s positions, +-flip_angle_deg in its fixed order: standstills
+/// that rested elsewhere or out of that order are findings ahead of the others (their cause),
+/// `failed` when at least half of the standstills are off (most updates used an H that is not the
+/// box's), else `degraded`. `counters` are the filter's at the end of the pass.
+void add_paper_mode_findings(HealthReport& h, const FilterCounters& counters, double flip_angle_deg);
 
 /// Watches the updates of one pass and gives the verdict at the end.
 class HealthMonitor {
