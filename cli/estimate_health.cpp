@@ -30,6 +30,7 @@ const char* cause_key(est::HealthCause c) {
     case est::HealthCause::kLateLock: return "late_lock";
     case est::HealthCause::kSignalChainLag: return "signal_chain_lag";
     case est::HealthCause::kSaturation: return "saturation";
+    case est::HealthCause::kAttitudeWithheld: return "attitude_withheld";
   }
   return "?";
 }
@@ -140,6 +141,12 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
                                "and the biases from this log cannot be trusted"
                              : ", also in a few standstills, which measure the rail there");
     }
+    case est::HealthCause::kAttitudeWithheld:
+      return fmt::format("attitude withheld from t = {:.2f} s: {:g} flip(s) moved both platforms at once, and with "
+                         "'standstill: gyro' no sensor then reads the box rate alone (the biases are not affected); "
+                         "flip one platform at a time, or log the platform angles (plat1_deg, plat2_deg) and use "
+                         "'standstill: platform'",
+                         f.value, f.suggested);
   }
   return "?";
 }

@@ -105,6 +105,8 @@ struct SampleOutput {
   // the residual of eq. (2) is valid for this sample (fault detection watches it)
   double plat1_deg = kNaN, plat2_deg = kNaN;
   bool at_rest = false;
+  // standstill: gyro: both platforms move, no sensor reads the box rate alone (rate_body NaN)
+  bool both_moving = false;
   PushStatus status = PushStatus::kInvalid;
 };
 
@@ -116,6 +118,7 @@ struct FilterCounters {
   std::uint64_t updates = 0;
   std::uint64_t rejected = 0;
   std::uint64_t standstills_too_short = 0;
+  std::uint64_t simultaneous_flips = 0;  // standstill: gyro: flips of both platforms at once
   std::uint64_t schedule_mismatches = 0;  // paper mode: measured positions differ from eq. (5)
   std::uint64_t source_switches = 0;
   std::uint64_t relocks = 0;  // gate re-locks after gate_relock_after consecutive rejections

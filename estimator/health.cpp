@@ -42,6 +42,15 @@ void add_saturation_findings(HealthReport& h, const std::vector<ClippedChannel>&
   h.verdict = first.verdict;
 }
 
+void add_attitude_withheld_finding(HealthReport& h, double t_s, std::uint64_t flips) {
+  if (!std::isfinite(t_s)) return;
+  HealthFinding f;
+  f.cause = HealthCause::kAttitudeWithheld;
+  f.value = t_s;
+  f.suggested = double(flips);
+  add(h, std::move(f));
+}
+
 const char* to_string(HealthVerdict v) {
   switch (v) {
     case HealthVerdict::kOk: return "ok";

@@ -38,6 +38,8 @@ enum class HealthCause {
   kLateLock,             // locked, but too few accepted updates after the lock to check the NIS
   kSignalChainLag,       // the residual follows the box's angular acceleration: one sensor reads late
   kSaturation,           // a gyro channel repeats its largest reading in runs: it clips there
+  kAttitudeWithheld,     // standstill: gyro: both platforms flipped at once, no sensor read the box
+                         // rate (value: from when, s; suggested: how many such flips)
 };
 
 /// One check that did not pass, with the numbers that describe() turns into text.
@@ -106,6 +108,10 @@ inline constexpr double kSaturationFailedFraction = 0.01;
 /// Puts a `saturation` finding for each suspected clipped channel ahead of the other findings (it
 /// is their cause) and sets the verdict; `rows` is the log's row count.
 void add_saturation_findings(HealthReport& h, const std::vector<ClippedChannel>& clipped, std::uint64_t rows);
+
+/// 'standstill: gyro' and `flips` flips of both platforms at once, the first inside the attitude
+/// comparison at `t_s`: the attitude from there on is withheld (degraded; the biases stand).
+void add_attitude_withheld_finding(HealthReport& h, double t_s, std::uint64_t flips);
 
 /// Watches the updates of one pass and gives the verdict at the end.
 class HealthMonitor {
