@@ -57,6 +57,16 @@ void print_findings(const log::LogReader& reader) {
   if (reader.rows_with_missing_gyro() > 0) {
     fmt::print("  warning: {} rows have a missing or NaN gyro value\n", reader.rows_with_missing_gyro());
   }
+  for (const est::DeadChannel& d : reader.dead_channels()) {
+    if (d.kind == est::DeadChannel::Kind::kEmpty) {
+      fmt::print("  warning: {} is empty in all {} rows: a dead axis, or a column the logger did not fill\n",
+                 log::gyro_column_name(d.channel), d.rows);
+    } else {
+      fmt::print("  warning: {} reads {:.9g} deg/s in all {} rows while its sensor's other axes move: a dead or "
+                 "stuck axis\n",
+                 log::gyro_column_name(d.channel), d.value_dps, d.rows);
+    }
+  }
   if (reader.dropped_truncated_row()) fmt::print("  warning: last row was cut off and dropped\n");
   const auto& meta = reader.metadata();
   if (!meta.complete()) {

@@ -31,6 +31,7 @@ const char* cause_key(est::HealthCause c) {
     case est::HealthCause::kSignalChainLag: return "signal_chain_lag";
     case est::HealthCause::kSaturation: return "saturation";
     case est::HealthCause::kAttitudeWithheld: return "attitude_withheld";
+    case est::HealthCause::kDeadAxis: return "dead_axis";
   }
   return "?";
 }
@@ -55,6 +56,11 @@ std::string component_names(const std::vector<int>& components) {
 std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cfg) {
   switch (f.cause) {
     case est::HealthCause::kNoUpdate:
+      if (f.suggested > 0.5) {
+        return fmt::format("no standstill became an update: {:.1f} % of the rows lack a gyro value and were "
+                           "skipped (a dead axis or an empty column: see the findings above, or 'driftless check')",
+                           100.0 * f.suggested);
+      }
       return "no standstill became an update: the platforms never rested for min_standstill_s "
              "(or the angle columns are empty); check plat1_deg/plat2_deg or set standstill: gyro";
     case est::HealthCause::kAllRejected:
@@ -140,6 +146,19 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
                              ? ", also while the platforms rest: those standstills measure the rail, not the rate, "
                                "and the biases from this log cannot be trusted"
                              : ", also in a few standstills, which measure the rail there");
+    }
+    case est::HealthCause::kDeadAxis: {
+      const int c = f.components.empty() ? 0 : f.components.front();
+      const std::string name(log::gyro_column_name(c));
+      if (std::isnan(f.value)) {
+        return fmt::format("{} is empty (no value) in all {:g} rows: a dead axis, or a column the logger did not "
+                           "fill; every row was skipped. Check the sensor and the column names in the header",
+                           name, f.suggested);
+      }
+      return fmt::format("{} reads {:.9g} deg/s in every one of the {:g} rows while the other axes of its sensor "
+                         "move: a dead or stuck axis, whose standstills measure that value, not the rate; the "
+                         "biases from this log cannot be trusted. Check the sensor",
+                         name, f.value, f.suggested);
     }
     case est::HealthCause::kAttitudeWithheld:
       return fmt::format("attitude withheld from t = {:.2f} s: {:g} flip(s) moved both platforms at once, and with "

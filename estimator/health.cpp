@@ -42,6 +42,23 @@ void add_saturation_findings(HealthReport& h, const std::vector<ClippedChannel>&
   h.verdict = first.verdict;
 }
 
+void add_dead_axis_findings(HealthReport& h, const std::vector<DeadChannel>& dead) {
+  if (dead.empty()) return;
+  HealthReport first;
+  for (const DeadChannel& d : dead) {
+    HealthFinding f;
+    f.cause = HealthCause::kDeadAxis;
+    f.severity = HealthVerdict::kFailed;
+    f.value = d.kind == DeadChannel::Kind::kStuck ? d.value_dps : kNaN;
+    f.suggested = double(d.rows);
+    f.components = {d.channel};
+    add(first, std::move(f));
+  }
+  for (HealthFinding& f : h.findings) first.findings.push_back(std::move(f));
+  h.findings = std::move(first.findings);
+  h.verdict = HealthVerdict::kFailed;
+}
+
 void add_attitude_withheld_finding(HealthReport& h, double t_s, std::uint64_t flips) {
   if (!std::isfinite(t_s)) return;
   HealthFinding f;
@@ -153,6 +170,11 @@ void HealthMonitor::add_lock_findings(HealthReport& h, const DriftlessFilter& fi
               : h.rejected == h.updates ? HealthCause::kAllRejected : HealthCause::kNeverLocked;
     f.value = filter.correction_sigma_dps().maxCoeff();  // what locking waits for
     f.suggested = h.rejected_fraction;  // rejections may be why the flips did not observe them
+    if (f.cause == HealthCause::kNoUpdate) {
+      // rows skipped for a missing gyro value come before "the platforms never rested"
+      const FilterCounters& c = filter.counters();
+      f.suggested = c.samples > 0 ? double(c.invalid) / double(c.samples) : 0.0;
+    }
     f.components = h.unobservable;
     add(h, f);
     return;

@@ -38,6 +38,8 @@ enum class HealthCause {
   kLateLock,             // locked, but too few accepted updates after the lock to check the NIS
   kSignalChainLag,       // the residual follows the box's angular acceleration: one sensor reads late
   kSaturation,           // a gyro channel repeats its largest reading in runs: it clips there
+  kDeadAxis,             // a gyro channel empty in every row, or one value throughout (components:
+                         // the channel; value: its value if stuck, NaN if empty; suggested: rows)
   kAttitudeWithheld,     // standstill: gyro: both platforms flipped at once, no sensor read the box
                          // rate (value: from when, s; suggested: how many such flips)
 };
@@ -47,7 +49,8 @@ struct HealthFinding {
   HealthCause cause = HealthCause::kNoUpdate;
   HealthVerdict severity = HealthVerdict::kDegraded;  // kOk = a note that leaves the verdict
   double value = kNaN;        // the measured quantity (fraction, NIS mean, ...; kLoneRejection: its NIS)
-  double suggested = kNaN;    // kNoiseUnder/Overstated: nis_mean / dof, the factor by which the
+  double suggested = kNaN;    // kNoUpdate: the fraction of rows without a gyro value (skipped);
+                              // kNoiseUnder/Overstated: nis_mean / dof, the factor by which the
                               // innovation variance exceeds (or falls short of) what S predicts;
                               // kNeverLocked: the rejected fraction; kLoneRejection: its time, s;
                               // kLateLock: the accepted updates after the lock (value: lock time, s);
@@ -108,6 +111,10 @@ inline constexpr double kSaturationFailedFraction = 0.01;
 /// Puts a `saturation` finding for each suspected clipped channel ahead of the other findings (it
 /// is their cause) and sets the verdict; `rows` is the log's row count.
 void add_saturation_findings(HealthReport& h, const std::vector<ClippedChannel>& clipped, std::uint64_t rows);
+
+/// Puts a failed `dead_axis` finding for each dead gyro channel ahead of the other findings (a
+/// dead channel makes every row invalid, or every standstill wrong on that axis: it is their cause).
+void add_dead_axis_findings(HealthReport& h, const std::vector<DeadChannel>& dead);
 
 /// 'standstill: gyro' and `flips` flips of both platforms at once, the first inside the attitude
 /// comparison at `t_s`: the attitude from there on is withheld (degraded; the biases stand).

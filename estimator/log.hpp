@@ -202,6 +202,8 @@ class LogReader {
   /// Channels that repeat their largest |reading| in runs: suspected clipping, stated full scale
   /// or not (estimator/clip_detector.hpp).
   std::vector<est::ClippedChannel> suspected_clipping() const { return clip_.suspected(); }
+  /// Gyro channels empty in every row, or stuck at one value (estimator/clip_detector.hpp).
+  std::vector<est::DeadChannel> dead_channels() const { return clip_.dead(sensors() == 1 ? 3 : 6); }
   /// "file:line" for messages.
   std::string where() const;
   const std::filesystem::path& path() const { return path_; }

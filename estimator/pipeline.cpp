@@ -324,7 +324,10 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
   score.finish();
   if (use_window) window.finish(filter);
   sum.health = health.finish(filter, sum.rows > 0 ? sum.t_last_s - sum.t_first_s : 0.0, lag.finish());
-  if (reader != nullptr) add_saturation_findings(sum.health, reader->suspected_clipping(), reader->rows_read());
+  if (reader != nullptr) {
+    add_saturation_findings(sum.health, reader->suspected_clipping(), reader->rows_read());
+    add_dead_axis_findings(sum.health, reader->dead_channels());
+  }
   add_attitude_withheld_finding(sum.health, sum.attitude_withheld_from_s, sum.counters.simultaneous_flips);
   return sum;
 }
