@@ -863,6 +863,10 @@ void DriftlessFilter::use_flip() {
   fm.moving = errors_of(m);
   fm.rest = errors_of(r);
   fm.use_g = has_gsens_states();
+  if (fm.use_g) {
+    fm.g_var_dps2_per_g2 = P_.diagonal().segment<18>(kGSens1.start).maxCoeff() +
+                           x_.segment<18>(kGSens1.start).cwiseAbs2().maxCoeff();
+  }
   const double n = double(flips_.samples().size());
   const double rate_hz = n / (flips_.t_end_s() - flips_.t_start_s());
   fm.sample_var_dps2 = cfg_.sample_variance_dps2(std::isfinite(box_.sample_rate_hz) ? box_.sample_rate_hz : rate_hz);
@@ -874,7 +878,7 @@ void DriftlessFilter::use_flip() {
   Eigen::Matrix<double, 3, kFullStateDim> H = Eigen::Matrix<double, 3, kFullStateDim>::Zero();
   H.block<3, 3>(0, at(kBias1, m, 3)) = fr.H_b_moving;
   H.block<3, 3>(0, at(kBias1, r, 3)) = fr.H_b_rest;
-  if (has_gsens_states()) {
+  if (has_gsens_states() && fr.g_columns) {
     H.block<3, 9>(0, at(kGSens1, m, 9)) = fr.H_G_moving;
     H.block<3, 9>(0, at(kGSens1, r, 9)) = fr.H_G_rest;
   }

@@ -299,6 +299,12 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
 
   if (reader != nullptr) add_reader_warnings(*reader, sum);
   if (sum.rows == 0) sum.warnings.push_back("the log holds no rows");
+  if (filter.has_gsens_states() && (fields & kFieldAccel) == 0 && sum.rows > 0) {
+    sum.warnings.push_back(
+        "no accel columns: the g-sensitivity states (--selfcal) cannot be observed and keep their prior sigma; "
+        "the flip updates were made without them (their prior variance in R) and the box dwells, which need "
+        "the accelerometers, not at all. Log accel1_*/accel2_* to estimate G");
+  }
   sum.counters = filter.counters();
   add_filter_warnings(filter, sum);
   sum.bias_dps = filter.bias_dps();
