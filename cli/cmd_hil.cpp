@@ -1,6 +1,7 @@
 // driftless hil: run the estimator live on a source of samples (the twin, a replayed log, two
 // MPU-6050s on I2C, the box's microcontroller on a serial link, or their emulators), record a
 // measurement log, and optionally switch sources mid-run without restarting the estimator.
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -146,6 +147,20 @@ void warn_if_never_locked(const est::DriftlessFilter& filter) {
                            : "");
 }
 
+// The log states one sample_rate_hz and the estimator's noise per sample (R) is set from it, so a
+// switch to a source of another rate would write rows that the log's own metadata misdescribes and
+// feed the filter with a wrong R. Refused before anything runs.
+void refuse_switch_between_rates(const hil::SampleSource& a, const hil::SampleSource& b) {
+  const double fa = a.sample_rate_hz();
+  const double fb = b.sample_rate_hz();
+  if (std::abs(fa - fb) <= 1e-9 * std::max(fa, fb)) return;
+  throw std::invalid_argument(fmt::format(
+      "hil: --switch-to {} samples at {:g} Hz but --source {} at {:g} Hz: one log states one sample_rate_hz and "
+      "the estimator's noise per sample follows it; switch between sources of one rate (--rate sets the emulated "
+      "and twin sources' rate; a replayed log keeps its own)",
+      b.name(), fb, a.name(), fa));
+}
+
 int run_hil(const HilOptions& o) {
   std::filesystem::create_directories(o.out_dir);
 
@@ -166,6 +181,7 @@ int run_hil(const HilOptions& o) {
     const hil::Status s = rig->source->configure();
     if (!s.ok()) throw std::runtime_error(s.message);
   }
+  if (second) refuse_switch_between_rates(*first->source, *second->source);
 
   log::Metadata meta;
   log::LogInfo info;

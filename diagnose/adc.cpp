@@ -12,6 +12,9 @@ namespace driftless::diagnose {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+// the coarsest plausible gyro ADC: 1 LSB per deg/s (a 16-bit ADC over +-32768 deg/s, a 12-bit
+// one over +-2048 deg/s); a coarser step fitted is a misread lattice
+constexpr double kMinPlausibleLsbPerDps = 1.0;
 
 ParamRef ref_of(Param p, int channel) {
   return ParamRef{p, static_cast<std::int8_t>(channel / 3), static_cast<std::int8_t>(channel % 3)};
@@ -41,12 +44,30 @@ double lattice(const std::vector<double>& y, double step, double cut) {
   return std::hypot(cr, si) / n;
 }
 
-// the coarsest LSB the outputs lie on: the model's, the common MPU6050 ranges, the data's step
+// the 5-95 % spread of the outputs, deg/s: a lattice is only seen where the outputs cover
+// several of its steps (a cluster narrower than the step has one phase for any step, |mean| ~ 1)
+double spread_5_95(std::vector<double> u) {
+  if (u.size() < 20) return 0.0;
+  const auto at = [&](double q) {
+    auto it = u.begin() + static_cast<std::ptrdiff_t>(q * static_cast<double>(u.size() - 1));
+    std::nth_element(u.begin(), it, u.end());
+    return *it;
+  };
+  const double lo = at(0.05), hi = at(0.95);
+  return hi - lo;
+}
+
+// the coarsest LSB the outputs lie on: the model's, the common MPU6050 ranges, the data's step.
+// `y` are the outputs at rest (the fits' samples): during a flip the few values spread over
+// +-360 deg/s, their median spacing is hundreds of LSB, and a step that the resting outputs (a
+// narrow cluster) do not span was taken for the LSB (0.655 LSB/(deg/s) on the hinge axes, P14).
+// A step is tried only where the outputs span at least two of it
 double data_lsb(const std::vector<double>& y, const twin::SensorParams& p, double* strength) {
   std::vector<double> steps;
   if (p.quantization.enabled) steps.push_back(1.0 / p.quantization.sensitivity_lsb_per_dps);
   for (int fs_sel = 0; fs_sel < 4; ++fs_sel) steps.push_back(1.0 / mpu6050::gyro_lsb_per_dps(fs_sel));
   std::vector<double> u(y.begin(), y.begin() + static_cast<std::ptrdiff_t>(std::min<std::size_t>(y.size(), 20000)));
+  const double spread = spread_5_95(u);
   std::sort(u.begin(), u.end());
   u.erase(std::unique(u.begin(), u.end(), [](double a, double b) { return std::abs(a - b) < 2e-7; }), u.end());
   std::vector<double> d;
@@ -61,6 +82,7 @@ double data_lsb(const std::vector<double>& y, const twin::SensorParams& p, doubl
   for (double st : steps) {
     if (!(st > 1e-6) || std::find(tried.begin(), tried.end(), st) != tried.end()) continue;  // a step twice: once
     tried.push_back(st);
+    if (spread < 2.0 * st) continue;  // the outputs do not span it: not testable
     const double R = lattice(y, st, 0.9);
     if (R > 0.9 && st > best) best = st, *strength = R;
   }
@@ -145,25 +167,30 @@ ChannelAdc channel_adc(const Replay& r, const Residual& res, const twin::SensorP
                        double log_m) {
   ChannelAdc out;
   const int s = c / 3, j = c % 3;
-  std::vector<double> y;
+  std::vector<double> y, y_rest;
   y.reserve(res.n);
-  for (std::size_t k = 0; k < res.n; ++k)
-    if (r.usable[k]) y.push_back(r.gyro_dps[s][k][j]);
-  const double ny = static_cast<double>(y.size());
+  for (std::size_t k = 0; k < res.n; ++k) {
+    if (!r.usable[k]) continue;
+    y.push_back(r.gyro_dps[s][k][j]);
+    if (res.mask[k]) y_rest.push_back(y.back());
+  }
   double R = 0.0;
-  const double lsb = data_lsb(y, p, &R);
+  const double lsb = data_lsb(y_rest, p, &R);
+  const double ny = static_cast<double>(y_rest.size());
   const double model_lsb = p.quantization.enabled ? 1.0 / p.quantization.sensitivity_lsb_per_dps : 0.0;
   double ev_q = -log_m;
   if (lsb > 0 && (model_lsb == 0.0 || std::abs(lsb - model_lsb) > 1e-3 * model_lsb)) {
     ev_q = std::min(2.0 * ny * R * R, 2.0 * ny) - 2 * log_m;
   } else if (lsb == 0.0 && model_lsb > 0.0) {
-    const double Rm = lattice(y, model_lsb, -1.0);  // the model quantises, the data lie on no lattice (the whole sum)
+    const double Rm = lattice(y_rest, model_lsb, -1.0);  // the model quantises, the data lie on no lattice (the whole sum)
     ev_q = (Rm < 0.5 ? 2.0 * ny * (1.0 - Rm) * 0.01 : 0.0) - log_m;
   }
   if (ev_q > 0) {
     out.ev_q = ev_q;
     out.q.push_back(param(Param::kQuantLsbPerDps, c, lsb > 0 ? 1.0 / lsb : 0.0, 0.0,
                           p.quantization.enabled ? p.quantization.sensitivity_lsb_per_dps : 0.0));
+    // a step above 1 deg/s: a 16-bit ADC's range would be +-32768 deg/s, no gyro's
+    out.q.back().absurd = lsb > 1.0 / kMinPlausibleLsbPerDps;
   }
   if (lsb > 0 && !p.adc_missing_codes.enabled) {
     double ev_m = 0.0;
@@ -208,6 +235,7 @@ std::vector<Candidate> adc_candidates(const Replay& r, const Residual& res, cons
     sat.params.insert(sat.params.end(), a.sat.begin(), a.sat.end());
   }
   finish(q, qev, log_m);
+  for (const auto& fp : q.params) q.absurd = q.absurd || fp.absurd;
   finish(sat, sev, log_m);
   finish(miss, mev, log_m);
   return {q, sat, miss};

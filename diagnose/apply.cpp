@@ -6,6 +6,7 @@
 #include <fmt/core.h>
 
 #include "diagnose/signal_chain.hpp"
+#include "diagnose/summary.hpp"
 
 namespace driftless::diagnose {
 namespace {
@@ -58,13 +59,25 @@ void write_param(CompareModel& m, const ParamRef& p, double v) {
     }
     case Param::kStopErrorDeg: stop_errors(m, p.sensor)[k] = v; return;
     case Param::kLatitudeDeg: m.latitude_deg = v; return;
-    case Param::kLowpassDelayS:
+    case Param::kLowpassDelayS: {
+      // a delay at the "no low-pass" boundary is written as no filter: a filter of microseconds
+      // takes its bandwidth from the datasheet relation (tens of kHz), and simulate would alias
+      // the white noise from there
+      const double d = v <= kNoLowpassDelayS ? 0.0 : v;
       for (int s = 0; s < 2; ++s)
-        if (p.sensor < 0 || p.sensor == s) m.sensor[static_cast<std::size_t>(s)] = with_lowpass_delay(m.sensor[static_cast<std::size_t>(s)], v);
+        if (p.sensor < 0 || p.sensor == s) m.sensor[static_cast<std::size_t>(s)] = with_lowpass_delay(m.sensor[static_cast<std::size_t>(s)], d);
       return;
+    }
     case Param::kSampleDelayS: sensor_of(m, p).sample_delay.enabled = v > 0.0, sensor_of(m, p).sample_delay.delay_s = v; return;
     case Param::kTimeOffsetS: m.time_offset_s = v; return;
-    case Param::kQuantLsbPerDps: sensor_of(m, p).quantization.enabled = true, sensor_of(m, p).quantization.sensitivity_lsb_per_dps = v; return;
+    case Param::kQuantLsbPerDps: {
+      // 0: the outputs lie on no lattice, the model's quantisation is removed (writing 0 LSB per
+      // deg/s was refused by the model's own check: --apply failed on every log without an ADC)
+      auto& q = sensor_of(m, p).quantization;
+      q.enabled = v > 0.0;
+      if (v > 0.0) q.sensitivity_lsb_per_dps = v;
+      return;
+    }
     case Param::kFullScaleDps: sensor_of(m, p).saturation.enabled = true, sensor_of(m, p).saturation.full_scale_dps = v; return;
     case Param::kConstantBiasDps: {
       auto& e = sensor_of(m, p).constant_bias;
@@ -100,6 +113,9 @@ void average_nonlinearity(std::vector<FittedParam>& params) {
 }
 
 std::string written_line(const Candidate& c, const FittedParam& fp) {
+  if (fp.ref.param == Param::kLowpassDelayS && fp.new_value() <= kNoLowpassDelayS)
+    return fmt::format("{}: {}: no low-pass (enabled: false)", effect_id(c.effect), fp.name());
+  if (removes_model_effect(fp)) return fmt::format("{}: {}: removed (enabled: false)", effect_id(c.effect), fp.name());
   return fmt::format("{}: {} = {:.6g} {}", effect_id(c.effect), fp.name(), fp.new_value(), fp.unit());
 }
 

@@ -85,6 +85,13 @@ void flag_offsets_beyond_zro(const CompareModel& model, int channels, CompareRes
   }
 }
 
+// the model with the selected effects written into it (as --apply writes them)
+CompareModel with_selected(const CompareModel& model, const std::vector<Candidate>& selected) {
+  CompareModel m = model;
+  for (const auto& c : selected) apply_candidate(m, c);
+  return m;
+}
+
 std::vector<int> axes_of(const Candidate& c, int s) {
   std::vector<int> axes;
   for (const auto& p : c.params) {
@@ -192,7 +199,10 @@ CompareResult compare(const Replay& r, const CompareModel& model, const CompareO
     after = AfterFit{};  // the last pass's per-sample series go before the selection runs again
     sel = select_effects(si);
     after = residual_after(ch, in, res, sel.spec, sel.fit, AfterDetail::kSamples);
-    nm = noise_model_candidates(r, res, ch, model, after, opt.evidence_threshold);
+    // the noise model is tested on the model with the selected effects: a selected low-pass
+    // changes the bandwidth the white density is referred to (its block variance), so a density
+    // read against the old filter was written beside the new one and missed after --apply
+    nm = noise_model_candidates(r, res, ch, with_selected(model, sel.selected), after, opt.evidence_threshold);
     if (pass == 2 || !adopt_drift(nm, res, ch)) break;
     out.notes.push_back("the bias drifts otherwise than the model's noise processes say: the effects were selected "
                         "again with the drift fitted to this log as the nuisance");
@@ -207,8 +217,7 @@ CompareResult compare(const Replay& r, const CompareModel& model, const CompareO
   out.noise_model = std::move(nm.supported);
   out.not_supported.insert(out.not_supported.end(), nm.not_supported.begin(), nm.not_supported.end());
   // 5: where it fails, and the verdict
-  CompareModel selected_model = model;
-  for (const auto& c : out.selected) apply_candidate(selected_model, c);
+  const CompareModel selected_model = with_selected(model, out.selected);
   summarise_channels(ch, res, model, selected_model, before, after, opt, out);
   summarise_regimes(r, res, ch, after, opt, out);
   flag_offsets_beyond_zro(model, res.channels(), out);

@@ -368,9 +368,12 @@ PlatformMotion platform_motion(Raw& raw, const ReplayOptions& opt, Replay& out) 
       pm.moving[s][k] = !std::isfinite(rate[k]) || std::abs(rate[k]) > opt.flip_rate_threshold_dps;
     }
   }
-  // flips: a platform turning or unknown; guard a few samples around it
+  // flips: a platform turning or unknown; guard a few samples around it, and at least the
+  // angular-acceleration stencil's half width: a sample whose stencil reaches into a flip takes
+  // the flip's rates into its regressors (at 10 Hz, 0.05 s is one sample and the stencil four)
   out.flipping.assign(n, 0);
-  const auto guard = static_cast<std::size_t>(std::ceil(opt.flip_guard_s * out.sample_rate_hz));
+  const auto guard = std::max(static_cast<std::size_t>(std::ceil(opt.flip_guard_s * out.sample_rate_hz)),
+                              Replay::kAngularAccelHalfWidth);
   for (std::size_t k = 0; k < n; ++k) {
     if (!(pm.moving[0][k] || pm.moving[1][k])) continue;
     const std::size_t a = k >= guard ? k - guard : 0, b = std::min(n - 1, k + guard);
@@ -505,8 +508,8 @@ std::size_t expected_rows(const log::Metadata& meta, const std::filesystem::path
 // third-order term, 17x the true one for 4.8 ms at 50 Hz, and on a wobble that projects onto the
 // tilt (a g-sensitivity of 0.05 deg/s/g that is not there)
 double Replay::dw_axis_radps2(int s, std::size_t k, int j) const {
-  static const std::vector<double> d4 = central_differentiator(4);
-  constexpr std::size_t M = 4;
+  constexpr std::size_t M = kAngularAccelHalfWidth;
+  static const std::vector<double> d4 = central_differentiator(static_cast<int>(M));
   const std::size_t n = size();
   const auto& w = w_radps[s];
   if (k >= M && k + M < n) {

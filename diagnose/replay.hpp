@@ -41,6 +41,8 @@ struct Replay {
   /// neighbour is not finite, 0 where unknown), rad/s^2, sensor axes: computed when asked (a
   /// stored copy was 17 MB an hour), one axis at a time (what a channel's column needs)
   double dw_axis_radps2(int s, std::size_t k, int j) const;
+  /// Neighbours on each side that dw_axis_radps2's stencil reads, samples.
+  static constexpr std::size_t kAngularAccelHalfWidth = 4;
 
   std::vector<double> t_s;                               // s, log time
   std::array<std::vector<Eigen::Vector3d>, 2> gyro_dps;  // measured, sensor axes, deg/s

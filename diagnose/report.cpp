@@ -11,6 +11,7 @@
 
 #include "diagnose/report_plots.hpp"
 #include "diagnose/report_text.hpp"
+#include "diagnose/summary.hpp"
 #include "estimator/output_file.hpp"
 #include "report/html.hpp"
 
@@ -34,7 +35,8 @@ const char* verdict_class(Verdict v) {
   return "bad";
 }
 
-std::string param_cell(const FittedParam& p) {
+std::string param_cell(const FittedParam& p, Effect e) {
+  if (removes_model_effect(p)) return html_escape(removal_text(e, p));
   // a parameter the data do not pin down has no finite sigma: said so, not "± inf"
   const std::string sigma = std::isfinite(p.sigma) ? fmt::format(" ± {:.2g}", p.sigma) : std::string();
   std::string s = fmt::format("{} = {:.5g}{} {}{}", html_escape(p.name()), p.new_value(), sigma, html_escape(p.unit()),
@@ -46,7 +48,7 @@ std::string param_cell(const FittedParam& p) {
 std::string params_cell(const Candidate& c) {
   if (!c.testable) return html_escape(c.note);
   std::string s;
-  for (const auto& p : c.params) s += (s.empty() ? "" : "<br>") + param_cell(p);
+  for (const auto& p : c.params) s += (s.empty() ? "" : "<br>") + param_cell(p, c.effect);
   for (const auto& p : c.diagnostics) s += fmt::format("<br><i>{} = {:.3f}</i>", html_escape(p.name()), p.new_value());
   if (!c.codes.empty()) s += fmt::format("<br>{} missing codes", c.codes.size());
   if (!c.note.empty()) s += "<br><small>" + html_escape(c.note) + "</small>";
@@ -142,7 +144,7 @@ std::string html(const CompareResult& r, const ReportExtras& x, const std::vecto
     << fmt::format("an effect is selected when its evidence exceeds <b>{:g}</b>", r.threshold)
     << (r.resampled ? "; <b>resampled</b>" : "") << "</p>\n";
   if (x.after) before_after(h, r, x);
-  h << "<h2>Missing effects (forward selection, in order)</h2>";
+  h << "<h2>Missing effects, and the model's effects the data lack (forward selection, in order)</h2>";
   if (r.selected.empty()) h << "<p>none: no physical, box, signal-chain or ADC effect is supported by the data.</p>\n";
   else candidate_table(h, r.selected, false, "evidence added");
   h << "<h2>Noise model changes (judged after the effects above)</h2>";

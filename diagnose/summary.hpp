@@ -4,12 +4,24 @@
 #pragma once
 
 #include <array>
+#include <string>
 #include <vector>
 
 #include "diagnose/channel_fit.hpp"
 #include "diagnose/compare.hpp"
 
 namespace driftless::diagnose {
+
+/// A fitted low-pass delay at or below this is "no low-pass" (the chain's boundary), s.
+inline constexpr double kNoLowpassDelayS = 1e-4;
+
+/// True when a fitted parameter switches off an effect the model has (a quantisation of 0
+/// LSB/(deg/s): the outputs lie on no lattice; a low-pass delay at "no low-pass"; a jitter or
+/// delay of 0): the model's effect is not in the data, and the fix is to remove it (P11).
+bool removes_model_effect(const FittedParam& p);
+/// "the model's quantization (s1.x.sensitivity_lsb_per_dps = 131 LSB/(deg/s)) is not in the
+/// data: remove it" for such a parameter.
+std::string removal_text(Effect e, const FittedParam& p);
 
 /// The residual of every channel after a fit (nuisance and the fit's effects taken out).
 struct AfterFit {

@@ -15,18 +15,29 @@ std::string value_text(const FittedParam& p) {
   return fmt::format("{} = {:.4g} ± {:.2g} {}", p.name(), p.new_value(), p.sigma, p.unit());
 }
 
-// "scale_factor on sensor 1 (x): s1.x.value_pct = 3.01 ± 0.02 %"
+// "scale_factor on sensor 1 (x): s1.x.value_pct = 3.01 ± 0.02 %"; an effect the model has and
+// the data lack is said as such ("the model's quantization (...) is not in the data: remove it"),
+// never as a missing effect of "0 ± 0"
 std::string effect_text(const Candidate& c) {
   std::string ps;
-  for (std::size_t i = 0; i < std::min<std::size_t>(c.params.size(), 4); ++i) ps += (i ? ", " : "") + value_text(c.params[i]);
-  if (c.params.size() > 4) ps += fmt::format(", ... ({} more)", c.params.size() - 4);
-  if (c.effect == Effect::kLowpass) {
-    // say "no filter" where the fitted delay is zero
-    for (const auto& p : c.params)
-      if (p.new_value() <= 1e-4) ps += p.ref.sensor < 0 ? std::string(": no low-pass") : fmt::format("; sensor {}: no low-pass", p.ref.sensor + 1);
+  std::size_t removed = 0;
+  for (const auto& p : c.params) removed += removes_model_effect(p);
+  if (removed > 0 && removed == c.params.size()) {
+    ps = removal_text(c.effect, c.params.front());
+    if (c.params.size() > 1) ps += fmt::format(" (and on {} more {})", c.params.size() - 1, c.params.size() == 2 ? "channel" : "channels");
+  } else {
+    for (std::size_t i = 0; i < std::min<std::size_t>(c.params.size(), 4); ++i)
+      ps += (i ? ", " : "") + (removes_model_effect(c.params[i]) ? removal_text(c.effect, c.params[i]) : value_text(c.params[i]));
+    if (c.params.size() > 4) ps += fmt::format(", ... ({} more)", c.params.size() - 4);
   }
+  // the white density's bandwidth assumption, where the data cannot tell it (docs/compare.md 3)
+  if (c.effect == Effect::kWhiteNoise && !c.note.empty()) ps += " (" + c.note + ")";
   const std::string where = sensor_text(c) == "-" ? "box" : "sensor " + sensor_text(c);
   return fmt::format("{} on {} ({}){}: {}", effect_id(c.effect), where, axis_text(c), c.absurd ? " [IMPLAUSIBLE]" : "", ps);
+}
+
+bool all_removals(const Candidate& c) {
+  return !c.params.empty() && std::all_of(c.params.begin(), c.params.end(), removes_model_effect);
 }
 
 }  // namespace
@@ -42,10 +53,21 @@ void verdict_from_fit(CompareResult& out) {
   const std::string noise_tail = noise.empty() ? "" : "; the noise model differs (a noise-model change, after the effects): " + noise;
   if (!out.selected.empty()) {
     out.verdict = Verdict::kMissingEffect;
-    std::string list;
-    for (const auto& c : out.selected) list += (list.empty() ? "" : "; ") + effect_text(c);
-    out.statement = fmt::format("{} missing effect{} (evidence > {:g}): {}{}", out.selected.size(),
-                                out.selected.size() == 1 ? "" : "s", out.threshold, list, noise_tail);
+    // the model's effects the data lack are said apart from the missing ones
+    std::string missing, extra;
+    std::size_t n_missing = 0, n_extra = 0;
+    for (const auto& c : out.selected) {
+      std::string& list = all_removals(c) ? extra : missing;
+      (all_removals(c) ? n_extra : n_missing) += 1;
+      list += (list.empty() ? "" : "; ") + effect_text(c);
+    }
+    std::string text;
+    if (n_missing > 0)
+      text = fmt::format("{} missing effect{} (evidence > {:g}): {}", n_missing, n_missing == 1 ? "" : "s", out.threshold, missing);
+    if (n_extra > 0)
+      text += fmt::format("{}{} effect{} of the model not in the data (evidence > {:g}): {}", text.empty() ? "" : "; ",
+                          n_extra, n_extra == 1 ? "" : "s", out.threshold, extra);
+    out.statement = text + noise_tail;
     if (out.any_absurd()) out.statement += "; IMPLAUSIBLE values: check the log's units, axes and frame (docs/log-format.md)";
     return;
   }
@@ -68,6 +90,28 @@ void verdict_from_fit(CompareResult& out) {
 }
 
 }  // namespace
+
+bool removes_model_effect(const FittedParam& p) {
+  if (p.model_value == 0.0) return false;
+  switch (p.ref.param) {
+    case Param::kLowpassDelayS: return p.new_value() <= kNoLowpassDelayS;
+    case Param::kQuantLsbPerDps:
+    case Param::kSampleDelayS:
+    case Param::kJitterSigmaS:
+    case Param::kFullScaleDps: return p.new_value() == 0.0;
+    default: return false;
+  }
+}
+
+std::string removal_text(Effect e, const FittedParam& p) {
+  if (p.ref.param == Param::kLowpassDelayS) {
+    const std::string who = p.ref.sensor < 0 ? std::string() : fmt::format("sensor {}: ", p.ref.sensor + 1);
+    return fmt::format("{}no low-pass: the model's {} ({} = {:.4g} {}) is not in the data: remove it", who,
+                       effect_id(e), p.name(), p.model_value, p.unit());
+  }
+  return fmt::format("the model's {} ({} = {:.4g} {}) is not in the data: remove it", effect_id(e), p.name(), p.model_value,
+                     p.unit());
+}
 
 // an offset beyond the sensor's zero-rate tolerance is said, with its cause and fix, and a
 // comparison that would otherwise call the log consistent calls it unexplained

@@ -66,11 +66,31 @@ std::unique_ptr<ImuReader> make_text_reader(const std::filesystem::path& path, c
   return std::make_unique<TextReader>(path, opt, euroc);
 }
 
+namespace {
+
+// An option that the detected format has no use for is refused, never silently ignored: a user who
+// gives --topic believes the file is a bag, and one who gives --separator believes it is text.
+void refuse_options_for_other_formats(const std::filesystem::path& path, Format f, const std::string& why,
+                                      const ImportOptions& opt) {
+  const bool text = f == Format::kText || f == Format::kEuroc;
+  const char* option = nullptr;
+  const char* applies = nullptr;
+  if (!opt.topic.empty() && f != Format::kBag) option = "--topic", applies = "ROS bags";
+  else if (!opt.separator.empty() && !text) option = "--separator", applies = "delimited text";
+  else if (opt.no_header && !text) option = "--no-header", applies = "delimited text";
+  if (option == nullptr) return;
+  throw ImportError(path.string() + ": " + option + " applies to " + applies + ", but this file is " + to_string(f) +
+                    " (" + why + "); drop " + option + " or give --format");
+}
+
+}  // namespace
+
 std::unique_ptr<ImuReader> open_imu(const std::filesystem::path& path, const ImportOptions& opt) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) throw ImportError(path.string() + ": no such file");
   std::string why = "as given (--format)";
   const Format f = opt.format == Format::kAuto ? detect_format(path, &why) : opt.format;
+  if (f != Format::kDriftlessLog) refuse_options_for_other_formats(path, f, why, opt);
   std::unique_ptr<ImuReader> r;
   switch (f) {
     case Format::kText: r = make_text_reader(path, opt, false); break;

@@ -131,6 +131,11 @@ rc=0; "$bin" hil --source "replay:$out/a/log.csv" --switch-to emu-i2c --at 60 --
 [[ $rc -eq 0 ]] || fail "--seed for the emulated second source refused: exit $rc"
 rc=0; "$bin" hil --source emu-i2c --duration -5 --out "$out/r3" 2> "$out/r3.err" || rc=$?
 [[ $rc -eq 2 ]] || fail "--duration -5: exit $rc, expected 2"
+# a switch to a source of another rate is refused before anything runs: the log states one rate
+rc=0; "$bin" hil --source "replay:$out/a/log.csv" --switch-to emu-i2c --rate 200 --at 60 --duration 70 --out "$out/r4" 2> "$out/r4.err" || rc=$?
+[[ $rc -ne 0 ]] || fail "a switch from 100 Hz to 200 Hz accepted"
+grep -q "switch-to emu-i2c samples at 200 Hz but --source replay:.* at 100 Hz" "$out/r4.err" || fail "rate switch: $(cat "$out/r4.err")"
+[ ! -e "$out/r4/log.csv" ] || fail "rate switch: a log was written"
 # a switch-over that never happens (the replay ends first) is not a success
 rc=0; "$bin" hil --source "replay:$out/a/log.csv" --switch-to emu-i2c --at 200 --duration 300 --out "$out/w" > /dev/null 2> "$out/w.err" || rc=$?
 [[ $rc -eq 1 ]] || fail "a switch after the replay's end: exit $rc, expected 1"

@@ -23,6 +23,16 @@ bool says(const ImuReader& r, const std::string& what) {
   return false;
 }
 
+// Opening `file` with `o` throws an ImportError whose text holds `expected`.
+void expect_refused(const std::filesystem::path& file, const ImportOptions& o, const std::string& expected) {
+  try {
+    open_imu(file, o);
+    ADD_FAILURE() << "accepted: " << expected;
+  } catch (const ImportError& e) {
+    EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+  }
+}
+
 int channel(const ImuReader& r, const std::string& name) {
   for (std::size_t c = 0; c < r.info().channels.size(); ++c) {
     if (r.info().channels[c].name == name) return static_cast<int>(c);
@@ -149,13 +159,8 @@ TEST(TextImport, AColumnNamedForTwoChannelsIsRefused) {
   std::string s = "t,gx,gy,gz,ax,ay,az,temp\n";
   for (int i = 0; i < 50; ++i) s += std::to_string(0.01 * i) + ",0.1,0.2,0.3,0,0,9.81,25\n";
   write_text(dir / "a.csv", s);
-  const auto refused = [&](ImportOptions o, const std::string& expected) {
-    try {
-      open_imu(dir / "a.csv", o);
-      ADD_FAILURE() << "accepted: " << expected;
-    } catch (const ImportError& e) {
-      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
-    }
+  const auto refused = [&](const ImportOptions& o, const std::string& expected) {
+    expect_refused(dir / "a.csv", o, expected);
   };
   // WHEN an option names a column another channel already reads, THEN it is refused, naming both
   ImportOptions twice;
@@ -179,6 +184,30 @@ TEST(TextImport, AColumnNamedForTwoChannelsIsRefused) {
   ok.columns = {"gz", "gy", "gx"};
   ok.accel_columns = {"ax", "ay", "az"};
   ok.temp_column = "temp";
+  EXPECT_NO_THROW(open_imu(dir / "a.csv", ok));
+}
+
+TEST(TextImport, OptionsForAnotherFormatAreRefusedNotIgnored) {
+  // GIVEN a delimited-text recording and a .npy array
+  const auto dir = scratch("otherformat");
+  std::string s = "t,gx,gy,gz\n";
+  for (int i = 0; i < 50; ++i) s += std::to_string(0.01 * i) + ",0.1,0.2,0.3\n";
+  write_text(dir / "a.csv", s);
+  const auto refused = [&](const ImportOptions& o, const std::string& expected) {
+    expect_refused(dir / "a.csv", o, expected);
+  };
+  // WHEN a bag's --topic is given for the text file, THEN it is refused, naming the detected format
+  ImportOptions topic;
+  topic.topic = "/imu0";
+  refused(topic, "a.csv: --topic applies to ROS bags, but this file is text (delimited text)");
+  // AND a text option given with another --format is refused too
+  ImportOptions sep;
+  sep.format = Format::kNpy;
+  sep.separator = ";";
+  refused(sep, "--separator applies to delimited text, but this file is npy (as given (--format))");
+  // AND the text options on the text file are taken
+  ImportOptions ok;
+  ok.separator = ",";
   EXPECT_NO_THROW(open_imu(dir / "a.csv", ok));
 }
 
