@@ -72,6 +72,12 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
                          f.suggested > 0.02 ? fmt::format("the gate rejected {:.0f} % of the updates, so the flips "
                                                           "that observe them were not used (see below)",
                                                           100.0 * f.suggested)
+                                            : !f.positions_deg.empty()
+                                                  ? fmt::format("the platforms only rested at {}: each flipped "
+                                                                "with the other, so the positions between never "
+                                                                "occurred; flip one platform at a time (eq. (5): "
+                                                                "(+,+) (+,-) (-,-) (-,+))",
+                                                                position_text(f.positions_deg))
                                             : cfg.self_calibration && !cfg.box_at_rest
                                                   ? "in self-calibrating mode a g-sensitivity that keeps its sign "
                                                     "about the box vertical looks like a bias common to both "

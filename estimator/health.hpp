@@ -56,7 +56,9 @@ struct HealthFinding {
                               // kLateLock: the accepted updates after the lock (value: lock time, s);
                               // kSignalChainLag: update_excess (value: the lag, s; sigma: its sigma)
   double sigma = kNaN;
-  // kRejectionsAtPosition: the (plat1, plat2) angle pairs (deg) where most updates were rejected
+  // kRejectionsAtPosition: the (plat1, plat2) angle pairs (deg) where most updates were rejected;
+  // kNeverLocked: the pairs that occurred, when both platforms rested on both sides but some
+  // pair of sides never came (they flipped together); empty otherwise
   std::vector<std::array<double, 2>> positions_deg;
   std::vector<int> components;  // kUnobservable: 0..5 = b1_x .. b2_z; kSaturation: the channel
                                 // (0..5 = gyro1_x .. gyro2_z), value: the fraction of the rows
@@ -137,6 +139,7 @@ class HealthMonitor {
   void add_gate_findings(HealthReport& h) const;
   void add_nis_findings(HealthReport& h) const;
   void add_lock_findings(HealthReport& h, const DriftlessFilter& filter, double duration_s) const;
+  std::vector<std::array<double, 2>> positions_if_never_apart() const;
 
   HealthLimits limits_;
   bool locked_ = false;
