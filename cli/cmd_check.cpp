@@ -46,8 +46,10 @@ void print_findings(const log::LogReader& reader) {
     }
   }
   if (reader.rows_saturated() > 0) {
-    fmt::print("  warning: {} rows have a gyro value at the full scale of {} deg/s (saturated)\n",
-               reader.rows_saturated(), reader.metadata().gyro_full_scale_dps());
+    const auto& m = reader.metadata();
+    fmt::print("  warning: {} rows have a gyro value at the stated full scale of {} / {} deg/s (sensor 1 / 2; "
+               "saturated)\n",
+               reader.rows_saturated(), m.gyro_full_scale_dps(1), m.gyro_full_scale_dps(2));
   }
   for (const est::ClippedChannel& c : reader.suspected_clipping()) {
     fmt::print("  warning: {} repeats its largest value, +-{:g} deg/s, in runs ({} samples): it clips there "
