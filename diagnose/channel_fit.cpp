@@ -166,7 +166,19 @@ double fit_white_density(const ChannelData& c, const BlockSeries& blocks, std::s
     nz.white_dps_rthz = std::exp(logN);
     return BiasWhitener::neg2_loglik(blocks, nz, z);
   };
-  return std::exp(brent_min(f, std::log(n0) - 2.0, std::log(n0) + 2.0, std::log(n0), 1e-6));
+  // the maximum likelihood over N, not over a bracket: the robust guess is from the block
+  // differences' median, which structure the selection has not yet taken out leaves far below
+  // the likelihood's N (a wobble's channel fitted at the bracket's edge ran its selection with a
+  // variance unit of 4 664); an optimum on an edge moves the bracket on, 4 in ln N at a time
+  double lo = std::log(n0) - 2.0, hi = std::log(n0) + 2.0, x = brent_min(f, lo, hi, std::log(n0), 1e-6);
+  for (int shift = 0; shift < 6; ++shift) {
+    const double edge_tol = 1e-4;
+    if (x > hi - edge_tol) lo = hi - 0.5, hi += 4.0;
+    else if (x < lo + edge_tol) hi = lo + 0.5, lo -= 4.0;
+    else break;
+    x = brent_min(f, lo, hi, x, 1e-6);
+  }
+  return std::exp(x);
 }
 
 // whitened Gram of [cols..., z] and the null (nuisance-only) fit's variance and objective

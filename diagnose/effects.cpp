@@ -233,9 +233,41 @@ void ColumnSweep::move_to(std::size_t k) {
   k_ = k;
 }
 
+bool column_before_chain(int col) {
+  return !(col == kDelay || col == kDelay2 || col == kDelay3 || col == kNonlin2 || col == kNonlin3 || col >= kFlip0);
+}
+
+ColumnSweep::ColumnSweep(const ColumnInputs& in, int s, int j) : in_(in), s_(s), j_(j) {
+  const double lag = std::max(0.0, in.chain_delay_s[static_cast<std::size_t>(s)]) * in.res.fs_hz;  // samples
+  lag_whole_ = static_cast<std::size_t>(std::floor(lag));
+  lag_frac_ = lag - static_cast<double>(lag_whole_);
+  for (auto& a : at_) a = {static_cast<std::size_t>(-1), static_cast<std::size_t>(-1)};
+}
+
+// a column before the chain at sample k: its undelayed values at the samples the chain delay
+// falls between (before the first sample: the first), each evaluated once as k moves forward
+double ColumnSweep::value(int col, std::size_t k) {
+  if (!column_before_chain(col) || (lag_whole_ == 0 && lag_frac_ == 0.0)) return undelayed(col, k);
+  const std::size_t i1 = k > lag_whole_ ? k - lag_whole_ : 0, i0 = i1 > 0 ? i1 - 1 : 0;
+  auto& at = at_[static_cast<std::size_t>(col)];
+  auto& val = val_[static_cast<std::size_t>(col)];
+  auto get = [&](std::size_t i) {
+    if (at[0] == i) return val[0];
+    if (at[1] == i) return val[1];
+    const double v = undelayed(col, i);
+    // the slot of the earlier sample (or an empty one) takes it
+    auto rank = [](std::size_t a) { return a == static_cast<std::size_t>(-1) ? -1.0 : static_cast<double>(a); };
+    const int slot = rank(at[0]) <= rank(at[1]) ? 0 : 1;
+    at[static_cast<std::size_t>(slot)] = i, val[static_cast<std::size_t>(slot)] = v;
+    return v;
+  };
+  const double v0 = get(i0), v1 = get(i1);
+  return v1 + lag_frac_ * (v0 - v1);
+}
+
 // the delay columns as column_value forms them, from the kept stencil values (the ends, where
 // column_value's one-sided forms apply, and every other column go to column_value)
-double ColumnSweep::value(int col, std::size_t k) {
+double ColumnSweep::undelayed(int col, std::size_t k) {
   const Replay& r = in_.r;
   if (col == kLat || col == kEarth) {  // the platform's rotation, turned again only when its angle changes
     const double ang = r.plat_deg[s_][k];

@@ -110,6 +110,8 @@ class Selector {
   }
   FitSpec spec_of(const Terms& S) const;
   FitSpec solve(const Terms& S, FitResult* fit) const;
+  std::vector<std::pair<ParamRef, double>> chain_held(const Terms& S, const FitSpec& spec, const FitResult& fit) const;
+  std::vector<std::pair<ParamRef, double>> rotation_held(const FitSpec& spec, const FitResult& fit) const;
   ChainTerms chain_terms(int s, double lowpass_delay_s, double extra_delay_s) const;
   double total(const Terms& S, FitResult* fit = nullptr) const;
   double best_delay(int s, const Terms& S, double* best_total) const;
@@ -167,12 +169,29 @@ ChainTerms Selector::chain_terms(int s, double lowpass_delay_s, double extra_del
   return chain_moments(lowpass_delay_s, T, extra_delay_s);
 }
 
-// the MAP fit of a selection; when it changes a signal chain, the chains' second- and third-order terms
-// (from the first solve's delays) are held and the fit solved again
+// the MAP fit of a selection. Two parts of it are not linear in the parameters and are held at
+// the first solve's values, then the fit is solved again: a changed signal chain's second- and
+// third-order terms, and a mounting rotation's second-order part
 FitSpec Selector::solve(const Terms& S, FitResult* fit) const {
   FitSpec spec = spec_of(S);
   *fit = map_fit(in_.ch, spec);
-  if (std::none_of(S.begin(), S.end(), [](const Term& t) { return is_signal_chain(t.ref); })) return spec;
+  const bool chain = std::any_of(S.begin(), S.end(), [](const Term& t) { return is_signal_chain(t.ref); });
+  const bool mount = std::any_of(S.begin(), S.end(), [](const Term& t) { return t.ref.param == Param::kMountingDeg; });
+  if (!chain && !mount) return spec;
+  std::vector<std::pair<ParamRef, double>> held;
+  if (chain) held = chain_held(S, spec, *fit);
+  if (mount) {
+    const auto rot = rotation_held(spec, *fit);
+    held.insert(held.end(), rot.begin(), rot.end());
+  }
+  spec.fixed.insert(spec.fixed.end(), held.begin(), held.end());
+  *fit = map_fit(in_.ch, spec);
+  return spec;
+}
+
+// the chains' second- and third-order terms where the fit's delays put them
+std::vector<std::pair<ParamRef, double>> Selector::chain_held(const Terms& S, const FitSpec& spec, const FitResult& fit) const {
+  std::vector<std::pair<ParamRef, double>> held;
   std::array<double, 2> D = model_delay_, d{};
   for (int s = 0; s < 2; ++s) d[s] = model_extra_delay_[static_cast<std::size_t>(s)];
   for (const Term& t : S)
@@ -180,7 +199,7 @@ FitSpec Selector::solve(const Terms& S, FitResult* fit) const {
       if (lowpass_on(t.ref, k)) D[static_cast<std::size_t>(k)] = t.delay_s;
   for (std::size_t i = 0; i < spec.free.size(); ++i) {
     const ParamRef& p = spec.free[i];
-    const double v = fit->value[static_cast<Eigen::Index>(i)];
+    const double v = fit.value[static_cast<Eigen::Index>(i)];
     if (p.param == Param::kTimeOffsetS) d[0] += v, d[1] += v;
     if (p.param == Param::kSampleDelayS) d[static_cast<std::size_t>(p.sensor)] += v;
   }
@@ -188,11 +207,45 @@ FitSpec Selector::solve(const Terms& S, FitResult* fit) const {
     const auto k = static_cast<std::size_t>(s);
     const ChainTerms c = chain_terms(s, D[k], d[k]);
     const double dc2 = c.c2 - model_c_[k].c2, dc3 = c.c3 - model_c_[k].c3;
-    if (dc2 != 0.0) spec.fixed.emplace_back(ParamRef{Param::kDelaySecondOrderS2, static_cast<std::int8_t>(s)}, dc2);
-    if (dc3 != 0.0) spec.fixed.emplace_back(ParamRef{Param::kDelayThirdOrderS3, static_cast<std::int8_t>(s)}, dc3);
+    if (dc2 != 0.0) held.emplace_back(ParamRef{Param::kDelaySecondOrderS2, static_cast<std::int8_t>(s)}, dc2);
+    if (dc3 != 0.0) held.emplace_back(ParamRef{Param::kDelayThirdOrderS3, static_cast<std::int8_t>(s)}, dc3);
   }
-  *fit = map_fit(in_.ch, spec);
-  return spec;
+  return held;
+}
+
+// a mounting rotation by the rotation vector t is w + t x w + t x (t x w) / 2 + ...; its columns
+// are the first-order part, and the second, (t t' - |t|^2 I) / 2, is a scale and a cross-axis
+// term on the scale and misalignment columns (held here as the change from the model's angles).
+// Left out, a 0.8 deg mounting about z read as a -0.0097 % scale on the other axes (cos t - 1),
+// selected at evidence 14-22 and undone by the next --apply, whose model rotates exactly
+std::vector<std::pair<ParamRef, double>> Selector::rotation_held(const FitSpec& spec, const FitResult& fit) const {
+  std::vector<std::pair<ParamRef, double>> held;
+  for (int s = 0; s < 2; ++s) {
+    const auto sensor = static_cast<std::int8_t>(s);
+    Eigen::Vector3d t0, t;
+    for (int k = 0; k < 3; ++k) t0[k] = model_value(in_.model, ParamRef{Param::kMountingDeg, sensor, static_cast<std::int8_t>(k)});
+    t = t0;
+    bool moved = false;
+    for (std::size_t i = 0; i < spec.free.size(); ++i) {
+      const ParamRef& p = spec.free[i];
+      if (p.param != Param::kMountingDeg || p.sensor != s) continue;
+      t[p.row] += fit.value[static_cast<Eigen::Index>(i)];
+      moved = true;
+    }
+    if (!moved) continue;
+    auto second = [](const Eigen::Vector3d& deg) {
+      const Eigen::Vector3d r = deg * kRadPerDeg;
+      return Eigen::Matrix3d(0.5 * (r * r.transpose() - r.squaredNorm() * Eigen::Matrix3d::Identity()));
+    };
+    const Eigen::Matrix3d M = 100.0 * (second(t) - second(t0));  // %
+    for (int j = 0; j < 3; ++j) {
+      const auto row = static_cast<std::int8_t>(j);
+      held.emplace_back(ParamRef{Param::kScalePct, sensor, row}, M(j, j));
+      for (int a = 0; a < 3; ++a)
+        if (a != j) held.emplace_back(ParamRef{Param::kMisalignmentPct, sensor, row, static_cast<std::int8_t>(a)}, M(j, a));
+    }
+  }
+  return held;
 }
 
 double Selector::total(const Terms& S, FitResult* fit_out) const {
@@ -238,6 +291,11 @@ double Selector::best_delay(int s, const Terms& S, double* best_total) const {
     const double vx = f(x);
     if (vx > vd) d = x, vd = vx;
   }
+  // a filter that fits better than none by less than 1 in 2 ln L (its delay within about 1 sigma
+  // of 0) is none: the golden search never ends on the boundary itself, and a filter of some
+  // microseconds is not "no filter" to the model (its bandwidth, extrapolated from the datasheet
+  // relation, refers the white noise to tens of kHz: a density written beside it was 14x low)
+  if (d > 0.0 && grid.front() == 0.0 && vd - v.front() < 1.0) d = 0.0, vd = v.front();
   if (best_total) *best_total = vd;
   return d;
 }

@@ -49,6 +49,7 @@ inline std::filesystem::path generate(const Source& src, const std::string& tag)
   if (src.single) cmd += " --single";
   if (src.accel) cmd += " --accel";
   for (const auto& p : src.plants) cmd += " --plant " + p;
+  if (std::getenv("DRIFTLESS_INDEP_SHOW")) std::printf("generate: %s\n", cmd.c_str());  // to rerun one case by hand
   const int rc = std::system(cmd.c_str());
   EXPECT_EQ(rc, 0) << "generator failed: " << cmd;
   return path;
@@ -62,14 +63,18 @@ inline CompareResult diagnose_log(const std::filesystem::path& log, CompareModel
   return compare(r, m, CompareOptions{});
 }
 
-/// --apply then compare again (written to YAML and read back, as the command does).
-inline CompareResult apply_and_compare(const std::filesystem::path& log, const CompareResult& r, const std::string& tag) {
-  CompareModel m = default_compare_model();
+/// --apply then compare again (written to YAML and read back, as the command does). `model_io`:
+/// the model `r` was compared with (the embedded default when null), replaced by the written one
+/// (a second apply starts from it).
+inline CompareResult apply_and_compare(const std::filesystem::path& log, const CompareResult& r, const std::string& tag,
+                                       CompareModel* model_io = nullptr) {
+  CompareModel m = model_io ? *model_io : default_compare_model();
   apply_result(m, r);
   const auto yaml = test::temp_path(fmt::format("driftless_indep_{}.yaml", tag));
   save_compare_model(m, yaml);
   const CompareModel back = load_compare_model(yaml);
   std::filesystem::remove(yaml);
+  if (model_io) *model_io = back;
   return compare(replay_log(log, ReplayOptions{}), back, CompareOptions{});
 }
 

@@ -8,9 +8,8 @@
 //   - two and three effects at once are all found in one run;
 //   - after --apply, the next comparison is consistent_with_noise.
 // Each test prints its rate; docs/compare.md quotes them (measured with DRIFTLESS_INDEP_SEEDS=24).
-// The thresholds are the 95 % where the 24-seed sweep meets it (planted first, clean,
-// signal chain), else the rate measured now with a margin for the lean default seed count
-// (docs/compare.md "Measured" says where it stands).
+// The thresholds are the 95 % (the 24-seed sweep meets it on every row since the fifth
+// stop; docs/compare.md "Measured" says where it stands).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -35,6 +34,13 @@ int sweep_seeds(int lean) {
   return env ? std::max(1, std::atoi(env)) : lean;
 }
 
+// DRIFTLESS_INDEP_ONLY=SEED runs that seed of each sweep only (to study one case by hand; the
+// rates are then not the sweep's)
+bool skipped(int seed) {
+  const char* env = std::getenv("DRIFTLESS_INDEP_ONLY");
+  return env && std::atoi(env) != seed;
+}
+
 // at least `fraction` of n (rounded down)
 int at_least(double fraction, int n) { return static_cast<int>(std::floor(fraction * n)); }
 
@@ -48,7 +54,10 @@ struct Plant {
 };
 
 // g-sensitivity needs the specific force along its column to vary while the platforms rest:
-// sensor 2's flips about x swap gravity between its y and z axes; sensor 1 rests at +-90 deg
+// sensor 2 rests at +-90 deg about x, so gravity is on its y axis (its sign swaps with each flip)
+// and the pitch tilts it onto its x axis; its z axis sees none of it at rest (seeds 313 and 322
+// planted s2 columns z, which change no sample the fits use: "not identified" was right, and
+// they were counted as misses); sensor 1 rests at +-90 deg
 // about z, so its x axis is the box's y axis, which only a roll tilts, and no motion of the
 // generator rolls (its pan/tilt and sweep pitch): a planted x column changes no sample the fits
 // use (seed 11 planted s1 x<-x and the log was rightly consistent). Its y axis is the box's x
@@ -70,7 +79,7 @@ Plant random_plant(std::mt19937& g, const std::string& motion) {
     }
     case 2: {
       const int sg = motion == "wobble" ? 2 : s;
-      const int r = uni(3), pick = uni(2), c = sg == 2 ? 1 + pick : 1;
+      const int r = uni(3), pick = uni(2), c = sg == 2 ? pick : 1;
       return {fmt::format("gsens:{}:{}:{}:{}", sg, ax[r], ax[c], 0.1 * sign), Effect::kGSensitivity,
               fmt::format("s{}.matrix_dps_per_g[{}][{}]", sg, ax[r], ax[c]), 0.1 * sign};
     }
@@ -128,6 +137,7 @@ TEST(IndependentLogs, PlantedPhysicalEffectIsFoundFirst) {
   std::map<std::string, std::pair<int, int>> per_effect;  // effect id: (found first, planted)
   const int seeds = sweep_seeds(12);
   for (int seed = 1; seed <= seeds; ++seed) {
+    if (skipped(seed)) continue;
     std::mt19937 g(static_cast<unsigned>(seed) * 104729u);
     Source src = indep::random_source(seed, true);
     const Plant p = random_plant(g, src.motion);
@@ -154,13 +164,14 @@ TEST(IndependentLogs, PlantedPhysicalEffectIsFoundFirst) {
               "after --apply consistent: %d / %d\n", ok, seeds, first_overall, applied_ok, applied);
   for (const auto& [id, t] : per_effect) std::printf("  %s: %d / %d\n", id.c_str(), t.first, t.second);
   EXPECT_GE(ok, at_least(0.95, seeds));
-  EXPECT_GE(applied_ok, at_least(0.6, applied));
+  EXPECT_GE(applied_ok, at_least(0.95, applied));
 }
 
 TEST(IndependentLogs, NothingPlantedIsConsistentOrItsSignalChain) {
   int ok = 0, consistent = 0;
   const int seeds = sweep_seeds(12);
   for (int seed = 101; seed < 101 + seeds; ++seed) {
+    if (skipped(seed)) continue;
     const Source src = indep::random_source(seed, true);
     const auto log = indep::generate(src, "clean");
     const CompareResult r = indep::diagnose_log(log);
@@ -176,6 +187,7 @@ TEST(IndependentLogs, NothingPlantedIsConsistentOrItsSignalChain) {
 TEST(IndependentLogs, SignalChainEffectsAreFoundAsThemselves) {
   int ok = 0, n = 0;
   for (int seed = 201; seed < 201 + sweep_seeds(9); ++seed) {
+    if (skipped(seed)) continue;
     Source src = indep::random_source(seed, false);
     // a lag or a time offset alone: the source has the model's filter (DLPF_CFG 3); another
     // filter besides is the multi-effect test's case (its split from a delay rests on the noise
@@ -220,9 +232,10 @@ TEST(IndependentLogs, SignalChainEffectsAreFoundAsThemselves) {
 }
 
 TEST(IndependentLogs, TwoAndThreeEffectsInOneRun) {
-  int ok = 0, applied_ok = 0;
+  int ok = 0, applied_ok = 0, applied2_ok = 0;
   const int seeds = sweep_seeds(6);
   for (int seed = 301; seed < 301 + seeds; ++seed) {
+    if (skipped(seed)) continue;
     std::mt19937 g(static_cast<unsigned>(seed) * 31u);
     Source src = indep::random_source(seed, false);
     src.dlpf = "none";  // the signal-chain mismatch: no DLPF against the model's DLPF_CFG 3
@@ -252,15 +265,24 @@ TEST(IndependentLogs, TwoAndThreeEffectsInOneRun) {
     if (src.lag_sensor) all = all && indep::selected(r, Effect::kSampleDelay) != nullptr;
     if (all) ++ok;
     else std::printf("MULTI %s: %s\n", indep::describe(src).c_str(), r.statement.c_str());
-    const CompareResult again = indep::apply_and_compare(log, r, "multi");
-    if (again.verdict == Verdict::kConsistent) ++applied_ok;
-    else std::printf("MULTI APPLY %s: %s\n", indep::describe(src).c_str(), again.statement.c_str());
+    // the claim: consistent after at most two applies (the second from the first's model)
+    CompareModel m = default_compare_model();
+    const CompareResult again = indep::apply_and_compare(log, r, "multi", &m);
+    if (again.verdict == Verdict::kConsistent) {
+      ++applied_ok, ++applied2_ok;
+    } else {
+      std::printf("MULTI APPLY %s: %s\n", indep::describe(src).c_str(), again.statement.c_str());
+      const CompareResult third = indep::apply_and_compare(log, again, "multi", &m);
+      if (third.verdict == Verdict::kConsistent) ++applied2_ok;
+      else std::printf("MULTI APPLY 2 %s: %s\n", indep::describe(src).c_str(), third.statement.c_str());
+    }
     std::filesystem::remove(log);
   }
-  std::printf("two and three effects (one a signal-chain mismatch) all found in one run: %d / %d; after --apply "
-              "consistent: %d / %d\n", ok, seeds, applied_ok, seeds);
-  EXPECT_GE(ok, at_least(0.8, seeds));
-  EXPECT_GE(applied_ok, at_least(0.65, seeds));
+  std::printf("two and three effects (one a signal-chain mismatch) all found in one run: %d / %d; consistent after "
+              "one --apply: %d / %d, after at most two: %d / %d\n", ok, seeds, applied_ok, seeds, applied2_ok, seeds);
+  EXPECT_GE(ok, at_least(0.95, seeds));
+  EXPECT_GE(applied_ok, at_least(0.95, seeds));
+  EXPECT_GE(applied2_ok, at_least(0.95, seeds));
 }
 
 }  // namespace
