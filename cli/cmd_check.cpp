@@ -9,6 +9,7 @@
 
 #include "cli/command.hpp"
 #include "estimator/log.hpp"
+#include "estimator/numbers.hpp"
 
 namespace driftless::cli {
 namespace {
@@ -64,9 +65,9 @@ void print_findings(const log::LogReader& reader) {
       fmt::print("  warning: {} is empty in all {} rows: a dead axis, or a column the logger did not fill\n",
                  log::gyro_column_name(d.channel), d.rows);
     } else {
-      fmt::print("  warning: {} reads {:.9g} deg/s in all {} rows while its sensor's other axes move: a dead or "
+      fmt::print("  warning: {} reads {} deg/s in all {} rows while its sensor's other axes move: a dead or "
                  "stuck axis\n",
-                 log::gyro_column_name(d.channel), d.value_dps, d.rows);
+                 log::gyro_column_name(d.channel), exact_number(d.value_dps), d.rows);
     }
   }
   if (reader.dropped_truncated_row()) fmt::print("  warning: last row was cut off and dropped\n");

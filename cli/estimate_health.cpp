@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "estimator/log.hpp"
+#include "estimator/numbers.hpp"
 #include "report/json.hpp"
 
 namespace driftless::cli {
@@ -161,10 +162,10 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
                            "fill; every row was skipped. Check the sensor and the column names in the header",
                            name, f.suggested);
       }
-      return fmt::format("{} reads {:.9g} deg/s in every one of the {:g} rows while the other axes of its sensor "
+      return fmt::format("{} reads {} deg/s in every one of the {:g} rows while the other axes of its sensor "
                          "move: a dead or stuck axis, whose standstills measure that value, not the rate; the "
                          "biases from this log cannot be trusted. Check the sensor",
-                         name, f.value, f.suggested);
+                         name, exact_number(f.value), f.suggested);
     }
     case est::HealthCause::kAttitudeWithheld:
       return fmt::format("attitude withheld from t = {:.2f} s: {:g} flip(s) moved both platforms at once, and with "
