@@ -113,7 +113,7 @@ void average_nonlinearity(std::vector<FittedParam>& params) {
 }
 
 std::string written_line(const Candidate& c, const FittedParam& fp) {
-  if (fp.ref.param == Param::kLowpassDelayS && fp.new_value() <= kNoLowpassDelayS)
+  if (is_no_lowpass(fp))
     return fmt::format("{}: {}: no low-pass (enabled: false)", effect_id(c.effect), fp.name());
   if (removes_model_effect(fp)) return fmt::format("{}: {}: removed (enabled: false)", effect_id(c.effect), fp.name());
   return fmt::format("{}: {} = {:.6g} {}", effect_id(c.effect), fp.name(), fp.new_value(), fp.unit());
@@ -176,7 +176,7 @@ ApplyReport apply_candidate(CompareModel& m, const Candidate& c) {
   std::vector<FittedParam> params = c.params;
   if (c.effect == Effect::kAdcNonlinearity) average_nonlinearity(params);
   for (const auto& fp : params) {
-    write_param(m, fp.ref, fp.new_value());
+    write_param(m, fp.ref, is_no_lowpass(fp) ? 0.0 : fp.new_value());
     rep.written.push_back(written_line(c, fp));
   }
   for (const auto& [channel, code] : c.codes) {

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -15,6 +16,10 @@ namespace driftless::diagnose {
 /// A fitted low-pass delay at or below this is "no low-pass" (the chain's boundary), s.
 inline constexpr double kNoLowpassDelayS = 1e-4;
 
+/// True when a fitted low-pass delay is "no low-pass": at or below kNoLowpassDelayS, or within
+/// 2 sigma of zero (0.10 +- 0.05 ms on a log without a filter: written as a filter, it took a
+/// 731 Hz bandwidth from the datasheet relation, and the noise aliased from there read 0.26x).
+bool is_no_lowpass(const FittedParam& p);
 /// True when a fitted parameter switches off an effect the model has (a quantisation of 0
 /// LSB/(deg/s): the outputs lie on no lattice; a low-pass delay at "no low-pass"; a jitter or
 /// delay of 0): the model's effect is not in the data, and the fix is to remove it (P11).

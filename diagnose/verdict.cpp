@@ -91,10 +91,15 @@ void verdict_from_fit(CompareResult& out) {
 
 }  // namespace
 
+bool is_no_lowpass(const FittedParam& p) {
+  if (p.ref.param != Param::kLowpassDelayS) return false;
+  return p.new_value() <= kNoLowpassDelayS || (std::isfinite(p.sigma) && p.new_value() < 2.0 * p.sigma);
+}
+
 bool removes_model_effect(const FittedParam& p) {
   if (p.model_value == 0.0) return false;
   switch (p.ref.param) {
-    case Param::kLowpassDelayS: return p.new_value() <= kNoLowpassDelayS;
+    case Param::kLowpassDelayS: return is_no_lowpass(p);
     case Param::kQuantLsbPerDps:
     case Param::kSampleDelayS:
     case Param::kJitterSigmaS:

@@ -113,6 +113,25 @@ TEST(ForeignRates, ExactStampsOnANoisierSensorGiveNoJitter) {
   std::filesystem::remove(log);
 }
 
+TEST(ForeignRates, ALowpassWithinTwoSigmaOfNoneIsNone) {
+  // GIVEN a 100 Hz BMI088-like log of a turning box, without any low-pass (this seed's fitted
+  // delay is 0.10 +- 0.05 ms)
+  const auto log = probe_log("--sensor bmi088 --motion turn --duration 300 --seed 2", "bmi088_turn");
+  const CompareResult r = indep::diagnose_log(log);
+  // THEN the low-pass is found absent ("no low-pass", the model's to remove), not a 0.1 ms filter
+  const Candidate* lp = find_in(r.selected, Effect::kLowpass);
+  ASSERT_NE(lp, nullptr) << r.statement;
+  ASSERT_FALSE(lp->params.empty());
+  EXPECT_TRUE(is_no_lowpass(lp->params.front())) << r.statement;
+  EXPECT_TRUE(removes_model_effect(lp->params.front())) << r.statement;
+  // AND the white density is the sensor's within 8 % (as a 0.1 ms filter it took a 731 Hz
+  // bandwidth from the datasheet relation, and the noise referred to it read 0.0037)
+  const Candidate* w = find_in(r.noise_model, Effect::kWhiteNoise);
+  ASSERT_NE(w, nullptr) << r.statement;
+  EXPECT_NEAR(mean_value(*w), 0.014, 0.08 * 0.014) << r.statement;
+  std::filesystem::remove(log);
+}
+
 TEST(ForeignRates, HingeAxesKeepTheirLsbAndAJitterBeyondASamplePeriodIsImplausible) {
   // GIVEN an MPU6050-like log (65.5 LSB/(deg/s) on every axis) on an irregular flip schedule:
   // the hinge axes' outputs during the flips are few and spread over +-360 deg/s
