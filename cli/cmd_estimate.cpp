@@ -81,14 +81,22 @@ void write_selfcal_files(const EstimateArgs& a, const log::Metadata& meta, const
 // --smooth: the backward pass over the updates, then the log again with the smoothed correction
 // into corrected.csv (docs/estimator.md section 6.3). Every row is marked locked when the forward
 // filter locked at all: the smoothed correction at any time uses the whole log
-void write_smoothed(const EstimateArgs& a, const log::ReaderOptions& read_opt, const est::EstimatorConfig& cfg,
-                    est::FixedIntervalSmoother& sm, EstimateFiles& files, const est::EstimateSummary& s) {
+// A stop (SIGINT/SIGTERM) ends the second pass at the next row: corrected.csv keeps the rows
+// written, and the time of the last one is returned (NaN: none) for summary.json's stopped_at_t_s
+double write_smoothed(const EstimateArgs& a, const log::ReaderOptions& read_opt, const est::EstimatorConfig& cfg,
+                      est::FixedIntervalSmoother& sm, EstimateFiles& files, const est::EstimateSummary& s) {
   sm.smooth();
   log::LogReader again(a.log, read_opt);
   const bool locked = std::isfinite(s.locked_from_t_s);
+  double last_t_s = kNaN;
   est::smoothed_outputs(
-      cfg, est::box_geometry_from_metadata(again.metadata()), [&again](Sample& x) { return again.next(x); }, sm,
-      [&](const Sample& x, const est::SampleOutput& o) { files.on_smoothed_sample(x, o, locked); });
+      cfg, est::box_geometry_from_metadata(again.metadata()),
+      [&again](Sample& x) { return !stop_requested().load() && again.next(x); }, sm,
+      [&](const Sample& x, const est::SampleOutput& o) {
+        files.on_smoothed_sample(x, o, locked);
+        last_t_s = x.t_s;
+      });
+  return last_t_s;
 }
 
 // --tune auto: a first pass over the log measures N and K (docs/estimator.md section 6.2)
@@ -112,7 +120,9 @@ int report_health(const EstimateArgs& a, const est::EstimatorConfig& cfg, const 
   const bool bad = h.verdict != est::HealthVerdict::kOk;
   for (const auto& l : lines) fmt::print(bad ? stderr : stdout, "{}{}\n", bad ? "driftless estimate: " : "  ", l);
   if (h.verdict == est::HealthVerdict::kFailed) {
-    fmt::print(stderr, "driftless estimate: the filter never locked: the estimates are not usable (exit 1)\n");
+    // the first finding is the cause (never locked, clipping, a schedule paper mode does not fit, ...)
+    fmt::print(stderr, "driftless estimate: health failed{}: the estimates are not usable (exit 1)\n",
+               h.locked ? "" : ", the filter never locked");
     return kExitFailed;
   }
   if (h.verdict == est::HealthVerdict::kDegraded && a.strict) {
@@ -196,7 +206,13 @@ int run_estimate_cmd(const EstimateArgs& a) {
   if (a.smooth) smoother = std::make_unique<est::FixedIntervalSmoother>(cfg.q_dps2_per_s());
   run_opt.update_observer = smoother.get();
   const auto summary = est::run_estimate(reader, cfg, &files, run_opt, &stop_polled);
-  if (smoother && !stop_requested().load()) write_smoothed(a, read_opt, cfg, *smoother, files, summary);
+  // --smooth: corrected.csv holds the smoother's rows only when its second pass ran to the end
+  double stopped_at_t_s = summary.t_last_s;
+  bool smoothed = false;
+  if (smoother && !stop_requested().load()) {
+    stopped_at_t_s = write_smoothed(a, read_opt, cfg, *smoother, files, summary);
+    smoothed = !stop_requested().load();
+  }
   files.commit();
   const bool interrupted = stop_requested().load();
 
@@ -220,7 +236,9 @@ int run_estimate_cmd(const EstimateArgs& a) {
   ctx.log_path = a.log;
   ctx.mode = cfg.mode;
   ctx.complete = !interrupted;
-  ctx.stopped_at_t_s = summary.t_last_s;
+  ctx.stopped_at_t_s = stopped_at_t_s;
+  ctx.smooth_requested = a.smooth;
+  ctx.smoothed = smoothed;
   ctx.figures = &figures;
   ctx.config = &cfg;
   ctx.tune = a.tune == "auto" ? &tune : nullptr;

@@ -33,6 +33,8 @@ const char* cause_key(est::HealthCause c) {
     case est::HealthCause::kSaturation: return "saturation";
     case est::HealthCause::kAttitudeWithheld: return "attitude_withheld";
     case est::HealthCause::kDeadAxis: return "dead_axis";
+    case est::HealthCause::kPaperRestAngles: return "paper_rest_angles";
+    case est::HealthCause::kPaperSchedule: return "paper_schedule";
   }
   return "?";
 }
@@ -140,6 +142,23 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
                          "to measure each sensor's chain",
                          f.value > 0.0 ? 2 : 1, 1e3 * std::fabs(f.value), 1e3 * f.sigma, f.value > 0.0 ? 1 : 2,
                          f.suggested);
+    case est::HealthCause::kPaperRestAngles:
+      return fmt::format("the platforms rested {:g} deg from the paper's positions in {:g} of {} standstills "
+                         "(plat*_deg read {:g} deg), while paper mode builds H from +-{:g} deg (flip_angle_deg){}; "
+                         "use --mode general (H from the angles read), or set flip_angle_deg: {:g} in the log "
+                         "header if every rest is at that angle",
+                         std::fabs(std::fabs(f.suggested) - f.sigma), f.value, f.count, f.suggested, f.sigma,
+                         f.severity == est::HealthVerdict::kFailed
+                             ? ": the biases and their sigma from this run are not the box's"
+                             : ": the updates from those standstills used an H the box did not have",
+                         std::fabs(f.suggested));
+    case est::HealthCause::kPaperSchedule:
+      return fmt::format("the platforms did not follow eq. (5)'s position sequence in {:g} of {} standstills "
+                         "(paper mode builds H from that sequence, not from the angles read){}; use --mode general",
+                         f.value, f.count,
+                         f.severity == est::HealthVerdict::kFailed
+                             ? ": the biases and their sigma from this run are not the box's"
+                             : ": the updates from those standstills used positions the box was not in");
     case est::HealthCause::kSaturation: {
       const int c = f.components.empty() ? 0 : f.components.front();
       return fmt::format("{} reads exactly +-{:.6g} deg/s, its largest value, in runs over {:.3g} % of the "

@@ -186,13 +186,17 @@ void write_estimate_summary(const fs::path& path, const SummaryContext& ctx, con
   };
   add("  \"complete\": {},\n", ctx.complete ? "true" : "false");
   add("  \"stopped_at_t_s\": {},\n", ctx.complete ? "null" : json_number(ctx.stopped_at_t_s));
+  // corrected.csv from the smoother (--smooth) to the end: true; asked for but stopped: false
+  add("  \"smoothed\": {},\n", ctx.smooth_requested ? (ctx.smoothed ? "true" : "false") : "null");
   add("  \"log\": {},\n", json_string(ctx.log_path));
   add("  \"mode\": \"{}\",\n", ctx.mode == est::FilterMode::kPaper ? "paper" : "general");
   add("  \"rows\": {},\n  \"rows_missing_gyro\": {},\n", s.rows, s.rows_missing_gyro);
   add("  \"log_complete\": {},\n", s.log_complete ? "true" : "false");
   add("  \"t_first_s\": {}, \"t_last_s\": {},\n", json_number(s.t_first_s), json_number(s.t_last_s));
-  add("  \"updates\": {}, \"rejected\": {}, \"standstills_too_short\": {}, \"schedule_mismatches\": {},\n",
-      s.counters.updates, s.counters.rejected, s.counters.standstills_too_short, s.counters.schedule_mismatches);
+  add("  \"updates\": {}, \"rejected\": {}, \"standstills_too_short\": {}, \"schedule_mismatches\": {}, "
+      "\"rest_angle_mismatches\": {},\n",
+      s.counters.updates, s.counters.rejected, s.counters.standstills_too_short, s.counters.schedule_mismatches,
+      s.counters.rest_angle_mismatches);
   add("  \"final_bias_dps\": {},\n", json_vec(s.bias_dps));
   add("  \"final_sigma_dps\": {},\n", json_vec(s.sigma_dps));
   add("  \"temperature_states\": {{\"enabled\": {}, \"reference_degc\": [{}, {}], \"coef_dps_per_degc\": {}, "
@@ -219,8 +223,9 @@ void write_estimate_summary(const fs::path& path, const SummaryContext& ctx, con
   add("  \"box_dwells\": {{\"updates\": {}, \"rejected\": {}}},\n", s.counters.box_dwell_updates,
       s.counters.box_dwell_rejected);
   const std::uint64_t flips_ok = s.counters.flip_updates - s.counters.flip_rejected;
-  add("  \"flips\": {{\"updates\": {}, \"rejected\": {}, \"nis_mean\": {}}},\n", s.counters.flip_updates,
-      s.counters.flip_rejected, json_number(flips_ok > 0 ? s.counters.flip_nis_sum / double(flips_ok) : kNaN));
+  add("  \"flips\": {{\"updates\": {}, \"rejected\": {}, \"nis_mean\": {}, \"skipped_clipped\": {}}},\n",
+      s.counters.flip_updates, s.counters.flip_rejected,
+      json_number(flips_ok > 0 ? s.counters.flip_nis_sum / double(flips_ok) : kNaN), s.counters.flip_clipped);
   add("  \"locked_from_t_s\": {}, \"rows_locked\": {},\n", json_number(s.locked_from_t_s), s.samples_locked);
   add("  \"attitude_start_s\": {}, \"attitude_withheld_from_s\": {},\n", json_number(s.attitude_start_s),
       json_number(s.attitude_withheld_from_s));

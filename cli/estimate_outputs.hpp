@@ -68,6 +68,9 @@ struct SummaryContext {
   est::FilterMode mode = est::FilterMode::kGeneral;
   bool complete = true;             // false: the run was interrupted
   double stopped_at_t_s = kNaN;     // s, the last row processed when interrupted
+  // --smooth given, and whether its second pass ran to the end (corrected.csv is then smoothed)
+  bool smooth_requested = false;
+  bool smoothed = false;
   const std::vector<FigureOutcome>* figures = nullptr;  // what --plot drew (nullptr: no "figures")
   const est::EstimatorConfig* config = nullptr;  // the configuration used (nullptr: no "health" text)
   const est::TuneResult* tune = nullptr;         // what --tune auto measured (nullptr: "tune": null)

@@ -393,6 +393,7 @@ bool DriftlessFilter::update(const Eigen::Matrix<double, D, 1>& r, const Eigen::
     P_.diagonal().head<kStateDim>().array() += innov.squaredNorm();
     ++counters_.relocks;
     rec.relocked = true;
+    rec.relock_nis = rec.nis;
     // one try on the widened P: the part of the innovation outside H's range (a rank-deficient
     // stacked H, a residual the model cannot explain) does not shrink with P, so a second re-lock
     // from here would recurse without end
@@ -429,6 +430,20 @@ void DriftlessFilter::emit_update(const UpdateRecord& in, bool accepted) {
   if (!accepted) ++counters_.rejected;
 }
 
+// paper mode: does the standstill rest where eq. (5) says (pattern `pattern`, +-flip_angle_deg)?
+// Both are counted for the health verdict (a schedule or rest angles that are not the paper's)
+void DriftlessFilter::check_paper_position(double plat1_deg, double plat2_deg, int pattern) {
+  if (!finite(plat1_deg) || !finite(plat2_deg)) return;
+  ++counters_.paper_standstills;
+  if (eq5_pattern_of(plat1_deg, plat2_deg) != pattern) ++counters_.schedule_mismatches;
+  for (double p : {plat1_deg, plat2_deg}) {
+    if (std::abs(std::abs(p) - box_.flip_angle_deg) <= cfg_.calibration.match_tolerance_deg) continue;
+    if (counters_.rest_angle_mismatches == 0) counters_.rest_angle_mismatch_deg = p;
+    ++counters_.rest_angle_mismatches;
+    break;
+  }
+}
+
 // paper mode: a standstill that could not be used still advances eq. (5)'s counter
 void DriftlessFilter::skip_paper_step() {
   prev_res_.valid = false;
@@ -444,7 +459,7 @@ int DriftlessFilter::use_segment(const StandstillSegment& s) {
   if (cfg_.mode == FilterMode::kPaper) {
     if (paper_k_ < 0) paper_k_ = finite(p1) && finite(p2) ? eq5_pattern_of(p1, p2) : 0;
     pattern = static_cast<int>(paper_k_ % 4);
-    if (finite(p1) && finite(p2) && eq5_pattern_of(p1, p2) != pattern) ++counters_.schedule_mismatches;
+    check_paper_position(p1, p2, pattern);
     p1 = eq5_position_deg(pattern, 1, box_.flip_angle_deg);
     p2 = eq5_position_deg(pattern, 2, box_.flip_angle_deg);
     ++paper_k_;
@@ -854,6 +869,11 @@ void DriftlessFilter::use_flip() {
   // the profile and the E regressor use the corrected rates: only once the correction is known
   // (as for the box dwells); before, a flip would pass the bias error into E
   if (!(correction_sigma_dps().maxCoeff() < 0.1 * cfg_.box_dwell_rate_dps)) return;
+  // a gyro that clipped in the flip integrates a turn short of it: that is no measurement of E
+  if (flip_clipped(flips_)) {
+    ++counters_.flip_clipped;
+    return;
+  }
   const int m = flips_.moving(), r = 3 - m;
   FlipModel fm;
   fm.M_moving_start = body_from_sensor(m, flips_.start_deg());

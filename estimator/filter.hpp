@@ -86,6 +86,7 @@ struct UpdateRecord {
   double nis_gate = kNaN;     // chi-square gate at nis_gate_probability and `dim`
   bool accepted = false;
   bool relocked = false;      // taken after gate_relock_after rejections in a row, P widened
+  double relock_nis = kNaN;   // a re-lock: the NIS that triggered it (nis is the one after widening)
   bool at_end = false;        // the stream ended inside this standstill (finish())
 };
 
@@ -120,6 +121,12 @@ struct FilterCounters {
   std::uint64_t standstills_too_short = 0;
   std::uint64_t simultaneous_flips = 0;  // standstill: gyro: flips of both platforms at once
   std::uint64_t schedule_mismatches = 0;  // paper mode: measured positions differ from eq. (5)
+  // paper mode: standstills with both angles read, and those where a platform rested more than
+  // calibration.match_tolerance_deg from +-flip_angle_deg (the angles eq. (5) builds H from); the first
+  // such rest angle (deg, as read) for the health text
+  std::uint64_t paper_standstills = 0;
+  std::uint64_t rest_angle_mismatches = 0;
+  double rest_angle_mismatch_deg = kNaN;
   std::uint64_t source_switches = 0;
   std::uint64_t relocks = 0;  // gate re-locks after gate_relock_after consecutive rejections
   // box-dwell updates of the vertical rate (box_dwell_updates; not in `updates`/`rejected`)
@@ -129,6 +136,7 @@ struct FilterCounters {
   std::uint64_t flip_updates = 0;
   std::uint64_t flip_rejected = 0;
   double flip_nis_sum = 0.0;  // sum of the accepted flip updates' NIS (3 dof each)
+  std::uint64_t flip_clipped = 0;  // flips skipped because a gyro clipped in them (flip_clipped())
 };
 
 /// What an accepted update changed (for an offline smoother: estimator/smoother.hpp). The pointers
@@ -270,6 +278,7 @@ class DriftlessFilter {
   bool update(const Eigen::Matrix<double, D, 1>& r, const Eigen::Matrix<double, D, kFullStateDim>& H,
               const Eigen::Matrix<double, D, D>& R, UpdateRecord& rec, bool may_relock = true);
   void emit_update(const UpdateRecord& rec, bool accepted);
+  void check_paper_position(double plat1_deg, double plat2_deg, int pattern);
   void fuse_rate(const Sample& s, const StandstillStep& st);
   Eigen::Vector3d box_rate_dps(const StandstillSegment& s, const Eigen::Matrix3d& M1, const Eigen::Matrix3d& M2) const;
   void stop_rows(const StandstillSegment& s, const Eigen::Matrix3d& M1, const Eigen::Matrix3d& M2, Residual3& cur) const;

@@ -3,9 +3,21 @@
 #include <algorithm>
 #include <cmath>
 
+#include "estimator/clip_detector.hpp"
 #include "estimator/geometry.hpp"
 
 namespace driftless::est {
+
+bool flip_clipped(const FlipWindow& w) {
+  ClipDetector d;
+  for (const FlipSample& s : w.samples()) {
+    for (int i = 0; i < 3; ++i) {
+      d.push(i, s.gyro1_dps[i], false);
+      d.push(3 + i, s.gyro2_dps[i], false);
+    }
+  }
+  return !d.suspected().empty();
+}
 
 FlipWindow::FlipWindow(double settle_s, double max_s, double rate_hz)
     : settle_s_(settle_s), max_s_(max_s) {

@@ -114,6 +114,11 @@ struct FlipRows {
   bool g_columns = false;  // H_G_* filled (use_g and every sample had accel); else G f is in R
 };
 
+/// Whether a gyro clipped inside the flip window: a channel whose largest |reading| in it comes in
+/// runs of identical values (the test of estimator/clip_detector.hpp, applied to the window). Its
+/// integrated turn then falls short of the flip, so the flip is no measurement of E.
+bool flip_clipped(const FlipWindow& w);
+
 /// Builds the flip measurement; invalid when the window is not a clean flip (the gyro-integrated
 /// turn more than 20 % off the angle change or of the other sign). With `use_g` and a sample
 /// without accel the G columns are left out and G f's variance goes into R (g_columns false).

@@ -17,12 +17,48 @@ void add(HealthReport& h, HealthFinding f) {
   h.findings.push_back(std::move(f));
 }
 
+// `first`'s findings ahead of h's (they are the others' cause); the verdict is the worse of both
+void put_first(HealthReport& h, HealthReport&& first) {
+  if (h.verdict == HealthVerdict::kFailed || (h.verdict == HealthVerdict::kDegraded && first.verdict == HealthVerdict::kOk))
+    first.verdict = h.verdict;
+  for (HealthFinding& f : h.findings) first.findings.push_back(std::move(f));
+  h.findings = std::move(first.findings);
+  h.verdict = first.verdict;
+}
+
 }  // namespace
+
+void add_paper_mode_findings(HealthReport& h, const FilterCounters& counters, double flip_angle_deg) {
+  const std::uint64_t n = counters.paper_standstills;
+  if (n == 0) return;
+  const auto severity = [n](std::uint64_t off) {
+    return 2 * off >= n ? HealthVerdict::kFailed : HealthVerdict::kDegraded;
+  };
+  HealthReport first;
+  if (counters.rest_angle_mismatches > 0) {
+    HealthFinding f;
+    f.cause = HealthCause::kPaperRestAngles;
+    f.severity = severity(counters.rest_angle_mismatches);
+    f.value = double(counters.rest_angle_mismatches);
+    f.suggested = counters.rest_angle_mismatch_deg;
+    f.sigma = flip_angle_deg;
+    f.count = n;
+    add(first, std::move(f));
+  }
+  if (counters.schedule_mismatches > 0) {
+    HealthFinding f;
+    f.cause = HealthCause::kPaperSchedule;
+    f.severity = severity(counters.schedule_mismatches);
+    f.value = double(counters.schedule_mismatches);
+    f.count = n;
+    add(first, std::move(f));
+  }
+  put_first(h, std::move(first));
+}
 
 void add_saturation_findings(HealthReport& h, const std::vector<ClippedChannel>& clipped, std::uint64_t rows) {
   if (clipped.empty() || rows == 0) return;
   HealthReport first;
-  first.verdict = h.verdict;
   for (const ClippedChannel& c : clipped) {
     HealthFinding f;
     f.cause = HealthCause::kSaturation;
@@ -37,9 +73,7 @@ void add_saturation_findings(HealthReport& h, const std::vector<ClippedChannel>&
                                                               : HealthVerdict::kDegraded;
     add(first, std::move(f));
   }
-  for (HealthFinding& f : h.findings) first.findings.push_back(std::move(f));
-  h.findings = std::move(first.findings);
-  h.verdict = first.verdict;
+  put_first(h, std::move(first));
 }
 
 void add_dead_axis_findings(HealthReport& h, const std::vector<DeadChannel>& dead) {

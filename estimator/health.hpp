@@ -42,6 +42,8 @@ enum class HealthCause {
                          // the channel; value: its value if stuck, NaN if empty; suggested: rows)
   kAttitudeWithheld,     // standstill: gyro: both platforms flipped at once, no sensor read the box
                          // rate (value: from when, s; suggested: how many such flips)
+  kPaperRestAngles,      // paper mode: the platforms rest away from +-flip_angle_deg (eq. (5)'s H)
+  kPaperSchedule,        // paper mode: the positions did not follow eq. (5)'s sequence
 };
 
 /// One check that did not pass, with the numbers that describe() turns into text.
@@ -63,6 +65,9 @@ struct HealthFinding {
   std::vector<int> components;  // kUnobservable: 0..5 = b1_x .. b2_z; kSaturation: the channel
                                 // (0..5 = gyro1_x .. gyro2_z), value: the fraction of the rows
                                 // clipped, suggested: the level in deg/s
+  // kPaperRestAngles: value = the standstills off, suggested = a rest angle read (deg), sigma =
+  // flip_angle_deg; kPaperSchedule: value = the standstills off; both: count = paper standstills
+  std::uint64_t count = 0;
 };
 
 /// Limits of the verdict (docs/estimator.md section 6.1).
@@ -121,6 +126,12 @@ void add_dead_axis_findings(HealthReport& h, const std::vector<DeadChannel>& dea
 /// 'standstill: gyro' and `flips` flips of both platforms at once, the first inside the attitude
 /// comparison at `t_s`: the attitude from there on is withheld (degraded; the biases stand).
 void add_attitude_withheld_finding(HealthReport& h, double t_s, std::uint64_t flips);
+
+/// Paper mode builds H from eq. (5)'s positions, +-flip_angle_deg in its fixed order: standstills
+/// that rested elsewhere or out of that order are findings ahead of the others (their cause),
+/// `failed` when at least half of the standstills are off (most updates used an H that is not the
+/// box's), else `degraded`. `counters` are the filter's at the end of the pass.
+void add_paper_mode_findings(HealthReport& h, const FilterCounters& counters, double flip_angle_deg);
 
 /// Watches the updates of one pass and gives the verdict at the end.
 class HealthMonitor {

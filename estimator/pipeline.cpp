@@ -132,10 +132,7 @@ void add_filter_warnings(const DriftlessFilter& filter, EstimateSummary& sum) {
   if (sum.counters.updates == 0 && sum.rows > 0) {
     sum.warnings.push_back("no filter update: no standstill of at least min_standstill_s was found");
   }
-  if (sum.counters.schedule_mismatches > 0) {
-    sum.warnings.push_back(std::to_string(sum.counters.schedule_mismatches) +
-                           " standstills did not match eq. (5)'s position sequence (paper mode)");
-  }
+  // paper mode's schedule and rest-angle mismatches are health findings (add_paper_mode_findings)
   for (const auto& r : sum.relocks) {
     sum.warnings.push_back("the NIS gate rejected " + std::to_string(filter.config().gate_relock_after) +
                            " updates in a row; the filter re-locked at t = " + std::to_string(r.t_s) +
@@ -224,7 +221,7 @@ void withhold_attitude(const DriftlessFilter& filter, EstimateSummary& sum) {
 // `t_s` is the time of the sample whose push made the update: the first row it corrects.
 bool lock_step(const DriftlessFilter& filter, double lock_sigma_dps, const UpdateRecord& u, double t_s,
                EstimateSummary& sum) {
-  if (u.relocked) sum.relocks.push_back({u.t_s, u.nis, kNaN});
+  if (u.relocked) sum.relocks.push_back({u.t_s, u.relock_nis, kNaN});
   const bool locked = filter_locked(filter, lock_sigma_dps);
   if (!locked) return false;
   if (!std::isfinite(sum.locked_from_t_s)) sum.locked_from_t_s = t_s;
@@ -330,6 +327,7 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
   score.finish();
   if (use_window) window.finish(filter);
   sum.health = health.finish(filter, sum.rows > 0 ? sum.t_last_s - sum.t_first_s : 0.0, lag.finish());
+  if (cfg.mode == FilterMode::kPaper) add_paper_mode_findings(sum.health, filter.counters(), filter.geometry().flip_angle_deg);
   if (reader != nullptr) {
     add_saturation_findings(sum.health, reader->suspected_clipping(), reader->rows_read());
     add_dead_axis_findings(sum.health, reader->dead_channels());

@@ -31,7 +31,7 @@ grep -q '"g_sensitivity_sigma_dps_per_g": \[\[\[' "$t/sc/summary.json" || fail "
 [[ $(verdict "$t/dw") == ok ]] || fail "--selfcal (box dwells): verdict $(verdict "$t/dw")"
 grep -Eq '"box_dwells": \{"updates": [1-9][0-9]*, "rejected": 0\}' "$t/dw/summary.json" ||
   fail "--selfcal: no box dwell updates: $(grep -o '"box_dwells": {[^}]*}' "$t/dw/summary.json")"
-grep -Eq '"flips": \{"updates": [1-9][0-9]*, "rejected": 0, "nis_mean": [0-9.]+\}' "$t/dw/summary.json" ||
+grep -Eq '"flips": \{"updates": [1-9][0-9]*, "rejected": 0, "nis_mean": [0-9.]+, "skipped_clipped": 0\}' "$t/dw/summary.json" ||
   fail "--selfcal: no flip updates: $(grep -o '"flips": {[^}]*}' "$t/dw/summary.json")"
 # AND without box dwells (box_dwell_updates: false), flip updates (they see gravity at the
 # platform's angles between the stops: a little of the vertical) nor --box-at-rest the lock

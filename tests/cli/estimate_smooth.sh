@@ -36,6 +36,9 @@ sf, ss = steps(hf, filt), steps(hs, smo)
 print(f"largest row-to-row change of the correction after the lock: filter {sf:.4g}, smoothed {ss:.4g} deg/s")
 sys.exit(0 if ss < 1e-3 and sf > 0.02 else 1)
 PY
+# AND summary.json says which outputs are smoothed: true with --smooth, null without
+grep -q '"smoothed": true' "$t/s/summary.json" || fail "summary.json of --smooth lacks \"smoothed\": true"
+grep -q '"smoothed": null' "$t/f/summary.json" || fail "summary.json without --smooth lacks \"smoothed\": null"
 # AND --smooth alone is refused with the reason
 "$bin" estimate --log "$t/sim/log.csv" --out "$t/x" --smooth > /dev/null 2> "$t/x.err"
 [[ $? -ne 0 ]] && grep -q -- "--smooth requires --corrected" "$t/x.err" || fail "--smooth without --corrected accepted: $(cat "$t/x.err")"

@@ -179,5 +179,42 @@ TEST(FlipUpdateTest, FlipsWithoutAccelColumnsAreUsedWithoutTheGColumns) {
   }
 }
 
+// GIVEN the static box of the test above, flips of 180 deg in 1 s (a 283 deg/s peak), and sensor 1
+// clipping at +-260 deg/s, so its integrated turn falls about 5 deg short in each of its flips
+// WHEN the self-calibrating filter runs with flip updates, on the clipped log and on the same log
+// unclipped
+// THEN on the clipped log every flip of platform 1 is skipped (counted in flip_clipped), sensor 1's
+// E column along its hinge keeps about its prior sigma and is not pulled by the short turns, while
+// platform 2's flips, which no gyro clipped, still measure E2's; the unclipped log skips none
+TEST(FlipUpdateTest, AFlipInWhichAGyroClippedIsSkipped) {
+  test::SynthParams p = flipping_box(10.0, 0.05);
+  p.body_rate_dps = nullptr;
+  p.lsb_dps = 1.0 / 65.5;
+  const auto run = [&](bool clip) {
+    test::SynthParams q = p;
+    if (clip) q.before_quantise = [](Sample& s) { s.gyro1_dps = s.gyro1_dps.cwiseMax(-260.0).cwiseMin(260.0); };
+    DriftlessFilter f(selfcal(true), test::synth_geometry(q));
+    test::synth_samples(q, [&](const Sample& s) { f.push(s); });
+    f.finish();
+    return f;
+  };
+  const DriftlessFilter clean = run(false), clipped = run(true);
+  EXPECT_EQ(clean.counters().flip_clipped, 0u);
+  EXPECT_GT(clean.counters().flip_updates, 20u);
+  // platform 1 flips every other cycle of eq. (5): about half of the flips
+  EXPECT_GE(clipped.counters().flip_clipped, 10u);
+  EXPECT_EQ(clipped.counters().flip_clipped + clipped.counters().flip_updates, clean.counters().flip_updates);
+  // (used, a short turn is 5 deg against a flip sigma of about 0.1 deg: the flip gate rejects it)
+  EXPECT_EQ(clipped.counters().flip_rejected, 0u);
+  const double prior = selfcal(true).scale_misalign_sigma_frac;
+  const Eigen::Matrix3d E1 = clipped.scale_misalign(1), S1 = clipped.scale_misalign_sigma(1);
+  const Eigen::Matrix3d S2 = clipped.scale_misalign_sigma(2);
+  for (int r = 0; r < 3; ++r) {
+    EXPECT_NEAR(E1(r, 2), p.E_frac[0](r, 2), 3.0 * S1(r, 2)) << "E1(" << r << ",z)";
+    EXPECT_GT(S1(r, 2), 0.5 * prior) << "E1(" << r << ",z)";
+    EXPECT_LT(S2(r, 0), 0.05 * prior) << "E2(" << r << ",x)";
+  }
+}
+
 }  // namespace
 }  // namespace driftless::est
