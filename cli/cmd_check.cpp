@@ -9,6 +9,7 @@
 
 #include "cli/command.hpp"
 #include "estimator/log.hpp"
+#include "estimator/numbers.hpp"
 
 namespace driftless::cli {
 namespace {
@@ -46,8 +47,10 @@ void print_findings(const log::LogReader& reader) {
     }
   }
   if (reader.rows_saturated() > 0) {
-    fmt::print("  warning: {} rows have a gyro value at the full scale of {} deg/s (saturated)\n",
-               reader.rows_saturated(), reader.metadata().gyro_full_scale_dps());
+    const auto& m = reader.metadata();
+    fmt::print("  warning: {} rows have a gyro value at the stated full scale of {} / {} deg/s (sensor 1 / 2; "
+               "saturated)\n",
+               reader.rows_saturated(), m.gyro_full_scale_dps(1), m.gyro_full_scale_dps(2));
   }
   for (const est::ClippedChannel& c : reader.suspected_clipping()) {
     fmt::print("  warning: {} repeats its largest value, +-{:g} deg/s, in runs ({} samples): it clips there "
@@ -56,6 +59,16 @@ void print_findings(const log::LogReader& reader) {
   }
   if (reader.rows_with_missing_gyro() > 0) {
     fmt::print("  warning: {} rows have a missing or NaN gyro value\n", reader.rows_with_missing_gyro());
+  }
+  for (const est::DeadChannel& d : reader.dead_channels()) {
+    if (d.kind == est::DeadChannel::Kind::kEmpty) {
+      fmt::print("  warning: {} is empty in all {} rows: a dead axis, or a column the logger did not fill\n",
+                 log::gyro_column_name(d.channel), d.rows);
+    } else {
+      fmt::print("  warning: {} reads {} deg/s in all {} rows while its sensor's other axes move: a dead or "
+                 "stuck axis\n",
+                 log::gyro_column_name(d.channel), exact_number(d.value_dps), d.rows);
+    }
   }
   if (reader.dropped_truncated_row()) fmt::print("  warning: last row was cut off and dropped\n");
   const auto& meta = reader.metadata();

@@ -253,7 +253,11 @@ int run_estimate_cmd(const EstimateArgs& a) {
              sg[1], sg[2]);
   fmt::print("  b2 = ({:+.5f}, {:+.5f}, {:+.5f}) +- ({:.5f}, {:.5f}, {:.5f}) deg/s\n", b[3], b[4], b[5], sg[3],
              sg[4], sg[5]);
-  if (summary.attitude_available) {
+  if (summary.attitude_available && std::isfinite(summary.attitude_withheld_from_s)) {
+    fmt::print("  attitude: compared from t = {:.1f} s, withheld from t = {:.1f} s (both platforms flipped at once; "
+               "see the warning)\n",
+               summary.attitude_start_s, summary.attitude_withheld_from_s);
+  } else if (summary.attitude_available) {
     fmt::print("  attitude drift from t = {:.1f} s: {:.2f} deg/h with DriftLess, {:.2f} deg/h with the bias "
                "fixed at that start, {:.2f} deg/h uncorrected\n",
                summary.attitude_start_s, summary.drift_corrected_deg_per_h, summary.drift_fixed_deg_per_h,

@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "estimator/log.hpp"
+#include "estimator/numbers.hpp"
 #include "report/json.hpp"
 
 namespace driftless::cli {
@@ -30,6 +31,8 @@ const char* cause_key(est::HealthCause c) {
     case est::HealthCause::kLateLock: return "late_lock";
     case est::HealthCause::kSignalChainLag: return "signal_chain_lag";
     case est::HealthCause::kSaturation: return "saturation";
+    case est::HealthCause::kAttitudeWithheld: return "attitude_withheld";
+    case est::HealthCause::kDeadAxis: return "dead_axis";
     case est::HealthCause::kPaperRestAngles: return "paper_rest_angles";
     case est::HealthCause::kPaperSchedule: return "paper_schedule";
   }
@@ -56,6 +59,11 @@ std::string component_names(const std::vector<int>& components) {
 std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cfg) {
   switch (f.cause) {
     case est::HealthCause::kNoUpdate:
+      if (f.suggested > 0.5) {
+        return fmt::format("no standstill became an update: {:.1f} % of the rows lack a gyro value and were "
+                           "skipped (a dead axis or an empty column: see the findings above, or 'driftless check')",
+                           100.0 * f.suggested);
+      }
       return "no standstill became an update: the platforms never rested for min_standstill_s "
              "(or the angle columns are empty); check plat1_deg/plat2_deg or set standstill: gyro";
     case est::HealthCause::kAllRejected:
@@ -67,6 +75,12 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
                          f.suggested > 0.02 ? fmt::format("the gate rejected {:.0f} % of the updates, so the flips "
                                                           "that observe them were not used (see below)",
                                                           100.0 * f.suggested)
+                                            : !f.positions_deg.empty()
+                                                  ? fmt::format("the platforms only rested at {}: each flipped "
+                                                                "with the other, so the positions between never "
+                                                                "occurred; flip one platform at a time (eq. (5): "
+                                                                "(+,+) (+,-) (-,-) (-,+))",
+                                                                position_text(f.positions_deg))
                                             : cfg.self_calibration && !cfg.box_at_rest
                                                   ? "in self-calibrating mode a g-sensitivity that keeps its sign "
                                                     "about the box vertical looks like a bias common to both "
@@ -159,6 +173,25 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
                                "and the biases from this log cannot be trusted"
                              : ", also in a few standstills, which measure the rail there");
     }
+    case est::HealthCause::kDeadAxis: {
+      const int c = f.components.empty() ? 0 : f.components.front();
+      const std::string name(log::gyro_column_name(c));
+      if (std::isnan(f.value)) {
+        return fmt::format("{} is empty (no value) in all {:g} rows: a dead axis, or a column the logger did not "
+                           "fill; every row was skipped. Check the sensor and the column names in the header",
+                           name, f.suggested);
+      }
+      return fmt::format("{} reads {} deg/s in every one of the {:g} rows while the other axes of its sensor "
+                         "move: a dead or stuck axis, whose standstills measure that value, not the rate; the "
+                         "biases from this log cannot be trusted. Check the sensor",
+                         name, exact_number(f.value), f.suggested);
+    }
+    case est::HealthCause::kAttitudeWithheld:
+      return fmt::format("attitude withheld from t = {:.2f} s: {:g} flip(s) moved both platforms at once, and with "
+                         "'standstill: gyro' no sensor then reads the box rate alone (the biases are not affected); "
+                         "flip one platform at a time, or log the platform angles (plat1_deg, plat2_deg) and use "
+                         "'standstill: platform'",
+                         f.value, f.suggested);
   }
   return "?";
 }

@@ -227,7 +227,8 @@ void write_estimate_summary(const fs::path& path, const SummaryContext& ctx, con
       s.counters.flip_updates, s.counters.flip_rejected,
       json_number(flips_ok > 0 ? s.counters.flip_nis_sum / double(flips_ok) : kNaN), s.counters.flip_clipped);
   add("  \"locked_from_t_s\": {}, \"rows_locked\": {},\n", json_number(s.locked_from_t_s), s.samples_locked);
-  add("  \"attitude_start_s\": {},\n", json_number(s.attitude_start_s));
+  add("  \"attitude_start_s\": {}, \"attitude_withheld_from_s\": {},\n", json_number(s.attitude_start_s),
+      json_number(s.attitude_withheld_from_s));
   add("  \"attitude_drift_deg_per_h\": {{\"with_driftless\": {}, \"bias_fixed_at_start\": {}, "
       "\"without_driftless\": {}}},\n",
       json_number(s.drift_corrected_deg_per_h), json_number(s.drift_fixed_deg_per_h),

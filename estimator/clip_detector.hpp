@@ -20,6 +20,15 @@ struct ClippedChannel {
   std::uint64_t samples_at_rest = 0;  // of those, while both platforms rested (or unknown)
 };
 
+/// A channel with no information: empty (NaN) in every row, or one value in every row while
+/// another channel of the same sensor varies (a dead axis, a column-name typo, a stuck register).
+struct DeadChannel {
+  enum class Kind { kEmpty, kStuck } kind = Kind::kEmpty;
+  int channel = 0;               // 0..5 = gyro1_x .. gyro2_z
+  double value_dps = 0.0;        // kStuck: the one value it reads
+  std::uint64_t rows = 0;        // rows seen
+};
+
 /// Watches the six gyro channels sample by sample (constant memory, a few compares a sample).
 class ClipDetector {
  public:
@@ -38,6 +47,10 @@ class ClipDetector {
   void push(int channel, double v_dps, bool platforms_resting);
   /// The channels whose largest |reading| came in runs, in channel order.
   std::vector<ClippedChannel> suspected() const;
+  /// Rows a stuck channel needs before it is reported (a short log may hold one rate exactly).
+  static constexpr std::uint64_t kMinStuckRows = 100;
+  /// The dead channels (DeadChannel), in channel order; `channels`: 3 (one sensor) or 6.
+  std::vector<DeadChannel> dead(int channels = 6) const;
 
  private:
   struct Channel {
@@ -47,6 +60,9 @@ class ClipDetector {
     std::uint64_t plateau = 0;  // samples in runs >= kMinRun at max_abs_dps
     std::uint64_t plateau_at_rest = 0;
     int run_at_rest = 0;        // of the current run, samples with the platforms at rest
+    std::uint64_t rows = 0, finite = 0;
+    double first_dps = std::numeric_limits<double>::quiet_NaN();  // first finite reading
+    bool varies = false;        // a finite reading other than the first
   };
   std::array<Channel, 6> ch_{};
 };

@@ -656,6 +656,7 @@ void DriftlessFilter::fuse_rate(const Sample& s, const StandstillStep& st) {
   out_.plat1_deg = st.plat1_deg;
   out_.plat2_deg = st.plat2_deg;
   out_.at_rest = st.plat1_rest && st.plat2_rest && finite(st.plat1_deg) && finite(st.plat2_deg);
+  out_.both_moving = st.both_moving;
   Eigen::Vector3d sum = Eigen::Vector3d::Zero(), raw = Eigen::Vector3d::Zero(),
                   fixed = Eigen::Vector3d::Zero();
   int n = 0;
@@ -667,14 +668,14 @@ void DriftlessFilter::fuse_rate(const Sample& s, const StandstillStep& st) {
     const Eigen::Vector3d& a = i == 1 ? box_.hinge1_axis : box_.hinge2_axis;
     return y + kRadPerDeg * x(stop_index(i, deg)) * a.normalized().cross(y);
   };
-  if (st.plat1_rest && finite(st.plat1_deg)) {
+  if (st.plat1_rest && !st.plat1_starting && finite(st.plat1_deg)) {
     const Eigen::Matrix3d M1 = body_from_sensor(1, st.plat1_deg);
     sum += M1 * turned(1, st.plat1_deg, out_.y1c_dps);
     raw += M1 * s.gyro1_dps;
     fixed += M1 * (s.gyro1_dps - fixed_bias_.segment<3>(kBias1.start));
     ++n;
   }
-  if (st.plat2_rest && finite(st.plat2_deg)) {
+  if (st.plat2_rest && !st.plat2_starting && finite(st.plat2_deg)) {
     const Eigen::Matrix3d M2 = body_from_sensor(2, st.plat2_deg);
     sum += M2 * turned(2, st.plat2_deg, out_.y2c_dps);
     raw += M2 * s.gyro2_dps;
@@ -734,6 +735,7 @@ PushStatus DriftlessFilter::push_corrected(const Sample& s) {
     if (r != 0) result = r;
   }
   counters_.standstills_too_short = standstill_.too_short();
+  counters_.simultaneous_flips = standstill_.simultaneous_flips();
   if (result != 0) {
     out_.status = result > 0 ? PushStatus::kUpdated : PushStatus::kRejected;
     // the update referred the bias to the standstill's mean temperatures; refer it to this
@@ -881,6 +883,10 @@ void DriftlessFilter::use_flip() {
   fm.moving = errors_of(m);
   fm.rest = errors_of(r);
   fm.use_g = has_gsens_states();
+  if (fm.use_g) {
+    fm.g_var_dps2_per_g2 = P_.diagonal().segment<18>(kGSens1.start).maxCoeff() +
+                           x_.segment<18>(kGSens1.start).cwiseAbs2().maxCoeff();
+  }
   const double n = double(flips_.samples().size());
   const double rate_hz = n / (flips_.t_end_s() - flips_.t_start_s());
   fm.sample_var_dps2 = cfg_.sample_variance_dps2(std::isfinite(box_.sample_rate_hz) ? box_.sample_rate_hz : rate_hz);
@@ -892,7 +898,7 @@ void DriftlessFilter::use_flip() {
   Eigen::Matrix<double, 3, kFullStateDim> H = Eigen::Matrix<double, 3, kFullStateDim>::Zero();
   H.block<3, 3>(0, at(kBias1, m, 3)) = fr.H_b_moving;
   H.block<3, 3>(0, at(kBias1, r, 3)) = fr.H_b_rest;
-  if (has_gsens_states()) {
+  if (has_gsens_states() && fr.g_columns) {
     H.block<3, 9>(0, at(kGSens1, m, 9)) = fr.H_G_moving;
     H.block<3, 9>(0, at(kGSens1, r, 9)) = fr.H_G_rest;
   }

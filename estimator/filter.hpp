@@ -106,6 +106,8 @@ struct SampleOutput {
   // the residual of eq. (2) is valid for this sample (fault detection watches it)
   double plat1_deg = kNaN, plat2_deg = kNaN;
   bool at_rest = false;
+  // standstill: gyro: both platforms move, no sensor reads the box rate alone (rate_body NaN)
+  bool both_moving = false;
   PushStatus status = PushStatus::kInvalid;
 };
 
@@ -117,6 +119,7 @@ struct FilterCounters {
   std::uint64_t updates = 0;
   std::uint64_t rejected = 0;
   std::uint64_t standstills_too_short = 0;
+  std::uint64_t simultaneous_flips = 0;  // standstill: gyro: flips of both platforms at once
   std::uint64_t schedule_mismatches = 0;  // paper mode: measured positions differ from eq. (5)
   // paper mode: standstills with both angles read, and those where a platform rested more than
   // calibration.match_tolerance_deg from +-flip_angle_deg (the angles eq. (5) builds H from); the first

@@ -120,10 +120,11 @@ FlipRows flip_rows(const FlipWindow& w, const FlipModel& m) {
   const auto fs = [m1](const FlipSample& k) -> Eigen::Vector3d { return (m1 ? k.accel2_mps2 : k.accel1_mps2) / kStandardGravityMps2; };
   // pass 1: the turn about the hinge relative to the box, from the gyros (the box's own rate
   // about the hinge, a^T C u_s, does not depend on the platform angle: Rot(a, δ) keeps a)
+  // G f needs the specific force of every sample; without it G is left out of the rows
+  const bool use_g = m.use_g && std::all_of(buf.begin(), buf.end(), accel_ok);
   double turn_deg = 0.0;
   for (const FlipSample& k : buf) {
-    if (m.use_g && !accel_ok(k)) return out;
-    const Eigen::Vector3d um = corrected(m.moving, ym(k), fm(k), m.use_g), us = corrected(m.rest, ys(k), fs(k), m.use_g);
+    const Eigen::Vector3d um = corrected(m.moving, ym(k), fm(k), use_g), us = corrected(m.rest, ys(k), fs(k), use_g);
     turn_deg += (a.dot(um) - a.dot(C0 * us)) * k.dt_s;
   }
   if (!(turn_deg * dtheta_deg > 0.0) || std::fabs(dtheta_deg / turn_deg - 1.0) > 0.2) return out;
@@ -135,7 +136,7 @@ FlipRows flip_rows(const FlipWindow& w, const FlipModel& m) {
   Eigen::Matrix3d S_b = Eigen::Matrix3d::Zero();
   Eigen::Vector3d F_m = Eigen::Vector3d::Zero(), W_c = Eigen::Vector3d::Zero();
   for (const FlipSample& k : buf) {
-    const Eigen::Vector3d um = corrected(m.moving, ym(k), fm(k), m.use_g), us = corrected(m.rest, ys(k), fs(k), m.use_g);
+    const Eigen::Vector3d um = corrected(m.moving, ym(k), fm(k), use_g), us = corrected(m.rest, ys(k), fs(k), use_g);
     const double step_deg = (a.dot(um) - a.dot(C0 * us)) * k.dt_s;
     jump_deg = std::max(jump_deg, std::fabs(step_deg - prev_step_deg));
     prev_step_deg = step_deg;
@@ -143,7 +144,7 @@ FlipRows flip_rows(const FlipWindow& w, const FlipModel& m) {
     delta_deg += step_deg;
     out.z_deg += (ym(k) - C * ys(k)) * k.dt_s;
     S_b += C * k.dt_s;
-    if (m.use_g) {
+    if (use_g) {
       F_m += fm(k) * k.dt_s;
       out.H_G_rest -= matrix_error_jacobian(C, fs(k)) * k.dt_s;
     }
@@ -158,7 +159,8 @@ FlipRows flip_rows(const FlipWindow& w, const FlipModel& m) {
   out.H_stop_start = -a - kRadPerDeg * a.cross(W_c);
   out.H_b_moving = span_s * Eigen::Matrix3d::Identity();
   out.H_b_rest = -S_b;
-  if (m.use_g) out.H_G_moving = matrix_error_jacobian(Eigen::Matrix3d::Identity(), F_m);
+  if (use_g) out.H_G_moving = matrix_error_jacobian(Eigen::Matrix3d::Identity(), F_m);
+  out.g_columns = use_g;
   out.H_E_moving = matrix_error_jacobian(Eigen::Matrix3d::Identity(), dtheta_deg * a + W_c);
   // white noise of both sensors (C is a rotation), and each rest angle's reading error along the hinge
   out.R_deg2 = 2.0 * m.sample_var_dps2 * sum_dt2 * Eigen::Matrix3d::Identity() +
@@ -171,6 +173,11 @@ FlipRows flip_rows(const FlipWindow& w, const FlipModel& m) {
   const Eigen::Matrix3d across = Eigen::Matrix3d::Identity() - a * a.transpose();
   const double w_across_deg = (across * W_c).norm();
   out.R_deg2 += q_deg2 * a * a.transpose() + q_deg2 * (kRadPerDeg * w_across_deg) * (kRadPerDeg * w_across_deg) * across;
+  if (m.use_g && !use_g) {
+    // G_m F_m - sum C G_s f_s dt with f unread, |f| <= 1 g: per axis var(sum_j G_ij F_j) =
+    // var(G) |F|^2 <= var(G) T^2 (g s)^2 for each sensor
+    out.R_deg2 += 2.0 * m.g_var_dps2_per_g2 * span_s * span_s * Eigen::Matrix3d::Identity();
+  }
   out.span_s = span_s;
   out.valid = out.z_deg.allFinite();
   return out;

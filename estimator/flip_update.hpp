@@ -83,7 +83,10 @@ struct FlipModel {
   Eigen::Vector3d hinge_box;       // the moving platform's hinge axis, box axes (unit)
   Eigen::Vector3d hinge_rest_box = Eigen::Vector3d::UnitX();  // the resting platform's, box axes
   SensorErrors moving, rest;       // the estimate (the profile and the E regressor use it)
-  bool use_g = false;              // g-sensitivity states: need the accel columns
+  bool use_g = false;              // g-sensitivity states: their columns need the accel columns
+  // (deg/s per g)^2: the uncertainty of each g-sensitivity element (its sigma^2 plus its estimate^2).
+  // A window without accel samples is used without the G columns; G f, |f| <= 1 g, then enters R
+  double g_var_dps2_per_g2 = 0.0;
   double sample_var_dps2 = 0.0;    // white-noise variance of one sample, per axis, (deg/s)^2
   double angle_sigma_deg = 0.0;    // 1 sigma of each rest-angle reading, deg
 };
@@ -108,6 +111,7 @@ struct FlipRows {
   Eigen::Vector3d H_stop_rest = Eigen::Vector3d::Zero();
   Eigen::Matrix3d R_deg2 = Eigen::Matrix3d::Zero();
   double span_s = 0.0;  // s, the window's length T
+  bool g_columns = false;  // H_G_* filled (use_g and every sample had accel); else G f is in R
 };
 
 /// Whether a gyro clipped inside the flip window: a channel whose largest |reading| in it comes in
@@ -115,8 +119,9 @@ struct FlipRows {
 /// integrated turn then falls short of the flip, so the flip is no measurement of E.
 bool flip_clipped(const FlipWindow& w);
 
-/// Builds the flip measurement; invalid when the window is not a clean flip (accel missing with
-/// `use_g`, the gyro-integrated turn more than 20 % off the angle change or of the other sign).
+/// Builds the flip measurement; invalid when the window is not a clean flip (the gyro-integrated
+/// turn more than 20 % off the angle change or of the other sign). With `use_g` and a sample
+/// without accel the G columns are left out and G f's variance goes into R (g_columns false).
 FlipRows flip_rows(const FlipWindow& w, const FlipModel& m);
 
 }  // namespace driftless::est

@@ -76,6 +76,32 @@ void add_saturation_findings(HealthReport& h, const std::vector<ClippedChannel>&
   put_first(h, std::move(first));
 }
 
+void add_dead_axis_findings(HealthReport& h, const std::vector<DeadChannel>& dead) {
+  if (dead.empty()) return;
+  HealthReport first;
+  for (const DeadChannel& d : dead) {
+    HealthFinding f;
+    f.cause = HealthCause::kDeadAxis;
+    f.severity = HealthVerdict::kFailed;
+    f.value = d.kind == DeadChannel::Kind::kStuck ? d.value_dps : kNaN;
+    f.suggested = double(d.rows);
+    f.components = {d.channel};
+    add(first, std::move(f));
+  }
+  for (HealthFinding& f : h.findings) first.findings.push_back(std::move(f));
+  h.findings = std::move(first.findings);
+  h.verdict = HealthVerdict::kFailed;
+}
+
+void add_attitude_withheld_finding(HealthReport& h, double t_s, std::uint64_t flips) {
+  if (!std::isfinite(t_s)) return;
+  HealthFinding f;
+  f.cause = HealthCause::kAttitudeWithheld;
+  f.value = t_s;
+  f.suggested = double(flips);
+  add(h, std::move(f));
+}
+
 const char* to_string(HealthVerdict v) {
   switch (v) {
     case HealthVerdict::kOk: return "ok";
@@ -161,6 +187,25 @@ void HealthMonitor::add_nis_findings(HealthReport& h) const {
   add(h, f);
 }
 
+// the position pairs of the updates, when each platform rested on both sides yet some pair of
+// sides never occurred (both platforms flipped together): eq. (2) then never separates the
+// components that one platform's flip alone would; empty otherwise
+std::vector<std::array<double, 2>> HealthMonitor::positions_if_never_apart() const {
+  bool seen[2][2] = {{false, false}, {false, false}};  // [plat1 >= 0][plat2 >= 0]
+  std::vector<std::array<double, 2>> pairs;
+  for (const auto& [key, pc] : by_position_) {
+    const double p1 = double(key.first) / 10.0, p2 = double(key.second) / 10.0;
+    if (!std::isfinite(p1) || !std::isfinite(p2) || std::fabs(p1) > 1e6 || std::fabs(p2) > 1e6) continue;
+    seen[p1 >= 0.0][p2 >= 0.0] = true;
+    pairs.push_back({p1, p2});
+  }
+  const bool both_sides1 = (seen[0][0] || seen[0][1]) && (seen[1][0] || seen[1][1]);
+  const bool both_sides2 = (seen[0][0] || seen[1][0]) && (seen[0][1] || seen[1][1]);
+  const bool all = seen[0][0] && seen[0][1] && seen[1][0] && seen[1][1];
+  if (!both_sides1 || !both_sides2 || all) pairs.clear();
+  return pairs;
+}
+
 // never locked (failed) and the components that kept their prior sigma
 void HealthMonitor::add_lock_findings(HealthReport& h, const DriftlessFilter& filter, double duration_s) const {
   const EstimatorConfig& cfg = filter.config();
@@ -178,6 +223,12 @@ void HealthMonitor::add_lock_findings(HealthReport& h, const DriftlessFilter& fi
               : h.rejected == h.updates ? HealthCause::kAllRejected : HealthCause::kNeverLocked;
     f.value = filter.correction_sigma_dps().maxCoeff();  // what locking waits for
     f.suggested = h.rejected_fraction;  // rejections may be why the flips did not observe them
+    if (f.cause == HealthCause::kNeverLocked) f.positions_deg = positions_if_never_apart();
+    if (f.cause == HealthCause::kNoUpdate) {
+      // rows skipped for a missing gyro value come before "the platforms never rested"
+      const FilterCounters& c = filter.counters();
+      f.suggested = c.samples > 0 ? double(c.invalid) / double(c.samples) : 0.0;
+    }
     f.components = h.unobservable;
     add(h, f);
     return;

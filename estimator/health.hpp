@@ -38,6 +38,10 @@ enum class HealthCause {
   kLateLock,             // locked, but too few accepted updates after the lock to check the NIS
   kSignalChainLag,       // the residual follows the box's angular acceleration: one sensor reads late
   kSaturation,           // a gyro channel repeats its largest reading in runs: it clips there
+  kDeadAxis,             // a gyro channel empty in every row, or one value throughout (components:
+                         // the channel; value: its value if stuck, NaN if empty; suggested: rows)
+  kAttitudeWithheld,     // standstill: gyro: both platforms flipped at once, no sensor read the box
+                         // rate (value: from when, s; suggested: how many such flips)
   kPaperRestAngles,      // paper mode: the platforms rest away from +-flip_angle_deg (eq. (5)'s H)
   kPaperSchedule,        // paper mode: the positions did not follow eq. (5)'s sequence
 };
@@ -47,13 +51,16 @@ struct HealthFinding {
   HealthCause cause = HealthCause::kNoUpdate;
   HealthVerdict severity = HealthVerdict::kDegraded;  // kOk = a note that leaves the verdict
   double value = kNaN;        // the measured quantity (fraction, NIS mean, ...; kLoneRejection: its NIS)
-  double suggested = kNaN;    // kNoiseUnder/Overstated: nis_mean / dof, the factor by which the
+  double suggested = kNaN;    // kNoUpdate: the fraction of rows without a gyro value (skipped);
+                              // kNoiseUnder/Overstated: nis_mean / dof, the factor by which the
                               // innovation variance exceeds (or falls short of) what S predicts;
                               // kNeverLocked: the rejected fraction; kLoneRejection: its time, s;
                               // kLateLock: the accepted updates after the lock (value: lock time, s);
                               // kSignalChainLag: update_excess (value: the lag, s; sigma: its sigma)
   double sigma = kNaN;
-  // kRejectionsAtPosition: the (plat1, plat2) angle pairs (deg) where most updates were rejected
+  // kRejectionsAtPosition: the (plat1, plat2) angle pairs (deg) where most updates were rejected;
+  // kNeverLocked: the pairs that occurred, when both platforms rested on both sides but some
+  // pair of sides never came (they flipped together); empty otherwise
   std::vector<std::array<double, 2>> positions_deg;
   std::vector<int> components;  // kUnobservable: 0..5 = b1_x .. b2_z; kSaturation: the channel
                                 // (0..5 = gyro1_x .. gyro2_z), value: the fraction of the rows
@@ -112,6 +119,14 @@ inline constexpr double kSaturationFailedFraction = 0.01;
 /// is their cause) and sets the verdict; `rows` is the log's row count.
 void add_saturation_findings(HealthReport& h, const std::vector<ClippedChannel>& clipped, std::uint64_t rows);
 
+/// Puts a failed `dead_axis` finding for each dead gyro channel ahead of the other findings (a
+/// dead channel makes every row invalid, or every standstill wrong on that axis: it is their cause).
+void add_dead_axis_findings(HealthReport& h, const std::vector<DeadChannel>& dead);
+
+/// 'standstill: gyro' and `flips` flips of both platforms at once, the first inside the attitude
+/// comparison at `t_s`: the attitude from there on is withheld (degraded; the biases stand).
+void add_attitude_withheld_finding(HealthReport& h, double t_s, std::uint64_t flips);
+
 /// Paper mode builds H from eq. (5)'s positions, +-flip_angle_deg in its fixed order: standstills
 /// that rested elsewhere or out of that order are findings ahead of the others (their cause),
 /// `failed` when at least half of the standstills are off (most updates used an H that is not the
@@ -135,6 +150,7 @@ class HealthMonitor {
   void add_gate_findings(HealthReport& h) const;
   void add_nis_findings(HealthReport& h) const;
   void add_lock_findings(HealthReport& h, const DriftlessFilter& filter, double duration_s) const;
+  std::vector<std::array<double, 2>> positions_if_never_apart() const;
 
   HealthLimits limits_;
   bool locked_ = false;

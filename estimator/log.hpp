@@ -63,6 +63,11 @@ class Metadata {
   Eigen::Vector3d hinge2_axis() const { return get_vector3("hinge2_axis", Eigen::Vector3d::UnitX()); }
   /// The gyro full scale the log states (deg/s), else kDefaultGyroFullScaleDps.
   double gyro_full_scale_dps() const { return get_number("gyro_full_scale_dps", kDefaultGyroFullScaleDps); }
+  /// The key that states sensor `sensor`'s (1 or 2) full scale: gyro1_/gyro2_full_scale_dps when
+  /// present (two unlike gyros), else the shared gyro_full_scale_dps; empty when neither is there.
+  std::string_view gyro_full_scale_key(int sensor) const;
+  /// Sensor `sensor`'s full scale (deg/s): its own key, else the shared one, else the default.
+  double gyro_full_scale_dps(int sensor) const;
   /// 1 for the single-sensor form ('sensors: 1'), else 2.
   int sensors() const;
 
@@ -202,6 +207,8 @@ class LogReader {
   /// Channels that repeat their largest |reading| in runs: suspected clipping, stated full scale
   /// or not (estimator/clip_detector.hpp).
   std::vector<est::ClippedChannel> suspected_clipping() const { return clip_.suspected(); }
+  /// Gyro channels empty in every row, or stuck at one value (estimator/clip_detector.hpp).
+  std::vector<est::DeadChannel> dead_channels() const { return clip_.dead(sensors() == 1 ? 3 : 6); }
   /// "file:line" for messages.
   std::string where() const;
   const std::filesystem::path& path() const { return path_; }
@@ -241,8 +248,10 @@ class LogReader {
   double gap_threshold_s_ = kGapMinS;
   bool rate_stated_ = false;
   double min_dt_s_ = std::numeric_limits<double>::infinity();  // s, shortest interval so far
-  double gyro_limit_dps_ = kFullScaleMargin * kDefaultGyroFullScaleDps;
-  double full_scale_dps_ = kNaN;  // stated full scale (NaN: none stated, no saturation count)
+  // per sensor: the plausibility bound and the stated full scale (NaN: none stated, no saturation count)
+  std::array<double, 2> gyro_limit_dps_{kFullScaleMargin * kDefaultGyroFullScaleDps,
+                                        kFullScaleMargin * kDefaultGyroFullScaleDps};
+  std::array<double, 2> full_scale_dps_{kNaN, kNaN};
   std::uint64_t rows_ = 0;
   std::uint64_t missing_gyro_rows_ = 0;
   std::uint64_t saturated_rows_ = 0;

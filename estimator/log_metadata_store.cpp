@@ -45,7 +45,7 @@ struct KeyRule {
 };
 
 // the standard keys and their valid values; other keys are provenance text, kept and not read
-constexpr std::array<KeyRule, 9> kKeyRules = {{
+constexpr std::array<KeyRule, 11> kKeyRules = {{
     {"format", Kind::kFormat, 0, 0, false, "'driftless-log 1'"},
     {"complete", Kind::kBool, 0, 0, false, "'true' or 'false'"},
     {"sample_rate_hz", Kind::kNumber, 0.0, 1e6, true, "a sample rate in Hz, > 0 and <= 1e6"},
@@ -53,6 +53,8 @@ constexpr std::array<KeyRule, 9> kKeyRules = {{
     {"hinge1_axis", Kind::kAxis, 0, 0, false, "three finite numbers 'x y z', not all zero"},
     {"hinge2_axis", Kind::kAxis, 0, 0, false, "three finite numbers 'x y z', not all zero"},
     {"gyro_full_scale_dps", Kind::kNumber, 0.0, 1e5, true, "a gyro full scale in deg/s, > 0 and <= 1e5"},
+    {"gyro1_full_scale_dps", Kind::kNumber, 0.0, 1e5, true, "a gyro full scale in deg/s, > 0 and <= 1e5"},
+    {"gyro2_full_scale_dps", Kind::kNumber, 0.0, 1e5, true, "a gyro full scale in deg/s, > 0 and <= 1e5"},
     {"sensors", Kind::kSensors, 0, 0, false, "1 (single-sensor form) or 2"},
     {"duration_s", Kind::kNumber, 0.0, 1e12, false, "a duration in s, >= 0"},
 }};
@@ -164,6 +166,17 @@ Eigen::Vector3d Metadata::get_vector3(std::string_view key, const Eigen::Vector3
 bool Metadata::complete() const {
   const std::string* v = find("complete");
   return v == nullptr || trim(*v) == "true";
+}
+
+std::string_view Metadata::gyro_full_scale_key(int sensor) const {
+  const std::string_view own = sensor == 1 ? "gyro1_full_scale_dps" : "gyro2_full_scale_dps";
+  if (has(own)) return own;
+  return has("gyro_full_scale_dps") ? std::string_view("gyro_full_scale_dps") : std::string_view();
+}
+
+double Metadata::gyro_full_scale_dps(int sensor) const {
+  const std::string_view key = gyro_full_scale_key(sensor);
+  return key.empty() ? kDefaultGyroFullScaleDps : get_number(key, kDefaultGyroFullScaleDps);
 }
 
 int Metadata::sensors() const {

@@ -74,8 +74,11 @@ LogReader::LogReader(const std::filesystem::path& path, ReaderOptions opts) : pa
   const double rate = meta_.sample_rate_hz();
   rate_stated_ = std::isfinite(rate);
   gap_threshold_s_ = rate_stated_ ? std::max(kGapMinS, kGapIntervals / rate) : kGapMinS;
-  gyro_limit_dps_ = kFullScaleMargin * meta_.gyro_full_scale_dps();
-  if (meta_.has("gyro_full_scale_dps")) full_scale_dps_ = meta_.gyro_full_scale_dps();
+  for (int sensor = 1; sensor <= 2; ++sensor) {
+    const std::size_t i = static_cast<std::size_t>(sensor - 1);
+    gyro_limit_dps_[i] = kFullScaleMargin * meta_.gyro_full_scale_dps(sensor);
+    if (!meta_.gyro_full_scale_key(sensor).empty()) full_scale_dps_[i] = meta_.gyro_full_scale_dps(sensor);
+  }
 }
 
 LogReader::~LogReader() = default;
@@ -287,7 +290,11 @@ void LogReader::check_row(const Sample& s) {
   if (!std::isfinite(s.t_s)) fail("column 't': expected a time in seconds, got an empty or non-finite value");
   if (!(s.t_s > last_t_)) {
     fail("t = " + time_text(s.t_s) + " s is not greater than the previous t = " + time_text(last_t_) +
-         " s (time must increase strictly)");
+         " s (time must increase strictly): " +
+         (s.t_s == last_t_ ? std::string("a logger that stamped two rows alike? drop the repeated row, or re-stamp it "
+                                         "(the previous t plus one sample interval)")
+                           : std::string("rows out of order, or a clock that jumped back? sort the rows by t, or "
+                                         "split the log where the clock restarted")));
   }
   if (rows_ > 0) {
     const double dt = s.t_s - last_t_;
@@ -312,15 +319,19 @@ void LogReader::check_row(const Sample& s) {
       continue;
     }
     const double a = std::fabs(v);
-    if (!(a <= gyro_limit_dps_)) {
+    const int sensor = i < 3 ? 1 : 2;
+    const std::size_t si = static_cast<std::size_t>(sensor - 1);
+    if (!(a <= gyro_limit_dps_[si])) {
+      const std::string_view key = meta_.gyro_full_scale_key(sensor);
       fail(std::string("column '") + std::string(gyro_column_name(i)) + "': " + number_text(v) +
            " deg/s is beyond " + number_text(kFullScaleMargin) + " x the gyro full scale of " +
-           number_text(meta_.gyro_full_scale_dps()) + " deg/s" +
-           (meta_.has("gyro_full_scale_dps") ? " stated in gyro_full_scale_dps"
-                                              : " assumed without a gyro_full_scale_dps key") +
-           "; not a reading a gyro can give (see docs/log-format.md)");
+           number_text(meta_.gyro_full_scale_dps(sensor)) + " deg/s" +
+           (!key.empty() ? " stated in " + std::string(key)
+                         : std::string(" assumed without a gyro_full_scale_dps key")) +
+           "; not a reading a gyro can give (two unlike gyros: gyro1_full_scale_dps / gyro2_full_scale_dps; "
+           "see docs/log-format.md)");
     }
-    saturated = saturated || a >= full_scale_dps_;
+    saturated = saturated || a >= full_scale_dps_[si];
   }
   missing_gyro_rows_ += missing ? 1 : 0;
   saturated_rows_ += saturated ? 1 : 0;

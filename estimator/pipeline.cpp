@@ -198,6 +198,24 @@ void add_attitude_results(const AttitudeComparison& att, const DriftlessFilter& 
   }
 }
 
+// 'standstill: gyro' and a flip of both platforms at once after the comparison began: during it
+// neither sensor read the box rate, so the attitude from there on is not known; the figures that
+// span it are withheld (the points before it, in attitude.csv, stand)
+void withhold_attitude(const DriftlessFilter& filter, EstimateSummary& sum) {
+  if (std::isnan(sum.attitude_withheld_from_s)) return;
+  sum.drift_corrected_deg_per_h = sum.drift_raw_deg_per_h = sum.drift_fixed_deg_per_h = kNaN;
+  sum.drift_net_corrected_deg_per_h = sum.drift_net_raw_deg_per_h = sum.drift_net_fixed_deg_per_h = kNaN;
+  AttitudeError none;
+  none.roll_deg = none.pitch_deg = none.heading_deg = none.angle_deg = kNaN;
+  sum.final_corrected = sum.final_raw = sum.final_fixed = none;
+  sum.warnings.push_back(
+      "attitude withheld from t = " + std::to_string(sum.attitude_withheld_from_s) + " s: with 'standstill: gyro' " +
+      std::to_string(filter.counters().simultaneous_flips) +
+      " flip(s) moved both platforms at once, and while both turn neither sensor reads the box rate; "
+      "attitude.csv stops there and the drift figures are not given. Flip one platform at a time, or log the "
+      "platform angles (plat1_deg, plat2_deg)");
+}
+
 // after an update: is the correction locked (filter_locked at the lock level)? Records the first
 // lock, each gate re-lock and when the lock came back after it.
 // `t_s` is the time of the sample whose push made the update: the first row it corrects.
@@ -260,9 +278,13 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
     if (use_window) window.add(filter, s);
 
     // attitude: the comparison starts at the first finite ref_q once the filter has locked on
-    // (every bias sigma below attitude_start_sigma_dps)
+    // (every bias sigma below attitude_start_sigma_dps); it stops where no sensor reads the box
+    // rate (standstill: gyro, both platforms flipping at once)
+    if (filter.output().both_moving && att.started() && std::isnan(sum.attitude_withheld_from_s)) {
+      sum.attitude_withheld_from_s = s.t_s;
+    }
     AttitudePoint ap;
-    if (att.push(s, filter, ap)) {
+    if (std::isnan(sum.attitude_withheld_from_s) && att.push(s, filter, ap)) {
       sum.final_corrected = ap.corrected;
       sum.final_raw = ap.raw;
       sum.final_fixed = ap.fixed;
@@ -274,6 +296,12 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
 
   if (reader != nullptr) add_reader_warnings(*reader, sum);
   if (sum.rows == 0) sum.warnings.push_back("the log holds no rows");
+  if (filter.has_gsens_states() && (fields & kFieldAccel) == 0 && sum.rows > 0) {
+    sum.warnings.push_back(
+        "no accel columns: the g-sensitivity states (--selfcal) cannot be observed and keep their prior sigma; "
+        "the flip updates were made without them (their prior variance in R) and the box dwells, which need "
+        "the accelerometers, not at all. Log accel1_*/accel2_* to estimate G");
+  }
   sum.counters = filter.counters();
   add_filter_warnings(filter, sum);
   sum.bias_dps = filter.bias_dps();
@@ -295,20 +323,16 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
   sum.stop_angle_deg = filter.stop_angle_deg();
   sum.stop_angle_sigma_deg = filter.stop_angle_sigma_deg();
   add_attitude_results(att, filter, opt, sum);
-  if (cfg.standstill == StandstillSource::kGyroSignal && sum.attitude_available) {
-    // the flip's positions come from the detector, which sees a flip only once it is under way
-    // and snaps its end: the part of the hinge turn it misses enters the fused body rate
-    sum.warnings.emplace_back(
-        "attitude with 'standstill: gyro': during a flip the sensors' positions come from the gyro-signal "
-        "detector, not from angle read-back, so part of each hinge turn can enter the attitude (degrees per "
-        "flip seen at 1 kHz and on a turning box); the biases are not affected. For attitude, log the "
-        "platform angles (plat1_deg, plat2_deg) and use 'standstill: platform'");
-  }
+  withhold_attitude(filter, sum);
   score.finish();
   if (use_window) window.finish(filter);
   sum.health = health.finish(filter, sum.rows > 0 ? sum.t_last_s - sum.t_first_s : 0.0, lag.finish());
   if (cfg.mode == FilterMode::kPaper) add_paper_mode_findings(sum.health, filter.counters(), filter.geometry().flip_angle_deg);
-  if (reader != nullptr) add_saturation_findings(sum.health, reader->suspected_clipping(), reader->rows_read());
+  if (reader != nullptr) {
+    add_saturation_findings(sum.health, reader->suspected_clipping(), reader->rows_read());
+    add_dead_axis_findings(sum.health, reader->dead_channels());
+  }
+  add_attitude_withheld_finding(sum.health, sum.attitude_withheld_from_s, sum.counters.simultaneous_flips);
   return sum;
 }
 

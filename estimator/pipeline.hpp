@@ -137,6 +137,9 @@ struct EstimateSummary {
   double drift_net_fixed_deg_per_h = kNaN;
   double attitude_start_s = kNaN;                  // s, where the comparison started
   double attitude_realign_s = kNaN;                // s, where it was re-aligned (NaN: not)
+  // s, 'standstill: gyro': the comparison stopped at the first flip of both platforms at once (no
+  // sensor read the box rate); the drifts and final errors are withheld (NaN). NaN: not withheld
+  double attitude_withheld_from_s = kNaN;
   Vector6d fixed_bias_dps = Vector6d::Constant(kNaN);  // deg/s, the bias held by `fixed`
   AttitudeError final_corrected, final_raw, final_fixed;
   TruthStats truth;

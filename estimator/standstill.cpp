@@ -12,10 +12,9 @@ bool finite(double v) { return std::isfinite(v); }
 
 }  // namespace
 
-StandstillDetector::StandstillDetector(const EstimatorConfig& cfg, const BoxGeometry& box) : cfg_(cfg) {
+StandstillDetector::StandstillDetector(const EstimatorConfig& cfg, const BoxGeometry& box)
+    : cfg_(cfg), gyro_(box, cfg.gyro_motion_threshold_dps, cfg.initial_plat1_deg, cfg.initial_plat2_deg) {
   restart(box);
-  gyro_.p1 = cfg_.initial_plat1_deg;
-  gyro_.p2 = cfg_.initial_plat2_deg;
 }
 
 void StandstillDetector::restart(const BoxGeometry& box) {
@@ -24,8 +23,7 @@ void StandstillDetector::restart(const BoxGeometry& box) {
   seg_ = StandstillSegment{};
   prev_p1_ = prev_p2_ = kNaN;
   sched_start_s_ = kNaN;
-  gyro_.moving = false;
-  gyro_.have_base = false;
+  gyro_.restart(box);  // positions kept, motion and rest level re-learned
   n_closed_ = 0;
   // the end-margin ring, sized once (unknown rate: assume up to 1 kHz)
   const double rate = finite(box_.sample_rate_hz) ? box_.sample_rate_hz : 1000.0;
@@ -68,64 +66,6 @@ bool StandstillDetector::classify(const Sample& s, StandstillStep& st) {
   return st.plat1_rest && st.plat2_rest;
 }
 
-// gyro-only flip detection: |y1| - |y2| is independent of the box rate (rotations keep norms),
-// so a jump in it is a platform moving; the hinge-rate integral y_i . a_i says which and how far
-bool StandstillDetector::track_gyro_positions(const Sample& s, double dt_s, const Eigen::Vector3d& b1,
-                                              const Eigen::Vector3d& b2) {
-  const Eigen::Vector3d y1 = s.gyro1_dps - b1, y2 = s.gyro2_dps - b2;
-  const double d = y1.norm() - y2.norm();
-  const double h1 = y1.dot(box_.hinge1_axis), h2 = y2.dot(box_.hinge2_axis);
-  auto& g = gyro_;
-  if (!g.have_base) {
-    g.have_base = true;
-    g.d_base = d;
-    g.h1_base = h1;
-    g.h2_base = h2;
-    g.prev_d = d;
-    return true;
-  }
-  const double thr = cfg_.gyro_motion_threshold_dps;
-  if (!g.moving) {
-    if (std::fabs(d - g.d_base) > thr) {
-      g.moving = true;
-      g.turn1_deg = g.turn2_deg = 0.0;
-      g.quiet = 0;
-    } else {
-      // slow rest levels (time constant ~1 s)
-      const double a = std::min(1.0, finite(dt_s) ? dt_s / 1.0 : 0.01);
-      g.d_base += a * (d - g.d_base);
-      g.h1_base += a * (h1 - g.h1_base);
-      g.h2_base += a * (h2 - g.h2_base);
-    }
-  }
-  if (g.moving) {
-    if (finite(dt_s)) {
-      g.turn1_deg += (h1 - g.h1_base) * dt_s;
-      g.turn2_deg += (h2 - g.h2_base) * dt_s;
-    }
-    // the flip is over when the statistic stays steady for ~0.25 s
-    g.quiet = std::fabs(d - g.prev_d) < 0.2 * thr ? g.quiet + 1 : 0;
-    const double rate = finite(box_.sample_rate_hz) ? box_.sample_rate_hz : 100.0;
-    if (g.quiet >= std::max(3, static_cast<int>(0.25 * rate))) {
-      g.moving = false;
-      const double flip = box_.flip_angle_deg;
-      auto apply = [&](double& p, double turn) {
-        if (std::fabs(turn) < 0.5 * flip) return;
-        p += turn;
-        // snap to the nearest end position
-        p = std::fabs(p - flip) < std::fabs(p + flip) ? flip : -flip;
-      };
-      apply(g.p1, g.turn1_deg);
-      apply(g.p2, g.turn2_deg);
-      g.d_base = d;
-      g.h1_base = h1;
-      g.h2_base = h2;
-    }
-  }
-  g.prev_d = d;
-  return !g.moving;
-}
-
 void StandstillDetector::schedule_positions(const Sample& s, StandstillStep& st) {
   if (!finite(sched_start_s_)) sched_start_s_ = s.t_s;
   const std::int64_t tag = static_cast<std::int64_t>(std::floor((s.t_s - sched_start_s_) / cfg_.standstill_period_s));
@@ -148,10 +88,16 @@ StandstillStep StandstillDetector::push(const Sample& s, double dt_s, const Eige
       at_rest = classify(s, st);
       break;
     case StandstillSource::kGyroSignal:
-      at_rest = track_gyro_positions(s, dt_s, bias1_dps, bias2_dps);
-      st.plat1_deg = gyro_.p1;
-      st.plat2_deg = gyro_.p2;
-      st.plat1_rest = st.plat2_rest = at_rest;
+      gyro_.push(s.gyro1_dps, s.gyro2_dps, bias1_dps, bias2_dps, dt_s);
+      at_rest = gyro_.motion() == GyroFlipTracker::Motion::kRest;
+      st.plat1_deg = gyro_.position_deg(1);
+      st.plat2_deg = gyro_.position_deg(2);
+      // each platform on its own: the one that rests still gives the box rate during the other's flip
+      st.plat1_rest = gyro_.rest(1);
+      st.plat2_rest = gyro_.rest(2);
+      st.plat1_starting = gyro_.starting(1);
+      st.plat2_starting = gyro_.starting(2);
+      st.both_moving = gyro_.motion() == GyroFlipTracker::Motion::kBoth;
       break;
     case StandstillSource::kSchedule:
       schedule_positions(s, st);

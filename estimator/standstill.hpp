@@ -15,6 +15,7 @@
 #include "estimator/box_geometry.hpp"
 #include "estimator/config.hpp"
 #include "estimator/sample.hpp"
+#include "estimator/standstill_gyro.hpp"
 
 namespace driftless::est {
 
@@ -61,6 +62,11 @@ struct StandstillStep {
   double plat1_deg = kNaN, plat2_deg = kNaN;  // deg, positions in force (NaN = unknown)
   bool plat1_rest = false, plat2_rest = false;  // each platform at rest with a known angle
   int closed = 0;  // segments handed over by this sample (0..2), see StandstillDetector::closed()
+  // 'standstill: gyro': a platform at rest whose hinge rate has begun to rise (the start of a flip,
+  // below the motion threshold): its sensor is left out of the fused box rate
+  bool plat1_starting = false, plat2_starting = false;
+  // 'standstill: gyro': both platforms move at once, so no sensor reads the box rate alone
+  bool both_moving = false;
 };
 
 /// Streaming standstill detector. push() never throws.
@@ -88,6 +94,8 @@ class StandstillDetector {
   std::uint64_t too_short() const { return too_short_; }
   /// A standstill was discarded by the last push()/finish() (paper mode counts it as a step).
   bool discarded_last() const { return discarded_last_; }
+  /// 'standstill: gyro': flips in which both platforms moved at once, since construction.
+  std::uint64_t simultaneous_flips() const { return gyro_.simultaneous_flips(); }
   /// Sample rate used for durations, Hz (the geometry's, else measured from the segment).
   double rate_hz(const StandstillSegment& seg) const;
 
@@ -97,7 +105,6 @@ class StandstillDetector {
     double temp1, temp2, t_s;
   };
   bool classify(const Sample& s, StandstillStep& st);
-  bool track_gyro_positions(const Sample& s, double dt_s, const Eigen::Vector3d& b1, const Eigen::Vector3d& b2);
   void schedule_positions(const Sample& s, StandstillStep& st);
   void start_segment(double t_s, double p1, double p2, std::int64_t tag);
   void end_standstill();
@@ -115,17 +122,7 @@ class StandstillDetector {
   std::size_t ring_head_ = 0, ring_count_ = 0, ring_capacity_ = 0;
   double prev_p1_ = kNaN, prev_p2_ = kNaN;
   double sched_start_s_ = kNaN;
-  // gyro-only position tracking
-  struct GyroTracker {
-    double p1 = 90.0, p2 = 90.0;          // deg, tracked positions
-    bool moving = false;
-    bool have_base = false;
-    double d_base = 0.0;                  // deg/s, rest level of |y1| - |y2|
-    double h1_base = 0.0, h2_base = 0.0;  // deg/s, rest level of y_i . a_i
-    double turn1_deg = 0.0, turn2_deg = 0.0;
-    double prev_d = 0.0;
-    int quiet = 0;
-  } gyro_;
+  GyroFlipTracker gyro_;  // positions from the gyros alone (standstill: gyro)
   std::array<StandstillSegment, 2> closed_{};
   int n_closed_ = 0;
   bool discarded_last_ = false;

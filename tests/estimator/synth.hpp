@@ -29,6 +29,7 @@ struct SynthParams {
   double flip_s = 1.0;          // s per flip
   double flip_angle_deg = 90.0;
   bool hold_platform2 = false;  // only platform 1 flips (two positions)
+  long both_at_cycle = -1;      // the flip ending this cycle moves both platforms (skips a position)
   bool nan_while_moving = false;  // end-stop hardware: angles empty while moving
   Eigen::Vector3d hinge1 = Eigen::Vector3d::UnitZ();
   Eigen::Vector3d hinge2 = Eigen::Vector3d::UnitX();
@@ -108,7 +109,7 @@ inline void synth_samples(const SynthParams& p, const std::function<void(const S
     const double in = t - c * cycle;
     // position index j = c; during the flip at the end of cycle c we move to j = c + 1
     auto angles = [&](long j, double& t1, double& t2) {
-      const int pj = static_cast<int>(j % 4);
+      const int pj = static_cast<int>((p.both_at_cycle >= 0 && j > p.both_at_cycle ? j + 1 : j) % 4);
       t1 = a * kS1[pj];
       t2 = p.hold_platform2 ? a : a * kS2[pj];
     };

@@ -125,5 +125,71 @@ TEST(HealthSaturation, AClipInsideTheStandstillsLeadsTheFindingsAndOneDuringFlip
   EXPECT_TRUE(ok.findings.empty());
 }
 
+TEST(ClipDetector, AnEmptyChannelAndOneStuckAtOneValueAreDeadOthersAreNot) {
+  // GIVEN 200 rows: gyro1_y empty throughout, gyro2_z stuck at 0.25 while gyro2_x and gyro2_y move,
+  // gyro1_x moving, gyro1_z a constant (its sensor has no other moving axis than gyro1_x)
+  ClipDetector d;
+  for (int k = 0; k < 200; ++k) {
+    const double moving = 0.01 * (k % 7);
+    d.push(0, moving, true);
+    d.push(1, std::nan(""), true);
+    d.push(2, 0.125, true);
+    d.push(3, moving, true);
+    d.push(4, -moving, true);
+    d.push(5, 0.25, true);
+  }
+  // THEN gyro1_y is empty and gyro2_z stuck at 0.25 ...
+  const auto dead = d.dead();
+  ASSERT_EQ(dead.size(), 3u);
+  EXPECT_EQ(dead[0].channel, 1);
+  EXPECT_EQ(dead[0].kind, DeadChannel::Kind::kEmpty);
+  EXPECT_EQ(dead[0].rows, 200u);
+  // ... and gyro1_z too: one value while gyro1_x moves
+  EXPECT_EQ(dead[1].channel, 2);
+  EXPECT_EQ(dead[1].kind, DeadChannel::Kind::kStuck);
+  EXPECT_EQ(dead[2].channel, 5);
+  EXPECT_EQ(dead[2].kind, DeadChannel::Kind::kStuck);
+  EXPECT_DOUBLE_EQ(dead[2].value_dps, 0.25);
+  // AND a single-sensor view looks at channels 0..2 only
+  EXPECT_EQ(d.dead(3).size(), 2u);
+}
+
+TEST(ClipDetector, AConstantSensorWithNothingMovingOrAShortLogIsNotDead) {
+  // GIVEN a noise-free box that never moves: every channel one value; and a log of 99 rows
+  ClipDetector still, shortlog;
+  for (int k = 0; k < 1000; ++k) {
+    for (int i = 0; i < 6; ++i) still.push(i, 0.1 * i, true);
+  }
+  for (int k = 0; k < int(ClipDetector::kMinStuckRows) - 1; ++k) {
+    shortlog.push(0, 0.01 * k, true);
+    shortlog.push(1, 0.5, true);
+  }
+  // THEN no channel is dead
+  EXPECT_TRUE(still.dead().empty());
+  EXPECT_TRUE(shortlog.dead(3).empty());
+}
+
+TEST(HealthDeadAxis, ADeadAxisLeadsTheFindingsAndFailsTheRun) {
+  // GIVEN an ok report with one note and a stuck gyro2_x
+  HealthReport h;
+  HealthFinding note;
+  note.cause = HealthCause::kNoiseOverstated;
+  note.severity = HealthVerdict::kOk;
+  h.findings.push_back(note);
+  add_dead_axis_findings(h, {{DeadChannel::Kind::kStuck, 3, 0.5, 1000}});
+  // THEN it fails, the dead axis first with its channel, value and rows
+  EXPECT_EQ(h.verdict, HealthVerdict::kFailed);
+  ASSERT_EQ(h.findings.size(), 2u);
+  EXPECT_EQ(h.findings[0].cause, HealthCause::kDeadAxis);
+  EXPECT_EQ(h.findings[0].components, std::vector<int>{3});
+  EXPECT_DOUBLE_EQ(h.findings[0].value, 0.5);
+  EXPECT_DOUBLE_EQ(h.findings[0].suggested, 1000.0);
+  EXPECT_EQ(h.findings[1].cause, HealthCause::kNoiseOverstated);
+  // AND with none the report is unchanged
+  HealthReport ok;
+  add_dead_axis_findings(ok, {});
+  EXPECT_EQ(ok.verdict, HealthVerdict::kOk);
+}
+
 }  // namespace
 }  // namespace driftless::est

@@ -151,6 +151,34 @@ TEST(FlipUpdateTest, FlipsObserveTheScaleAndMisalignmentAlongTheHinge) {
   }
 }
 
+// GIVEN the same static box with g-sensitivity in its readings but no accel columns in the log
+// (P13: the flips were dropped whole, 0 flip updates, no word)
+// WHEN the self-calibrating filter runs THEN the flips are used without the G columns, G f's
+// prior variance in R: the hinge columns of E are recovered within 3 sigma, sigma below a tenth of
+// the prior, no flip rejected; and every G element keeps its prior sigma (nothing observes it)
+TEST(FlipUpdateTest, FlipsWithoutAccelColumnsAreUsedWithoutTheGColumns) {
+  test::SynthParams p = flipping_box(10.0, 0.05);
+  p.body_rate_dps = nullptr;
+  p.write_accel_temp = false;
+  DriftlessFilter f(selfcal(true), test::synth_geometry(p));
+  test::synth_samples(p, [&](const Sample& s) { f.push(s); });
+  f.finish();
+  EXPECT_GT(f.counters().flip_updates, 20u);
+  EXPECT_EQ(f.counters().flip_rejected, 0u);
+  const double prior = selfcal(true).scale_misalign_sigma_frac;
+  const double g_prior = selfcal(true).gsens_sigma_dps_per_g;
+  for (int i = 1; i <= 2; ++i) {
+    const int hinge_col = i == 1 ? 2 : 0;
+    const Eigen::Matrix3d E = f.scale_misalign(i), S = f.scale_misalign_sigma(i);
+    for (int r = 0; r < 3; ++r) {
+      EXPECT_NEAR(E(r, hinge_col), p.E_frac[static_cast<std::size_t>(i - 1)](r, hinge_col), 3.0 * S(r, hinge_col))
+          << "E" << i << "(" << r << "," << hinge_col << ")";
+      EXPECT_LT(S(r, hinge_col), 0.1 * prior) << "E" << i << "(" << r << "," << hinge_col << ")";
+    }
+    EXPECT_GT(f.g_sensitivity_sigma_dps_per_g(i).minCoeff(), 0.99 * g_prior) << "G" << i;
+  }
+}
+
 // GIVEN the static box of the test above, flips of 180 deg in 1 s (a 283 deg/s peak), and sensor 1
 // clipping at +-260 deg/s, so its integrated turn falls about 5 deg short in each of its flips
 // WHEN the self-calibrating filter runs with flip updates, on the clipped log and on the same log

@@ -106,6 +106,34 @@ TEST(HealthTest, AFilterThatNeverLocksFailsAndNamesTheUnobservableComponents) {
   EXPECT_EQ(h.findings.front().components, h.unobservable);
 }
 
+TEST(HealthTest, PlatformsThatOnlyFlipTogetherAreNamedWithThePositionsThatOccurred) {
+  // GIVEN a filter that never locks, whose updates came at (90, 90) and (-90, -90) only (both
+  // platforms flipping together: each rested on both sides), and one whose platform 2 never
+  // left +90 (there the "flip both platforms" advice fits)
+  const test::SynthParams p = mpu_like(21);
+  const DriftlessFilter fresh(EstimatorConfig{}, test::synth_geometry(p));  // never updated
+  HealthMonitor together, one_only;
+  for (int k = 0; k < 8; ++k) {
+    UpdateRecord r;
+    r.t_s = 10.0 * k;
+    r.accepted = true;
+    r.dim = 3;
+    r.nis = 3.0;
+    r.plat1_deg = r.plat2_deg = k % 2 == 0 ? 90.0 : -90.0;
+    together.on_update(r, fresh);
+    r.plat2_deg = 90.0;
+    one_only.on_update(r, fresh);
+  }
+  const HealthReport h = together.finish(fresh, 80.0), h1 = one_only.finish(fresh, 80.0);
+  // THEN the never-locked finding carries the two pairs that occurred, the other one none
+  ASSERT_EQ(h.findings.front().cause, HealthCause::kNeverLocked);
+  ASSERT_EQ(h.findings.front().positions_deg.size(), 2u);
+  EXPECT_EQ(h.findings.front().positions_deg[0], (std::array<double, 2>{-90.0, -90.0}));
+  EXPECT_EQ(h.findings.front().positions_deg[1], (std::array<double, 2>{90.0, 90.0}));
+  ASSERT_EQ(h1.findings.front().cause, HealthCause::kNeverLocked);
+  EXPECT_TRUE(h1.findings.front().positions_deg.empty());
+}
+
 TEST(HealthTest, NoStandstillFails) {
   // GIVEN a log whose rests are shorter than min_standstill_s after the settle time
   auto p = mpu_like(14);

@@ -276,6 +276,44 @@ TEST(LogValidation, GyroBeyondTheFullScaleIsRefusedWithItsLine) {
             std::string::npos);
 }
 
+TEST(LogValidation, EachSensorsOwnFullScaleOverridesTheSharedOne) {
+  // GIVEN two unlike gyros (P3): sensor 1 of +-250 deg/s, sensor 2 of +-2000 reading 600 deg/s
+  const std::string head = "# format: driftless-log 1\n# complete: true\n# gyro_full_scale_dps: 250\n";
+  const std::string header = "t,gyro1_x,gyro1_y,gyro1_z,gyro2_x,gyro2_y,gyro2_z,plat1_deg,plat2_deg\n";
+  const std::string rows = "0,1,2,250,4,600,6,90,90\n0.01,1,2,-250,4,5,2000,90,90\n0.02,1,2,3,4,5,6,90,90\n";
+  const auto path = temp_file("unlike.csv");
+  const auto read_all = [&](LogReader& r) {
+    Sample s;
+    while (r.next(s)) {
+    }
+  };
+  // WHEN only the shared key says 250 THEN sensor 2's good reading is refused, the key named
+  write_text(path, head + header + rows);
+  EXPECT_NE(message_of([&] {
+              LogReader r(path);
+              read_all(r);
+            }).find(":5: column 'gyro2_y': 600 deg/s is beyond 1.1 x the gyro full scale of 250 deg/s stated in "
+                    "gyro_full_scale_dps"),
+            std::string::npos);
+  // WHEN gyro2_full_scale_dps says 2000 THEN every row is read; the saturated ones are sensor 1's two
+  // rows at 250 and sensor 2's at 2000
+  write_text(path, head + "# gyro2_full_scale_dps: 2000\n" + header + rows);
+  LogReader r(path);
+  read_all(r);
+  EXPECT_EQ(r.rows_read(), 3u);
+  EXPECT_EQ(r.rows_saturated(), 2u);
+  EXPECT_EQ(r.metadata().gyro_full_scale_dps(1), 250.0);
+  EXPECT_EQ(r.metadata().gyro_full_scale_dps(2), 2000.0);
+  EXPECT_EQ(r.metadata().gyro_full_scale_key(2), "gyro2_full_scale_dps");
+  // AND gyro1_full_scale_dps alone states sensor 1 only: sensor 2 keeps the 4000 deg/s bound
+  write_text(path, std::string("# format: driftless-log 1\n# gyro1_full_scale_dps: 250\n") + header + rows);
+  LogReader r1(path);
+  read_all(r1);
+  EXPECT_EQ(r1.rows_saturated(), 2u);
+  EXPECT_TRUE(r1.metadata().gyro_full_scale_key(2).empty());
+  EXPECT_EQ(r1.metadata().gyro_full_scale_dps(2), kDefaultGyroFullScaleDps);
+}
+
 TEST(LogValidation, TimeGapsAreReportedWithTheirLines) {
   const auto path = temp_file("gaps.csv");
   std::string text = "# format: driftless-log 1\n# sample_rate_hz: 100\n"

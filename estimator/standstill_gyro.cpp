@@ -1,0 +1,169 @@
+#include "estimator/standstill_gyro.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "estimator/geometry.hpp"
+
+namespace driftless::est {
+namespace {
+
+// the second platform starting while the first turns is seen against the first's tracked angle
+// and the filter's bias estimate, whose error turns with it: a wider threshold than at rest
+constexpr double kSecondStartFactor = 3.0;
+// a platform whose hinge rate at rest exceeds this fraction of the threshold (the other's not)
+// is left out of the fused rate: the start of its flip
+constexpr double kStartingFraction = 0.2;
+// s: a flip is over when its hinge rate stays below the threshold this long
+constexpr double kQuietS = 0.25;
+// s: time constant of the rest level (it follows the biases' slow wander and the rest noise)
+constexpr double kLevelTauS = 1.0;
+
+double snap_deg(double p_deg, double turn_deg, double flip_deg) {
+  if (std::fabs(turn_deg) < 0.5 * flip_deg) return p_deg;  // an aborted or false start: no change
+  const double p = p_deg + turn_deg;
+  return std::fabs(p - flip_deg) < std::fabs(p + flip_deg) ? flip_deg : -flip_deg;
+}
+
+}  // namespace
+
+GyroFlipTracker::GyroFlipTracker(const BoxGeometry& box, double threshold_dps, double p1_deg, double p2_deg)
+    : thr_dps_(threshold_dps), p1_(p1_deg), p2_(p2_deg) {
+  restart(box);
+}
+
+void GyroFlipTracker::restart(const BoxGeometry& box) {
+  box_ = box;
+  motion_ = Motion::kRest;
+  have_level_ = false;
+  turn1_deg_ = turn2_deg_ = 0.0;
+  quiet_ = 0;
+  starting_ = 0;
+  // r1 - r2 = u1 a1 - u2 a2 (+ what lies off both hinges): least squares on [a1, -a2]
+  Eigen::Matrix<double, 3, 2> A;
+  A.col(0) = box_.hinge1_axis.normalized();
+  A.col(1) = -box_.hinge2_axis.normalized();
+  const Eigen::Matrix2d AtA = A.transpose() * A;
+  can_split_ = AtA.determinant() > 0.1;  // hinges more than ~18 deg from parallel
+  if (can_split_) split_ = AtA.inverse() * A.transpose();
+}
+
+bool GyroFlipTracker::rest(int i) const {
+  switch (motion_) {
+    case Motion::kRest: return true;
+    case Motion::kPlatform1: return i == 2;
+    case Motion::kPlatform2: return i == 1;
+    case Motion::kBoth: return false;
+  }
+  return false;
+}
+
+int GyroFlipTracker::quiet_samples() const {
+  const double rate = std::isfinite(box_.sample_rate_hz) ? box_.sample_rate_hz : 100.0;
+  return std::max(3, static_cast<int>(kQuietS * rate));
+}
+
+// r1 - r2 - rest level with both sensors turned into box axes at their last rest positions
+Eigen::Vector3d GyroFlipTracker::rest_difference(const Eigen::Vector3d& y1, const Eigen::Vector3d& y2) const {
+  return geo::rot_about_axis_deg(box_.hinge1_axis, p1_) * y1 - geo::rot_about_axis_deg(box_.hinge2_axis, p2_) * y2 -
+         level_;
+}
+
+void GyroFlipTracker::push(const Eigen::Vector3d& y1, const Eigen::Vector3d& y2, const Eigen::Vector3d& b1,
+                           const Eigen::Vector3d& b2, double dt_s) {
+  if (!have_level_) {  // the first sample sets the rest level (the box starts at rest)
+    level_ = rest_difference(y1, y2);
+    have_level_ = true;
+    return;
+  }
+  const Eigen::Vector3d diff = rest_difference(y1, y2);
+  if (motion_ == Motion::kRest) {
+    const Eigen::Vector2d u = can_split_ ? Eigen::Vector2d(split_ * diff) : Eigen::Vector2d::Constant(diff.norm());
+    const double low = kStartingFraction * thr_dps_;
+    const bool s1 = std::fabs(u[0]) > low, s2 = std::fabs(u[1]) > low;
+    starting_ = can_split_ && s1 != s2 ? (s1 ? 1 : 2) : 0;
+    if (u.cwiseAbs().maxCoeff() <= thr_dps_) {
+      const double a = std::min(1.0, std::isfinite(dt_s) ? dt_s / kLevelTauS : 0.01);
+      level_ += a * diff;
+      return;
+    }
+    start_motion(u);
+  }
+  if (motion_ == Motion::kBoth) {
+    track_both(y1, y2, b1, b2, dt_s);
+  } else {
+    track_one(diff, y1, y2, b1, b2, dt_s);
+  }
+}
+
+void GyroFlipTracker::start_motion(const Eigen::Vector2d& u) {
+  const bool m1 = std::fabs(u[0]) > thr_dps_, m2 = std::fabs(u[1]) > thr_dps_;
+  motion_ = (m1 && m2) || !can_split_ ? Motion::kBoth : m1 ? Motion::kPlatform1 : Motion::kPlatform2;
+  if (motion_ == Motion::kBoth) ++simultaneous_;
+  turn1_deg_ = turn2_deg_ = 0.0;
+  quiet_ = 0;
+}
+
+// one platform turns, the other rests: its hinge rate is exact from the rest difference; the
+// other platform starting is looked for in what is left once the tracked turn is taken out
+void GyroFlipTracker::track_one(const Eigen::Vector3d& diff, const Eigen::Vector3d& y1, const Eigen::Vector3d& y2,
+                                const Eigen::Vector3d& b1, const Eigen::Vector3d& b2, double dt_s) {
+  const bool one = motion_ == Motion::kPlatform1;
+  const Eigen::Vector3d a1 = box_.hinge1_axis.normalized(), a2 = box_.hinge2_axis.normalized();
+  const double rate = one ? diff.dot(a1) : -diff.dot(a2);
+  double& turn = one ? turn1_deg_ : turn2_deg_;
+  if (std::isfinite(dt_s)) turn += rate * dt_s;
+  // r_k at the tracked angle (bias estimate turned with it), the other at rest: what remains of
+  // the difference beyond the rest level and the tracked hinge rate is the other platform moving
+  const Eigen::Vector3d r1 = one ? Eigen::Vector3d(geo::rot_about_axis_deg(a1, p1_ + turn) * (y1 - b1) +
+                                                   geo::rot_about_axis_deg(a1, p1_) * b1)
+                                 : Eigen::Vector3d(geo::rot_about_axis_deg(a1, p1_) * y1);
+  const Eigen::Vector3d r2 = one ? Eigen::Vector3d(geo::rot_about_axis_deg(a2, p2_) * y2)
+                                 : Eigen::Vector3d(geo::rot_about_axis_deg(a2, p2_ + turn) * (y2 - b2) +
+                                                   geo::rot_about_axis_deg(a2, p2_) * b2);
+  const Eigen::Vector3d e = r1 - r2 - level_ - (one ? rate * a1 : Eigen::Vector3d(-rate * a2));
+  const double other = one ? -e.dot(a2) : e.dot(a1);
+  if (std::fabs(other) > kSecondStartFactor * thr_dps_) {
+    motion_ = Motion::kBoth;
+    ++simultaneous_;
+    quiet_ = 0;
+    return;
+  }
+  quiet_ = std::fabs(rate) < thr_dps_ ? quiet_ + 1 : 0;
+  if (quiet_ >= quiet_samples()) end_motion(y1, y2);
+}
+
+// both platforms turn: with both sensors turned into box axes at their tracked angles (bias
+// estimate removed), r1 - r2 = theta1' a1 - theta2' a2, so both hinge rates come from its split
+void GyroFlipTracker::track_both(const Eigen::Vector3d& y1, const Eigen::Vector3d& y2, const Eigen::Vector3d& b1,
+                                 const Eigen::Vector3d& b2, double dt_s) {
+  double rate = 0.0;
+  if (can_split_) {
+    const Eigen::Vector3d d = geo::rot_about_axis_deg(box_.hinge1_axis, p1_ + turn1_deg_) * (y1 - b1) -
+                              geo::rot_about_axis_deg(box_.hinge2_axis, p2_ + turn2_deg_) * (y2 - b2);
+    const Eigen::Vector2d u = split_ * d;
+    if (std::isfinite(dt_s)) {
+      turn1_deg_ += u[0] * dt_s;
+      turn2_deg_ += u[1] * dt_s;
+    }
+    rate = u.cwiseAbs().maxCoeff();
+  } else {
+    // parallel hinges: the turns cannot be told apart; the motion is over when the rest
+    // difference is back at its level (the positions are kept)
+    rate = rest_difference(y1, y2).norm();
+  }
+  quiet_ = rate < thr_dps_ ? quiet_ + 1 : 0;
+  if (quiet_ >= quiet_samples()) end_motion(y1, y2);
+}
+
+void GyroFlipTracker::end_motion(const Eigen::Vector3d& y1, const Eigen::Vector3d& y2) {
+  p1_ = snap_deg(p1_, turn1_deg_, box_.flip_angle_deg);
+  p2_ = snap_deg(p2_, turn2_deg_, box_.flip_angle_deg);
+  motion_ = Motion::kRest;
+  turn1_deg_ = turn2_deg_ = 0.0;
+  quiet_ = 0;
+  level_.setZero();
+  level_ = rest_difference(y1, y2);  // the new rest level from this sample (refined as it rests)
+}
+
+}  // namespace driftless::est

@@ -1,0 +1,75 @@
+// Platform positions from the gyros alone ('standstill: gyro', hardware without angle read-back),
+// docs/estimator.md section 2. Each sensor's reading turned into box axes at its platform's last
+// rest position, r_i = M_i y_i, agrees with the other's at rest (both read the box rate plus their
+// biases). A platform i that turns by theta about its hinge a_i adds theta' a_i to its own r_i
+// and nothing else along a_i (a turn about a_i keeps the a_i component of the box rate), so
+//   (r1 - r2 - rest level) . a1 = theta1'   while platform 2 rests, whatever the box does,
+// and the other platform's sensor then reads the box rate alone. Which platform started is told
+// by splitting the difference along a1 and a2; a flip ends when its hinge rate stays below the
+// threshold, and the platform's new position is its integrated turn snapped to the nearer stop.
+// When both platforms move at once no sensor reads the box rate: the tracker says so (the
+// attitude cannot be made then) and follows both turns from a least-squares fit of the box rate
+// and both hinge rates to the six readings. Eigen + std only; push() never throws nor allocates.
+#pragma once
+
+#include <cstdint>
+
+#include <Eigen/Core>
+
+#include "estimator/box_geometry.hpp"
+
+namespace driftless::est {
+
+/// Where the platforms are and which of them rest, from the two gyros' readings.
+class GyroFlipTracker {
+ public:
+  enum class Motion : std::uint8_t { kRest, kPlatform1, kPlatform2, kBoth };
+
+  /// `threshold_dps`: a hinge rate above this is a platform moving (gyro_motion_threshold_dps);
+  /// `p1_deg`/`p2_deg`: the positions at the start (initial_plat*_deg).
+  GyroFlipTracker(const BoxGeometry& box, double threshold_dps, double p1_deg, double p2_deg);
+  /// A new source: the motion and the rest level are forgotten, the positions kept.
+  void restart(const BoxGeometry& box);
+
+  /// One sample: raw readings y1/y2 (deg/s, sensor axes), the filter's bias estimate b1/b2 and
+  /// the time since the previous sample (NaN for the first).
+  void push(const Eigen::Vector3d& y1, const Eigen::Vector3d& y2, const Eigen::Vector3d& b1,
+            const Eigen::Vector3d& b2, double dt_s);
+
+  Motion motion() const { return motion_; }
+  /// Platform `i` (1 or 2) at rest at position_deg(i).
+  bool rest(int i) const;
+  /// Platform `i` rests by the threshold, but its hinge rate already exceeds a fifth of it while
+  /// the other's does not: the start of a flip, which the fused box rate leaves out (a raised-
+  /// cosine 180 deg flip of 1 s turns 0.06 deg before reaching 5 deg/s, 0.005 deg before 1 deg/s).
+  bool starting(int i) const { return motion_ == Motion::kRest && starting_ == i; }
+  /// Position of platform `i` at its last rest, deg (the new one once its flip has ended).
+  double position_deg(int i) const { return i == 1 ? p1_ : p2_; }
+  /// Flips in which both platforms moved at once (counted when they began).
+  std::uint64_t simultaneous_flips() const { return simultaneous_; }
+
+ private:
+  Eigen::Vector3d rest_difference(const Eigen::Vector3d& y1, const Eigen::Vector3d& y2) const;
+  void start_motion(const Eigen::Vector2d& u);
+  void track_one(const Eigen::Vector3d& diff, const Eigen::Vector3d& y1, const Eigen::Vector3d& y2,
+                 const Eigen::Vector3d& b1, const Eigen::Vector3d& b2, double dt_s);
+  void track_both(const Eigen::Vector3d& y1, const Eigen::Vector3d& y2, const Eigen::Vector3d& b1,
+                  const Eigen::Vector3d& b2, double dt_s);
+  void end_motion(const Eigen::Vector3d& y1, const Eigen::Vector3d& y2);
+  int quiet_samples() const;
+
+  BoxGeometry box_;
+  double thr_dps_;
+  double p1_, p2_;                 // deg, positions at the last rest
+  Motion motion_ = Motion::kRest;
+  bool have_level_ = false;
+  Eigen::Vector3d level_ = Eigen::Vector3d::Zero();  // deg/s, rest level of r1 - r2 (M1 b1 - M2 b2)
+  Eigen::Matrix<double, 2, 3> split_ = Eigen::Matrix<double, 2, 3>::Zero();  // r1 - r2 -> (u1, u2)
+  bool can_split_ = false;         // the hinges are far enough from parallel to tell them apart
+  double turn1_deg_ = 0.0, turn2_deg_ = 0.0;  // deg, since the motion began
+  int quiet_ = 0;
+  int starting_ = 0;               // 1 or 2: that platform's hinge rate is above a fifth of the threshold
+  std::uint64_t simultaneous_ = 0;
+};
+
+}  // namespace driftless::est
