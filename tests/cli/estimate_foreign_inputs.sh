@@ -9,11 +9,8 @@
 # usage: estimate_foreign_inputs.sh <path-to-driftless> <source-dir>
 set -uo pipefail
 bin=$1; src=$2
-py=/usr/bin/python3
-gen=$src/tests/diagnose/probe_log.py
-"$py" -c 'import numpy' 2>/dev/null || { echo "no numpy for $py: skipped"; exit 77; }
-t=$(mktemp -d); trap 'rm -rf "$t"' EXIT
-fail() { echo "FAIL: $*"; exit 1; }
+# shellcheck source=lib/outsider_log.sh
+source "$src/tests/cli/lib/outsider_log.sh"
 json() { "$py" -c "import json,sys; d=json.load(open(sys.argv[1])); print(eval(sys.argv[2]))" "$1/summary.json" "$2"; }
 # column $2 (1-based) of every data row replaced by $3
 set_column() { awk -F, -v c="$2" -v v="$3" 'BEGIN{OFS=","} /^#/ || $1=="t" {print; next} {$c=v; print}' "$1"; }

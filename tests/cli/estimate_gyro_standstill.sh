@@ -10,11 +10,8 @@
 # usage: estimate_gyro_standstill.sh <path-to-driftless> <source-dir>
 set -uo pipefail
 bin=$1; src=$2
-py=/usr/bin/python3
-gen=$src/tests/diagnose/probe_log.py
-"$py" -c 'import numpy' 2>/dev/null || { echo "no numpy for $py: skipped"; exit 77; }
-t=$(mktemp -d); trap 'rm -rf "$t"' EXIT
-fail() { echo "FAIL: $*"; exit 1; }
+# shellcheck source=lib/outsider_log.sh
+source "$src/tests/cli/lib/outsider_log.sh"
 printf 'standstill: gyro\n' > "$t/gyro.cfg"
 # the angle columns (8, 9: plat1_deg, plat2_deg) emptied in every row
 blank() { awk -F, 'BEGIN{OFS=","} /^#/ || $1=="t" {print; next} {$8=""; $9=""; print}' "$1" > "$2"; }
