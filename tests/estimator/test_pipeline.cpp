@@ -1,6 +1,8 @@
 // One pass over a log: filter + attitude with/without correction + truth statistics.
 #include <cmath>
 #include <memory>
+#include <string>
+#include <utility>
 
 #include <gtest/gtest.h>
 
@@ -15,6 +17,17 @@ std::filesystem::path temp_path(const std::string& name) {
   auto dir = test::temp_path("driftless_test_pipeline");
   std::filesystem::create_directories(dir);
   return dir / name;
+}
+
+// The synthetic log of `p`, estimated twice: with its platform-angle columns (the default
+// standstill source) and with 'standstill: gyro' (the angles not used).
+std::pair<EstimateSummary, EstimateSummary> with_angles_and_gyro_only(const test::SynthParams& p, const std::string& name) {
+  const auto path = temp_path(name);
+  test::synth_log(p, path);
+  EstimatorConfig gyro;
+  gyro.standstill = StandstillSource::kGyroSignal;
+  log::LogReader r1(path), r2(path);
+  return {run_estimate(r1, EstimatorConfig{}, nullptr), run_estimate(r2, gyro, nullptr)};
 }
 
 TEST(PipelineTest, CorrectionCutsAttitudeDriftOnAPanTiltRun) {
@@ -81,13 +94,7 @@ TEST(PipelineTest, AttitudeFromGyroOnlyStandstillsMatchesTheOneFromTheAngles) {
   p.body_rate_dps = [](double t) {
     return Eigen::Vector3d(20.0 * std::sin(0.3 * t), 10.0 * std::cos(0.13 * t), 30.0 * std::sin(0.05 * t));
   };
-  const auto path = temp_path("gyro_standstill.csv");
-  test::synth_log(p, path);
-  EstimatorConfig gyro;
-  gyro.standstill = StandstillSource::kGyroSignal;
-  log::LogReader r1(path), r2(path);
-  const auto with_angles = run_estimate(r1, EstimatorConfig{}, nullptr);
-  const auto gyro_only = run_estimate(r2, gyro, nullptr);
+  const auto [with_angles, gyro_only] = with_angles_and_gyro_only(p, "gyro_standstill.csv");
   // THEN both compare the attitude from the same start, the final errors agree within 0.02 deg
   // (the two runs' bias estimates differ by their noise) and the drifts within 0.5 deg/h
   ASSERT_TRUE(gyro_only.attitude_available);
@@ -109,13 +116,7 @@ TEST(PipelineTest, GyroOnlyAttitudeIsWithheldFromAFlipOfBothPlatformsAtOnce) {
   p.noise_sigma_dps = 0.05;
   p.both_at_cycle = 15;  // cycles of 10 s at rest + 1 s flip: that flip starts at 15 * 11 + 10 s
   p.body_rate_dps = [](double t) { return Eigen::Vector3d(5.0 * std::sin(0.3 * t), 3.0, -4.0 * std::cos(0.1 * t)); };
-  const auto path = temp_path("both_at_once.csv");
-  test::synth_log(p, path);
-  EstimatorConfig gyro;
-  gyro.standstill = StandstillSource::kGyroSignal;
-  log::LogReader r1(path), r2(path);
-  const auto with_angles = run_estimate(r1, EstimatorConfig{}, nullptr);
-  const auto gyro_only = run_estimate(r2, gyro, nullptr);
+  const auto [with_angles, gyro_only] = with_angles_and_gyro_only(p, "both_at_once.csv");
   // THEN with 'standstill: gyro' the comparison starts, stops at that flip, and its figures are
   // withheld (NaN) with a degraded verdict whose finding says when and why
   ASSERT_TRUE(std::isfinite(gyro_only.attitude_start_s));
