@@ -35,6 +35,7 @@ const char* cause_key(est::HealthCause c) {
     case est::HealthCause::kDeadAxis: return "dead_axis";
     case est::HealthCause::kPaperRestAngles: return "paper_rest_angles";
     case est::HealthCause::kPaperSchedule: return "paper_schedule";
+    case est::HealthCause::kLockLost: return "lock_lost";
   }
   return "?";
 }
@@ -89,12 +90,17 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
     case est::HealthCause::kNoiseUnderstated:
       return fmt::format("NIS mean {:.3g} above its 95 % band{}: the innovations are {:.2g}x larger than the "
                          "filter expects, its sigma too small (data noisier or bias wandering more than "
-                         "noise_density_dps_rthz {:.3g} and the bias instability say); use --tune auto",
+                         "noise_density_dps_rthz {:.3g} and the bias instability say); {}",
                          f.value,
                          f.severity == est::HealthVerdict::kOk
                              ? " (inside the 99.9 % band: one consistent run in 40 lands here)"
                              : " and its 99.9 % band",
-                         std::sqrt(f.suggested), cfg.noise_density_dps_rthz);
+                         std::sqrt(f.suggested), cfg.noise_density_dps_rthz,
+                         cfg.noise_from_log
+                             ? "the density and the wander were already measured from this log (--tune auto), so the "
+                               "excess is not white noise: a sensor error the model lacks (g-sensitivity, scale or "
+                               "misalignment on a moving box: --selfcal) or a signal-chain mismatch between the sensors"
+                             : "use --tune auto");
     case est::HealthCause::kNoiseOverstated:
       return fmt::format("NIS mean {:.3g} below its 95 % band: the innovations are {:.2g}x smaller than the "
                          "filter expects, its sigma too large (data quieter or the bias steadier than configured): "
@@ -124,6 +130,13 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
       return fmt::format("{} kept most of the prior sigma (largest sigma {:.3g} deg/s): the flips in this "
                          "log do not observe them; flip both platforms",
                          component_names(f.components), f.value);
+    case est::HealthCause::kLockLost:
+      return fmt::format("the filter locked, then lost the lock at t = {:.1f} s (a gate re-lock widened its sigma) and "
+                         "did not lock again before the end: the largest bias sigma at the end is {:.3g} deg/s, above "
+                         "the lock level {:g} deg/s, so the final biases are not usable (corrected.csv: locked = 0 from "
+                         "there). The findings above name why the updates stopped fitting; a bias jump, or noise and "
+                         "bias wander larger than configured (--tune auto), are the common causes",
+                         f.suggested, f.value, f.sigma);
     case est::HealthCause::kRelocks:
       return fmt::format("the filter lost lock and re-locked {:g} time(s) (see relocks): a bias jump, a new "
                          "sensor, or a model that does not fit; check the log around those times",
@@ -210,13 +223,15 @@ std::string health_json(const est::HealthReport& h, const est::EstimatorConfig& 
   }
   findings += h.findings.empty() ? "]" : "\n  ]";
   return fmt::format(
-      "  \"health\": {{\"verdict\": \"{}\", \"locked\": {}, \"lock_t_s\": {}, \"updates\": {}, \"rejected\": {}, "
+      "  \"health\": {{\"verdict\": \"{}\", \"locked\": {}, \"lock_t_s\": {}, \"locked_at_end\": {}, \"lock_lost_t_s\": {}, "
+      "\"updates\": {}, \"rejected\": {}, "
       "\"rejected_fraction\": {}, \"nis_updates\": {}, \"nis_dof_mean\": {}, \"nis_mean\": {}, "
       "\"nis_mean_band_95\": [{}, {}], \"nis_mean_degraded_above\": {}, \"relocks\": {}, \"unobservable\": {},\n"
       "  \"signal_chain\": {{\"samples\": {}, \"lag_s\": {}, \"lag_sigma_s\": {}, \"update_excess\": {}, "
       "\"significant\": {}}},\n"
       "  \"findings\": {}}}",
-      est::to_string(h.verdict), h.locked ? "true" : "false", json_number(h.lock_t_s), h.updates, h.rejected,
+      est::to_string(h.verdict), h.locked ? "true" : "false", json_number(h.lock_t_s),
+      h.locked_at_end ? "true" : "false", json_number(h.lock_lost_t_s), h.updates, h.rejected,
       json_number(h.rejected_fraction), h.nis_updates, json_number(h.nis_dof_mean), json_number(h.nis_mean), json_number(h.nis_mean_band_lo),
       json_number(h.nis_mean_band_hi), json_number(h.nis_mean_degraded_above), h.relocks, unobs, h.signal_chain.samples,
       json_number(h.signal_chain.lag_s), json_number(h.signal_chain.lag_sigma_s), json_number(h.signal_chain.update_excess),
@@ -233,11 +248,21 @@ std::string tune_json(const est::TuneResult* t) {
                      json_number(t->q_dps2_per_s));
 }
 
+namespace {
+// "locked at t = 57.0 s", "locked at t = 57.0 s, lost at t = 518.9 s", "never locked"
+std::string lock_text(const est::HealthReport& h) {
+  if (!h.locked) return "never locked";
+  std::string o = fmt::format("locked at t = {:.1f} s", h.lock_t_s);
+  if (!h.locked_at_end) o += fmt::format(", lost at t = {:.1f} s", h.lock_lost_t_s);
+  return o;
+}
+}  // namespace
+
 std::vector<std::string> health_lines(const est::HealthReport& h, const est::EstimatorConfig& cfg) {
   std::vector<std::string> lines;
   lines.push_back(fmt::format(
       "health: {}: {}, {} of {} updates rejected ({:.1f} %), NIS mean {:.3g} (95 % band {:.3g}..{:.3g}), {} re-lock(s)",
-      est::to_string(h.verdict), h.locked ? fmt::format("locked at t = {:.1f} s", h.lock_t_s) : "never locked",
+      est::to_string(h.verdict), lock_text(h),
       h.rejected, h.updates, std::isfinite(h.rejected_fraction) ? 100.0 * h.rejected_fraction : 0.0, h.nis_mean,
       h.nis_mean_band_lo, h.nis_mean_band_hi, h.relocks));
   for (const auto& f : h.findings) lines.push_back(fmt::format("  {}: {}", est::to_string(f.severity), describe(f, cfg)));
