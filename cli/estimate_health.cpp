@@ -57,7 +57,10 @@ std::string component_names(const std::vector<int>& components) {
   return o;
 }
 
-std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cfg) {
+namespace {
+
+// the lock: whether the filter locked, kept it, and what stayed unobserved
+std::string describe_lock(const est::HealthFinding& f, const est::EstimatorConfig& cfg) {
   switch (f.cause) {
     case est::HealthCause::kNoUpdate:
       if (f.suggested > 0.5) {
@@ -87,6 +90,34 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
                                                     "about the box vertical looks like a bias common to both "
                                                     "sensors; if the box stands still, add --box-at-rest"
                                                   : "record more flips (both platforms, both directions) or a longer log");
+    case est::HealthCause::kUnobservable:
+      return fmt::format("{} kept most of the prior sigma (largest sigma {:.3g} deg/s): the flips in this "
+                         "log do not observe them; flip both platforms",
+                         component_names(f.components), f.value);
+    case est::HealthCause::kLockLost:
+      return fmt::format("the filter locked, then lost the lock at t = {:.1f} s (a gate re-lock widened its sigma) and "
+                         "did not lock again before the end: the largest bias sigma at the end is {:.3g} deg/s, above "
+                         "the lock level {:g} deg/s, so the final biases are not usable (corrected.csv: locked = 0 from "
+                         "there). The findings above name why the updates stopped fitting; a bias jump, or noise and "
+                         "bias wander larger than configured (--tune auto), are the common causes",
+                         f.suggested, f.value, f.sigma);
+    case est::HealthCause::kRelocks:
+      return fmt::format("the filter lost lock and re-locked {:g} time(s) (see relocks): a bias jump, a new "
+                         "sensor, or a model that does not fit; check the log around those times",
+                         f.value);
+    case est::HealthCause::kLateLock:
+      return fmt::format("locked only at t = {:.1f} s, with {:g} accepted update(s) after it: too few to check "
+                         "the NIS against its band or to compare the attitude; record a longer log or more "
+                         "flips after the lock",
+                         f.value, f.suggested);
+    default: break;
+  }
+  return "?";
+}
+
+// how the updates fit the model: the NIS, the gate's rejections, the signal chain
+std::string describe_fit(const est::HealthFinding& f, const est::EstimatorConfig& cfg) {
+  switch (f.cause) {
     case est::HealthCause::kNoiseUnderstated:
       return fmt::format("NIS mean {:.3g} above its 95 % band{}: the innovations are {:.2g}x larger than the "
                          "filter expects, its sigma too small (data noisier or bias wandering more than "
@@ -126,26 +157,6 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
                          "which the gate is there to remove; the estimate is unaffected. Repeated rejections "
                          "would mean noise or bias wander larger than configured (--tune auto)",
                          f.suggested, f.value);
-    case est::HealthCause::kUnobservable:
-      return fmt::format("{} kept most of the prior sigma (largest sigma {:.3g} deg/s): the flips in this "
-                         "log do not observe them; flip both platforms",
-                         component_names(f.components), f.value);
-    case est::HealthCause::kLockLost:
-      return fmt::format("the filter locked, then lost the lock at t = {:.1f} s (a gate re-lock widened its sigma) and "
-                         "did not lock again before the end: the largest bias sigma at the end is {:.3g} deg/s, above "
-                         "the lock level {:g} deg/s, so the final biases are not usable (corrected.csv: locked = 0 from "
-                         "there). The findings above name why the updates stopped fitting; a bias jump, or noise and "
-                         "bias wander larger than configured (--tune auto), are the common causes",
-                         f.suggested, f.value, f.sigma);
-    case est::HealthCause::kRelocks:
-      return fmt::format("the filter lost lock and re-locked {:g} time(s) (see relocks): a bias jump, a new "
-                         "sensor, or a model that does not fit; check the log around those times",
-                         f.value);
-    case est::HealthCause::kLateLock:
-      return fmt::format("locked only at t = {:.1f} s, with {:g} accepted update(s) after it: too few to check "
-                         "the NIS against its band or to compare the attitude; record a longer log or more "
-                         "flips after the lock",
-                         f.value, f.suggested);
     case est::HealthCause::kSignalChainLag:
       return fmt::format("the residual follows the box's angular acceleration: sensor {} reads the rate {:.2f} ms "
                          "(+-{:.2f}) later than sensor {}, which adds {:.2g}x the white noise's variance to the "
@@ -155,6 +166,15 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
                          "to measure each sensor's chain",
                          f.value > 0.0 ? 2 : 1, 1e3 * std::fabs(f.value), 1e3 * f.sigma, f.value > 0.0 ? 1 : 2,
                          f.suggested);
+    default: break;
+  }
+  return "?";
+}
+
+// what the log itself holds against the model: paper mode's positions, clipping, dead axes,
+// the attitude withheld
+std::string describe_input(const est::HealthFinding& f) {
+  switch (f.cause) {
     case est::HealthCause::kPaperRestAngles:
       return fmt::format("the platforms rested {:g} deg from the paper's positions in {:g} of {} standstills "
                          "(plat*_deg read {:g} deg), while paper mode builds H from +-{:g} deg (flip_angle_deg){}; "
@@ -205,6 +225,36 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
                          "flip one platform at a time, or log the platform angles (plat1_deg, plat2_deg) and use "
                          "'standstill: platform'",
                          f.value, f.suggested);
+    default: break;
+  }
+  return "?";
+}
+
+}  // namespace
+
+std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cfg) {
+  switch (f.cause) {
+    case est::HealthCause::kNoUpdate:
+    case est::HealthCause::kAllRejected:
+    case est::HealthCause::kNeverLocked:
+    case est::HealthCause::kUnobservable:
+    case est::HealthCause::kLockLost:
+    case est::HealthCause::kRelocks:
+    case est::HealthCause::kLateLock:
+      return describe_lock(f, cfg);
+    case est::HealthCause::kNoiseUnderstated:
+    case est::HealthCause::kNoiseOverstated:
+    case est::HealthCause::kRejectionsAtPosition:
+    case est::HealthCause::kRejections:
+    case est::HealthCause::kLoneRejection:
+    case est::HealthCause::kSignalChainLag:
+      return describe_fit(f, cfg);
+    case est::HealthCause::kPaperRestAngles:
+    case est::HealthCause::kPaperSchedule:
+    case est::HealthCause::kSaturation:
+    case est::HealthCause::kDeadAxis:
+    case est::HealthCause::kAttitudeWithheld:
+      return describe_input(f);
   }
   return "?";
 }
