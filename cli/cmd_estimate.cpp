@@ -109,7 +109,10 @@ est::TuneResult tune_config(const EstimateArgs& a, est::EstimatorConfig& cfg) {
              t.noise_estimated ? fmt::format("{:.4g} deg/s/sqrt(Hz)", t.noise_density_dps_rthz)
                                : "not measured, configured value kept",
              t.noise_block_pairs, t.block_s,
-             t.q_estimated ? fmt::format("{:.4g} (deg/s)^2/s", t.q_dps2_per_s) : "not measured, configured value kept",
+             !t.q_estimated    ? std::string("not measured, configured value kept")
+             : t.q_upper_bound ? fmt::format("at most {:.4g} (deg/s)^2/s (no wander above the noise: its upper bound)",
+                                             t.q_dps2_per_s)
+                               : fmt::format("{:.4g} (deg/s)^2/s", t.q_dps2_per_s),
              t.wander_pairs);
   return t;
 }

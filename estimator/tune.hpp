@@ -38,6 +38,8 @@ struct TuneResult {
   std::uint64_t wander_pairs = 0;            // same-position visit pairs used
   bool q_estimated = false;
   double q_dps2_per_s = kNaN;                // (deg/s)^2/s, K^2 per axis
+  bool q_upper_bound = false;                // the revisits showed no wander above the noise: Q is
+                                             // their one-sided 97.5 % upper bound, not a measurement
   double sample_rate_hz = kNaN;              // Hz, used for N
 };
 
