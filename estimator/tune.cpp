@@ -24,7 +24,7 @@ EstimatorConfig block_config(EstimatorConfig cfg, const TuneLimits& limits) {
 }  // namespace
 
 NoiseTuner::NoiseTuner(const EstimatorConfig& cfg, const BoxGeometry& box, const TuneLimits& limits)
-    : limits_(limits), geometry_(block_config(cfg, limits), box), detector_(block_config(cfg, limits), box) {
+    : limits_(limits), configured_q_dps2_per_s_(cfg.q_dps2_per_s()), geometry_(block_config(cfg, limits), box), detector_(block_config(cfg, limits), box) {
   if (!(limits_.block_s > 0.0)) throw std::invalid_argument("tune: block_s must be > 0 s");
 }
 
@@ -180,12 +180,14 @@ TuneResult NoiseTuner::finish() {
     num_var += 6.0 * v * v;
   }
   if (!(den > 0.0)) return t;
-  t.q_estimated = true;
   const double bound = kWanderBoundZ * std::sqrt(num_var);
   // a wander the noise could have made (a FOG's, below a MEMS default by 1e4) is not measured:
-  // its upper bound is, and the filter's sigma then follows the data, not the configured part
+  // its upper bound is, and the filter's sigma then follows the data, not the configured part. A
+  // bound above the configured Q does not contradict it (noise inflated by a signal-chain lag gives
+  // such bounds): the configured Q is kept
   t.q_upper_bound = !(num > bound);
   t.q_dps2_per_s = (t.q_upper_bound ? std::max(num, 0.0) + bound : num) / den;
+  t.q_estimated = !t.q_upper_bound || t.q_dps2_per_s < configured_q_dps2_per_s_;
   return t;
 }
 
