@@ -89,6 +89,7 @@ struct EstimatorConfig {
 
   // tuning. R: per-axis white noise of one sample = noise_density^2 * sample rate
   double noise_density_dps_rthz = 0.005;   // deg/s/sqrt(Hz), MPU6050 data sheet (paper sec. 4)
+  bool noise_from_log = false;             // set by --tune auto (apply_tune): the density was measured
   // Q: the bias wanders like a random walk that reaches the bias-instability level B at tau_B:
   // K = 0.664 B sqrt(3 / tau_B), Q = K^2 dt per axis. The default B is the MPU6050's wander as the
   // twin's preset draws it (a Gauss-Markov of 0.1 deg/s over 3 h, driven at 2 sigma^2 / tau =
