@@ -144,7 +144,8 @@ struct EstimateSummary {
   AttitudeWithheld attitude_withheld_why = AttitudeWithheld::kNo;
   double attitude_withheld_gap_s = kNaN;  // s, the gap's length (kTimeGap)
   Vector6d fixed_bias_dps = Vector6d::Constant(kNaN);  // deg/s, the bias held by `fixed`
-  AttitudeError final_corrected, final_raw, final_fixed;
+  AttitudeError final_corrected = kAttitudeErrorUnknown, final_raw = kAttitudeErrorUnknown,
+                final_fixed = kAttitudeErrorUnknown;  // NaN while no comparison was made
   TruthStats truth;
   WindowStats window;  // with EstimateRunOptions::eval_start_s
   bool log_complete = true;
