@@ -238,7 +238,7 @@ void withhold_attitude(const DriftlessFilter& filter, EstimateSummary& sum) {
 }
 
 // the attitude comparison stops at the first sample after its start that follows a time gap, or
-// where no sensor gave the box rate
+// where no sensor gave the box rate (a row the filter could not use at all is not one)
 void check_attitude_input(const Sample& s, double prev_t_s, double gap_s, const DriftlessFilter& filter,
                           const AttitudeComparison& att, EstimateSummary& sum) {
   if (!att.started() || !std::isnan(sum.attitude_withheld_from_s)) return;
@@ -246,7 +246,8 @@ void check_attitude_input(const Sample& s, double prev_t_s, double gap_s, const 
     sum.attitude_withheld_from_s = prev_t_s;
     sum.attitude_withheld_why = AttitudeWithheld::kTimeGap;
     sum.attitude_withheld_gap_s = s.t_s - prev_t_s;
-  } else if (!filter.output().rate_body_dps.allFinite()) {
+  } else if (!filter.output().rate_body_dps.allFinite() && filter.output().status != PushStatus::kInvalid) {
+    // (a row without a gyro value is bridged as before: the integrator holds the last rate)
     sum.attitude_withheld_from_s = s.t_s;
     sum.attitude_withheld_why =
         filter.output().both_moving ? AttitudeWithheld::kBothFlipping : AttitudeWithheld::kNoBoxRate;
