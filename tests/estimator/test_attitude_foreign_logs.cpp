@@ -75,7 +75,7 @@ TEST(AttitudeOnForeignLogs, BothPlatformsFlippingAtOnceKeepTheAttitudeFromTheAng
   const EstimateSummary s = run_estimate(reader, EstimatorConfig{}, &sink, opt);
   // THEN during each of the 9 flips the moving sensors give the box rate, M(theta) y - theta' a,
   // and the attitude stays within 0.1 deg of the truth over 200 s (measured 0.056; holding the
-  // last rate through a flip, as before, put it 5.5 deg off at the first flip)
+  // last rate through a flip, as before, turned it 5.0 deg off at the first flip)
   std::printf("largest attitude error %.4f deg over %zu points\n", sink.deg, sink.points);
   EXPECT_EQ(s.counters.simultaneous_flips, 9u);
   EXPECT_TRUE(std::isnan(s.attitude_withheld_from_s));
