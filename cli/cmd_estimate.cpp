@@ -264,9 +264,11 @@ int run_estimate_cmd(const EstimateArgs& a) {
   fmt::print("  b2 = ({:+.5f}, {:+.5f}, {:+.5f}) +- ({:.5f}, {:.5f}, {:.5f}) deg/s\n", b[3], b[4], b[5], sg[3],
              sg[4], sg[5]);
   if (summary.attitude_available && std::isfinite(summary.attitude_withheld_from_s)) {
-    fmt::print("  attitude: compared from t = {:.1f} s, withheld from t = {:.1f} s (both platforms flipped at once; "
-               "see the warning)\n",
-               summary.attitude_start_s, summary.attitude_withheld_from_s);
+    fmt::print("  attitude: compared from t = {:.1f} s, withheld from t = {:.1f} s ({}; see the warning)\n",
+               summary.attitude_start_s, summary.attitude_withheld_from_s,
+               summary.attitude_withheld_why == est::AttitudeWithheld::kBothFlipping ? "both platforms flipped at once"
+               : summary.attitude_withheld_why == est::AttitudeWithheld::kTimeGap    ? "a time gap"
+                                                                                    : "no sensor gave the box rate");
   } else if (summary.attitude_available) {
     fmt::print("  attitude drift from t = {:.1f} s: {:.2f} deg/h with DriftLess, {:.2f} deg/h with the bias "
                "fixed at that start, {:.2f} deg/h uncorrected\n",

@@ -712,6 +712,22 @@ void DriftlessFilter::fuse_rate(const Sample& s, const StandstillStep& st) {
     fixed += M2 * (s.gyro2_dps - fixed_bias_.segment<3>(kBias2.start));
     ++n;
   }
+  // no platform rests (both flip at once): a moving sensor whose angle and hinge rate the platform
+  // columns give reads M(theta) y = w + theta' a, so w = M(theta) y - theta' a (a turned by M stays a)
+  const auto moving = [&](int i, double deg, double rate_dps, const Eigen::Vector3d& yc, const Eigen::Vector3d& y) {
+    if (!finite(deg) || !finite(rate_dps)) return;
+    const Eigen::Matrix3d M = body_from_sensor(i, deg);
+    const Eigen::Vector3d hinge = rate_dps * (i == 1 ? box_.hinge1_axis : box_.hinge2_axis).normalized();
+    const Eigen::Vector3d& fb = i == 1 ? fixed_bias_.segment<3>(kBias1.start) : fixed_bias_.segment<3>(kBias2.start);
+    sum += M * yc - hinge;
+    raw += M * y - hinge;
+    fixed += M * (y - fb) - hinge;
+    ++n;
+  };
+  if (n == 0) {
+    moving(1, st.plat1_deg, st.plat1_rate_dps, out_.y1c_dps, s.gyro1_dps);
+    moving(2, st.plat2_deg, st.plat2_rate_dps, out_.y2c_dps, s.gyro2_dps);
+  }
   out_.sensors_fused = n;
   if (n > 0) {
     out_.rate_body_dps = sum / double(n);

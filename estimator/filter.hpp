@@ -248,6 +248,8 @@ class DriftlessFilter {
   /// Corrected outputs and fused body rate of the sample last pushed.
   const SampleOutput& output() const { return out_; }
   const FilterCounters& counters() const { return counters_; }
+  /// The standstill detector (its gyro flip tracker, the angle columns' jitter).
+  const StandstillDetector& standstill() const { return standstill_; }
   const EstimatorConfig& config() const { return cfg_; }
   const BoxGeometry& geometry() const { return box_; }
 

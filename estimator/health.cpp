@@ -93,13 +93,108 @@ void add_dead_axis_findings(HealthReport& h, const std::vector<DeadChannel>& dea
   h.verdict = HealthVerdict::kFailed;
 }
 
-void add_attitude_withheld_finding(HealthReport& h, double t_s, std::uint64_t flips) {
-  if (!std::isfinite(t_s)) return;
+void add_attitude_withheld_finding(HealthReport& h, AttitudeWithheld why, double t_s, double detail) {
+  if (why == AttitudeWithheld::kNo || !std::isfinite(t_s)) return;
   HealthFinding f;
-  f.cause = HealthCause::kAttitudeWithheld;
+  f.cause = why == AttitudeWithheld::kBothFlipping ? HealthCause::kAttitudeWithheld
+            : why == AttitudeWithheld::kTimeGap    ? HealthCause::kAttitudeWithheldGap
+                                                   : HealthCause::kAttitudeWithheldNoRate;
   f.value = t_s;
-  f.suggested = double(flips);
+  if (why == AttitudeWithheld::kBothFlipping) f.suggested = detail;
+  if (why == AttitudeWithheld::kTimeGap) f.sigma = detail;
   add(h, std::move(f));
+}
+
+void add_flip_setup_findings(HealthReport& h, const BoxGeometry& box,
+                             const std::vector<std::array<double, 2>>& positions_deg, std::uint64_t updates) {
+  HealthReport first;
+  const double sin_apart = box.hinge1_axis.normalized().cross(box.hinge2_axis.normalized()).norm();
+  if (sin_apart < std::sin(kParallelHingesDeg * kRadPerDeg)) {
+    HealthFinding f;
+    f.cause = HealthCause::kParallelHinges;
+    f.severity = HealthVerdict::kFailed;
+    f.value = std::asin(std::min(1.0, sin_apart)) * kDegPerRad;
+    add(first, std::move(f));
+  }
+  if (updates > 0 && positions_deg.size() == 1) {
+    HealthFinding f;
+    f.cause = HealthCause::kNeverFlipped;
+    f.severity = HealthVerdict::kFailed;
+    f.positions_deg = positions_deg;
+    f.count = updates;
+    add(first, std::move(f));
+  }
+  put_first(h, std::move(first));
+}
+
+void add_angle_jitter_finding(HealthReport& h, const StandstillDetector::AngleJitter& j, double tolerance_deg) {
+  if (j.samples == 0 || 2 * j.jittery <= j.samples) return;
+  HealthFinding f;
+  f.cause = HealthCause::kAngleJitter;
+  f.severity = HealthVerdict::kFailed;
+  f.value = j.max_change_deg;
+  f.sigma = tolerance_deg;
+  f.suggested = double(j.jittery) / double(j.samples);
+  HealthReport first;
+  add(first, std::move(f));
+  put_first(h, std::move(first));
+}
+
+void name_prior_rejection(HealthReport& h, const UpdateRecord& first) {
+  if (first.accepted || first.index != 0) return;
+  for (HealthFinding& f : h.findings) {
+    if (f.cause != HealthCause::kLoneRejection || f.suggested != first.t_s) continue;
+    f.cause = HealthCause::kPriorRejected;
+    f.sigma = first.innovation_dps.head(first.dim).cwiseAbs().maxCoeff();
+  }
+}
+
+bool stamp_rate_off(double stated_hz, double median_hz, double mean_hz) {
+  const auto off = [stated_hz](double hz) { return std::fabs(hz / stated_hz - 1.0) > kStampRateTolerance; };
+  return std::isfinite(stated_hz) && std::isfinite(median_hz) && std::isfinite(mean_hz) && off(median_hz) &&
+         off(mean_hz);
+}
+
+void add_stamp_rate_finding(HealthReport& h, double stated_hz, double median_hz, double mean_hz) {
+  if (!stamp_rate_off(stated_hz, median_hz, mean_hz)) return;
+  HealthFinding f;
+  f.cause = HealthCause::kStampRate;
+  const double ratio = median_hz / stated_hz;
+  f.severity = ratio < 0.5 || ratio > 2.0 ? HealthVerdict::kFailed : HealthVerdict::kDegraded;
+  f.value = median_hz;
+  f.sigma = mean_hz;
+  f.suggested = stated_hz;
+  HealthReport first;
+  add(first, std::move(f));
+  put_first(h, std::move(first));
+}
+
+void add_gyro_standstill_findings(HealthReport& h, const GyroFlipTracker& tracker, double flip_angle_deg) {
+  HealthReport first;
+  const GyroFlipTracker::FlipAngleRecord& a = tracker.flip_angles();
+  if (a.unlike > 0) {
+    HealthFinding f;
+    f.cause = HealthCause::kGyroFlipAngle;
+    f.severity = 2 * a.unlike >= a.flips ? HealthVerdict::kFailed : HealthVerdict::kDegraded;
+    f.value = a.measured_flip_angle_deg;
+    f.sigma = flip_angle_deg;
+    f.count = a.unlike;
+    f.suggested = double(a.flips);
+    add(first, std::move(f));
+  }
+  const GyroFlipTracker::GapRecord& g = tracker.gaps();
+  if (g.count > 0) {
+    HealthFinding f;
+    f.cause = HealthCause::kGyroGapPositions;
+    const bool lost = tracker.motion() == GyroFlipTracker::Motion::kUnknown;
+    f.severity = lost ? HealthVerdict::kDegraded : HealthVerdict::kOk;
+    f.value = g.t_s;
+    f.sigma = g.length_s;
+    f.suggested = lost ? kNaN : g.recovered_t_s;
+    f.count = g.changed;
+    add(first, std::move(f));
+  }
+  put_first(h, std::move(first));
 }
 
 const char* to_string(HealthVerdict v) {

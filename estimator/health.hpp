@@ -14,6 +14,7 @@
 #include "estimator/clip_detector.hpp"
 #include "estimator/filter.hpp"
 #include "estimator/lag_check.hpp"
+#include "estimator/standstill_gyro.hpp"
 
 namespace driftless::est {
 
@@ -42,6 +43,29 @@ enum class HealthCause {
                          // the channel; value: its value if stuck, NaN if empty; suggested: rows)
   kAttitudeWithheld,     // standstill: gyro: both platforms flipped at once, no sensor read the box
                          // rate (value: from when, s; suggested: how many such flips)
+  kAttitudeWithheldNoRate,  // no platform rested with a known angle and none moved with its angle
+                            // read (value: from when, s)
+  kAttitudeWithheldGap,  // a time gap inside the comparison: the box's turn in it is unknown
+                         // (value: the sample before it, s; sigma: its length, s)
+  kGyroFlipAngle,        // standstill: gyro: the flips turned unlike 2 flip_angle_deg (value: the
+                         // measured flip angle, deg; sigma: flip_angle_deg; count: such flips;
+                         // suggested: all flips)
+  kStampRate,            // the stamps step at another rate than sample_rate_hz states (value: the
+                         // stamps' rate from the median interval, Hz; sigma: from the mean one, Hz;
+                         // suggested: the stated rate, Hz)
+  kParallelHinges,       // the hinge axes are within kParallelHingesDeg of parallel: the bias along
+                         // the common hinge can never be observed (value: the angle between them, deg)
+  kNeverFlipped,         // every update at one position pair: the platforms never moved
+                         // (positions_deg: that pair; count: the updates)
+  kAngleJitter,          // no standstill, and the angle columns move by small steps above
+                         // angle_tolerance_deg most of the time (value: the largest step, deg; sigma:
+                         // angle_tolerance_deg; suggested: the fraction of samples)
+  kPriorRejected,        // the first update was rejected: its residual lies beyond the prior
+                         // (value: its NIS; suggested: its time, s; sigma: the largest residual
+                         // component, deg/s) - a note, the biases are larger than initial_sigma_dps
+  kGyroGapPositions,     // standstill: gyro: a time gap, after which the positions were recovered
+                         // (a note; count: 1 if a flip was lost in it) or not (degraded); value: the
+                         // sample before the gap, s; sigma: its length, s; suggested: when recovered, s
   kPaperRestAngles,      // paper mode: the platforms rest away from +-flip_angle_deg (eq. (5)'s H)
   kPaperSchedule,        // paper mode: the positions did not follow eq. (5)'s sequence
   kLockLost,             // locked once, then a re-lock widened P and it did not lock again
@@ -128,9 +152,46 @@ void add_saturation_findings(HealthReport& h, const std::vector<ClippedChannel>&
 /// dead channel makes every row invalid, or every standstill wrong on that axis: it is their cause).
 void add_dead_axis_findings(HealthReport& h, const std::vector<DeadChannel>& dead);
 
-/// 'standstill: gyro' and `flips` flips of both platforms at once, the first inside the attitude
-/// comparison at `t_s`: the attitude from there on is withheld (degraded; the biases stand).
-void add_attitude_withheld_finding(HealthReport& h, double t_s, std::uint64_t flips);
+/// The stamps disagree with the stated sample_rate_hz: both their median and their mean interval
+/// (log::LogReader::stamp_rate_*_hz) more than kStampRateTolerance off 1 / sample_rate_hz.
+inline constexpr double kStampRateTolerance = 0.1;
+bool stamp_rate_off(double stated_hz, double median_hz, double mean_hz);
+/// Puts a `stamp_rate` finding first when stamp_rate_off(): durations, the noise per sample and the
+/// gap threshold all use the stated rate. Failed beyond a factor 2 (a unit: ms or us stamps, or a
+/// wrong key), degraded otherwise.
+void add_stamp_rate_finding(HealthReport& h, double stated_hz, double median_hz, double mean_hz);
+
+/// Hinges closer than this to parallel (deg) cannot observe the bias along their common line.
+inline constexpr double kParallelHingesDeg = 10.0;
+/// Two causes of `never_locked` that more flips cannot cure, put first (failed): parallel hinge
+/// axes, and platforms that never moved (`positions_deg`: the position pairs of the `updates`).
+void add_flip_setup_findings(HealthReport& h, const BoxGeometry& box,
+                             const std::vector<std::array<double, 2>>& positions_deg, std::uint64_t updates);
+
+/// Platform columns and no update: the angles moved by small steps (above angle_tolerance_deg,
+/// at most StandstillDetector::kAngleJitterDeg) in more than half of the samples: their noise
+/// hid every standstill. Put first (failed).
+void add_angle_jitter_finding(HealthReport& h, const StandstillDetector::AngleJitter& j, double tolerance_deg);
+/// The lone rejection was the filter's first update: not an outlier but biases beyond the prior.
+/// `first` is that update; the lone_rejection note becomes a prior_rejected note.
+void name_prior_rejection(HealthReport& h, const UpdateRecord& first);
+
+/// Why the attitude comparison stopped (EstimateSummary::attitude_withheld_from_s).
+enum class AttitudeWithheld : std::uint8_t {
+  kNo,
+  kBothFlipping,  // standstill: gyro: both platforms flipped at once
+  kNoBoxRate,     // no sensor gave the box rate (no platform at rest with a known angle)
+  kTimeGap,       // a time gap: the box's turn in it is unknown
+};
+
+/// The attitude from `t_s` on is withheld for `why` (degraded; the biases stand). `detail`: the
+/// flips of both platforms at once (kBothFlipping) or the gap's length, s (kTimeGap).
+void add_attitude_withheld_finding(HealthReport& h, AttitudeWithheld why, double t_s, double detail);
+
+/// 'standstill: gyro': flips whose measured turn was unlike 2 flip_angle_deg (ahead of the others:
+/// their positions were snapped to the wrong stops; failed when at least half of the flips), and a
+/// time gap after which the positions were recovered (a note) or not (degraded).
+void add_gyro_standstill_findings(HealthReport& h, const GyroFlipTracker& tracker, double flip_angle_deg);
 
 /// Paper mode builds H from eq. (5)'s positions, +-flip_angle_deg in its fixed order: standstills
 /// that rested elsewhere or out of that order are findings ahead of the others (their cause),

@@ -137,9 +137,12 @@ struct EstimateSummary {
   double drift_net_fixed_deg_per_h = kNaN;
   double attitude_start_s = kNaN;                  // s, where the comparison started
   double attitude_realign_s = kNaN;                // s, where it was re-aligned (NaN: not)
-  // s, 'standstill: gyro': the comparison stopped at the first flip of both platforms at once (no
-  // sensor read the box rate); the drifts and final errors are withheld (NaN). NaN: not withheld
+  // s, the comparison stopped here: no sensor read the box rate ('standstill: gyro' and a flip of
+  // both platforms at once; no platform angle known), or a time gap hid the box's turn; the drifts
+  // and final errors are withheld (NaN). NaN: not withheld
   double attitude_withheld_from_s = kNaN;
+  AttitudeWithheld attitude_withheld_why = AttitudeWithheld::kNo;
+  double attitude_withheld_gap_s = kNaN;  // s, the gap's length (kTimeGap)
   Vector6d fixed_bias_dps = Vector6d::Constant(kNaN);  // deg/s, the bias held by `fixed`
   AttitudeError final_corrected = kAttitudeErrorUnknown, final_raw = kAttitudeErrorUnknown,
                 final_fixed = kAttitudeErrorUnknown;  // NaN while no comparison was made
