@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include "cli/estimate_health_flip.hpp"
 #include "estimator/log.hpp"
 #include "estimator/numbers.hpp"
 #include "report/json.hpp"
@@ -35,6 +36,7 @@ const char* cause_key(est::HealthCause c) {
     case est::HealthCause::kDeadAxis: return "dead_axis";
     case est::HealthCause::kPaperRestAngles: return "paper_rest_angles";
     case est::HealthCause::kPaperSchedule: return "paper_schedule";
+    default: if (is_flip_cause(c)) return flip_cause_key(c);
   }
   return "?";
 }
@@ -57,6 +59,7 @@ std::string component_names(const std::vector<int>& components) {
 }
 
 std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cfg) {
+  if (is_flip_cause(f.cause)) return describe_flip(f, cfg);
   switch (f.cause) {
     case est::HealthCause::kNoUpdate:
       if (f.suggested > 0.5) {
@@ -192,6 +195,7 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
                          "flip one platform at a time, or log the platform angles (plat1_deg, plat2_deg) and use "
                          "'standstill: platform'",
                          f.value, f.suggested);
+    default: break;  // the flip-turn check's causes: describe_flip()
   }
   return "?";
 }
