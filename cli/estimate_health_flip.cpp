@@ -79,8 +79,9 @@ std::string platform_text(const est::HealthFinding& f, const est::EstimatorConfi
                          f.header_axis[1], f.header_axis[2]);
     default:
       return fmt::format("the gyro turned {:.3g}x the change of plat{}_deg about the hinge in {}: neither a unit nor "
-                         "a sign explains it; check the angle column's scale and the gyro's range (a gyro that "
-                         "clips in a flip reads it short)",
+                         "a sign explains it; check the angle column's scale, the other platform's angle (a wrong "
+                         "resting angle turns the box's rate into the flip: see the findings above) and the gyro's "
+                         "range (a gyro that clips in a flip reads it short)",
                          f.value, p, how_many(f));
   }
 }

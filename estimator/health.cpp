@@ -136,10 +136,12 @@ void add_flip_check_findings(HealthReport& h, const FlipCheckResult& r, const Es
     add_flip_kind(first, r, k, {1, 2}, bad);
   }
   const bool unit_error = !first.findings.empty();
+  // by kind, then platform: a stuck platform's wrong angle also spoils the resting frame in the
+  // other platform's flips (the box's rate leaks into their turn: kOther), so the causes go first
+  for (FlipTurn k : {FlipTurn::kSwapped, FlipTurn::kStuck, FlipTurn::kSign, FlipTurn::kAxis, FlipTurn::kOther}) {
+    for (int p = 1; p <= 2; ++p) add_flip_kind(first, r, k, {p}, bad);
+  }
   for (int p = 1; p <= 2; ++p) {
-    for (FlipTurn k : {FlipTurn::kSwapped, FlipTurn::kStuck, FlipTurn::kSign, FlipTurn::kAxis, FlipTurn::kOther}) {
-      add_flip_kind(first, r, k, {p}, bad);
-    }
     add_flip_kind(first, r, FlipTurn::kWrapped, {p}, selfcal);
     // a scale error along the hinge beyond 3 sigma of its prior: the flip gate rejects its flips
     const PlatformFlipSummary& s = r.platform[static_cast<std::size_t>(p - 1)];

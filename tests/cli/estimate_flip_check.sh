@@ -58,7 +58,9 @@ $mut "$t/car.csv" "$t/swap.csv" swap_sensors || fail "mutate swap_sensors"
 run swap 1; first_finding swap flip_sensors_swapped failed
 $mut "$t/car.csv" "$t/hinges.csv" drop_hinges || fail "mutate drop_hinges"
 run hinges 1; first_finding hinges flip_axis failed
-grep -q "platform 1 turned about (-\?0.00, 1.00, -\?0.00)" "$t/hinges.txt" || fail "hinges: measured axis not y"
+# the truth is y for platform 1 and z for platform 2 (the box's turn tilts the measured axis a little)
+grep -q "platform 1 turned about (-\?0.0[0-9], 1.00, -\?0.0[0-9])" "$t/hinges.txt" || fail "hinges: platform 1's axis not y"
+grep -q "platform 2 turned about (-\?0.0[0-9], -\?0.0[0-9], 1.00)" "$t/hinges.txt" || fail "hinges: platform 2's axis not z"
 
 # F18 --selfcal, sensor 2's scale along its hinge -6.24 % (seed 173): 6 sigma of the 0.01 prior
 $nav --out "$t/scale.csv" --sensor bmi088 --flip-s 2 --scale 0.03 --misalign 1 --gsens 0.05 --duration 200 --seed 173 \
