@@ -30,6 +30,14 @@ void mark_wrapped(std::vector<FlipTurnRecord>& recs, int platform) {
   }
 }
 
+// the six channels (bias-corrected: a constant offset keeps the clip's runs of one value)
+void push_clip(ClipDetector& d, const Eigen::Vector3d& y1, const Eigen::Vector3d& y2) {
+  for (int i = 0; i < 3; ++i) {
+    d.push(i, y1[i], false);
+    d.push(3 + i, y2[i], false);
+  }
+}
+
 }  // namespace
 
 FlipTurn classify_flip(const Eigen::Vector3d& v, const Eigen::Vector3d& w, const Eigen::Vector3d& a, double dtheta_deg,
@@ -67,6 +75,7 @@ bool FlipCheck::push(double t_s, const Eigen::Vector3d& y1c_dps, const Eigen::Ve
   t_last_s_ = valid ? t_s : kNaN;
   if (!valid) {  // a flip with a hole in it is not measured
     open_ = was_rest_ = false;
+    t_back_s_ = kNaN;
     return false;
   }
   if (open_) {
@@ -75,21 +84,34 @@ bool FlipCheck::push(double t_s, const Eigen::Vector3d& y1c_dps, const Eigen::Ve
     } else {
       s1_ += y1c_dps * dt_s;
       s2_ += y2c_dps * dt_s;
+      push_clip(clip_, y1c_dps, y2c_dps);
     }
   }
+  if (both_rest && open_) {
+    if (!std::isfinite(t_back_s_)) {  // back at rest: the end of the turn, then settle_s more
+      t_back_s_ = t_s;
+      p1_end_ = plat1_deg;
+      p2_end_ = plat2_deg;
+    }
+    if (t_s - t_back_s_ < settle_s_) return false;
+  }
+  if (!both_rest) t_back_s_ = kNaN;
   if (both_rest) {
     const bool closing = open_;
     open_ = false;
     was_rest_ = std::isfinite(plat1_deg) && std::isfinite(plat2_deg);
     t_rest_s_ = t_s;
     if (closing) {
-      p1_end_ = plat1_deg;
-      p2_end_ = plat2_deg;
-      t_end_s_ = t_s;
+      t_end_s_ = t_back_s_;  // the flip's length leaves the settle time out
+      t_back_s_ = kNaN;
     }
     p1_rest_ = plat1_deg;
     p2_rest_ = plat2_deg;
     if (!closing || !was_rest_) return false;
+    if (!clip_.suspected().empty()) {  // a gyro clipped in the flip: its turn reads short (saturation finding)
+      ++clipped_;
+      return false;
+    }
     // one platform turned, the other stayed (within a twentieth of the turn: encoder noise)
     const double d1 = std::fabs(p1_end_ - p1_start_), d2 = std::fabs(p2_end_ - p2_start_);
     return std::isfinite(d1 + d2) && std::max(d1, d2) > 0.0 && std::min(d1, d2) < 0.05 * std::max(d1, d2);
@@ -101,6 +123,8 @@ bool FlipCheck::push(double t_s, const Eigen::Vector3d& y1c_dps, const Eigen::Ve
     t_start_s_ = t_rest_s_;
     s1_ = y1c_dps * dt_s;
     s2_ = y2c_dps * dt_s;
+    clip_ = ClipDetector{};
+    push_clip(clip_, y1c_dps, y2c_dps);
   }
   was_rest_ = false;
   return false;
@@ -135,6 +159,7 @@ FlipCheckResult FlipCheck::finish() const {
   mark_wrapped(recs, 2);
   FlipCheckResult out;
   out.flip_max_s = flip_max_s_;
+  out.clipped = clipped_;
   for (int p = 1; p <= 2; ++p) {
     PlatformFlipSummary& s = out.platform[static_cast<std::size_t>(p - 1)];
     s.first_t_s.fill(kNaN);

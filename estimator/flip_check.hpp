@@ -21,6 +21,7 @@
 
 #include <Eigen/Core>
 
+#include "estimator/clip_detector.hpp"
 #include "estimator/sample.hpp"
 
 namespace driftless::est {
@@ -77,13 +78,16 @@ struct FlipCheckResult {
   std::array<PlatformFlipSummary, 2> platform;  // [0]: platform 1
   std::uint64_t flips = 0;                      // flips of one platform with both angles read
   std::uint64_t disagree = 0;                   // flips whose kind is neither kAgrees nor kWrapped
+  std::uint64_t clipped = 0;                    // flips left out: a gyro clipped in them (short turn)
   double flip_max_s = kNaN;                     // s, the configured limit (slower_than_max)
 };
 
 /// Fed each sample of the estimate pass; finish() sums the flips up.
 class FlipCheck {
  public:
-  explicit FlipCheck(double flip_max_s) : flip_max_s_(flip_max_s) {}
+  /// `settle_s`: integrate on this long after both rest again (a sensor's low-pass filter still
+  /// releases the end of the turn then, as in the flip updates' window)
+  FlipCheck(double flip_max_s, double settle_s) : flip_max_s_(flip_max_s), settle_s_(settle_s) {}
   /// Where the platforms' hinges are: body-from-sensor matrices at the flip's start angles.
   struct Frames {
     Eigen::Matrix3d M1_start, M2_start;   // sensor 1 / 2 at its angle before the flip
@@ -102,12 +106,15 @@ class FlipCheck {
   const std::vector<FlipTurnRecord>& records() const { return records_; }
 
  private:
-  double flip_max_s_;
+  double flip_max_s_, settle_s_;
+  double t_back_s_ = kNaN;  // s, when both rested again (the settle time runs from there)
   bool was_rest_ = false, open_ = false;
   double t_last_s_ = kNaN, t_rest_s_ = kNaN, p1_rest_ = kNaN, p2_rest_ = kNaN;
   double p1_start_ = kNaN, p2_start_ = kNaN, p1_end_ = kNaN, p2_end_ = kNaN, t_start_s_ = kNaN, t_end_s_ = kNaN;
   Eigen::Vector3d s1_ = Eigen::Vector3d::Zero(), s2_ = Eigen::Vector3d::Zero();  // deg, integrated readings
   std::vector<FlipTurnRecord> records_;
+  ClipDetector clip_;             // the window's readings (a clipped flip reads short: left out)
+  std::uint64_t clipped_ = 0;
 };
 
 /// The kind of one flip from its sums (pure; exposed for the tests): `v` = S_m − C0 S_s and

@@ -257,7 +257,7 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
   const bool use_window = have_truth && std::isfinite(opt.eval_start_s);
   HealthMonitor health(opt.health);
   LagCheck lag(filter.geometry().sample_rate_hz);
-  FlipCheck flips(cfg.flip_max_s);
+  FlipCheck flips(cfg.flip_max_s, cfg.settle_s);
 
   // the lock state changes only at updates (P shrinks there; a gate re-lock widens it)
   bool locked = false;
