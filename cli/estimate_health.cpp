@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include "cli/estimate_health_flip.hpp"
 #include "estimator/log.hpp"
 #include "estimator/numbers.hpp"
 #include "report/json.hpp"
@@ -45,6 +46,7 @@ const char* cause_key(est::HealthCause c) {
     case est::HealthCause::kPaperRestAngles: return "paper_rest_angles";
     case est::HealthCause::kPaperSchedule: return "paper_schedule";
     case est::HealthCause::kLockLost: return "lock_lost";
+    default: if (is_flip_cause(c)) return flip_cause_key(c);
   }
   return "?";
 }
@@ -324,6 +326,7 @@ std::string describe_input_checks(const est::HealthFinding& f, const est::Estima
 }  // namespace
 
 std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cfg) {
+  if (is_flip_cause(f.cause)) return describe_flip(f, cfg);
   switch (f.cause) {
     case est::HealthCause::kNoUpdate:
     case est::HealthCause::kAllRejected:
@@ -356,6 +359,7 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
     case est::HealthCause::kNeverFlipped:
     case est::HealthCause::kGyroGapPositions:
       return describe_input_checks(f, cfg);
+    default: break;  // the flip-turn check's causes: describe_flip() above
   }
   return "?";
 }

@@ -76,6 +76,101 @@ void add_saturation_findings(HealthReport& h, const std::vector<ClippedChannel>&
   put_first(h, std::move(first));
 }
 
+namespace {
+
+HealthCause flip_cause(FlipTurn k) {
+  switch (k) {
+    case FlipTurn::kGyroRadPerS: return HealthCause::kFlipGyroUnit;
+    case FlipTurn::kAngleRadians: return HealthCause::kFlipAngleUnit;
+    case FlipTurn::kTimeMs:
+    case FlipTurn::kTimeUs: return HealthCause::kFlipTimeUnit;
+    case FlipTurn::kStuck: return HealthCause::kFlipNotSeen;
+    case FlipTurn::kSign: return HealthCause::kFlipAngleSign;
+    case FlipTurn::kWrapped: return HealthCause::kFlipWrapped;
+    case FlipTurn::kSwapped: return HealthCause::kFlipSensorsSwapped;
+    case FlipTurn::kAxis: return HealthCause::kFlipAxis;
+    case FlipTurn::kAgrees:
+    case FlipTurn::kOther: break;
+  }
+  return HealthCause::kFlipTurnRatio;
+}
+
+// one finding for the flips of `kind` on the platforms that had any (a unit error shows on both)
+void add_flip_kind(HealthReport& first, const FlipCheckResult& r, FlipTurn kind, const std::vector<int>& platforms,
+                   HealthVerdict severity) {
+  HealthFinding f;
+  f.cause = flip_cause(kind);
+  f.severity = severity;
+  f.sigma = kNaN;
+  const int k = static_cast<int>(kind);
+  std::uint64_t most = 0;
+  for (int p : platforms) {
+    const PlatformFlipSummary& s = r.platform[static_cast<std::size_t>(p - 1)];
+    if (s.count[k] == 0) continue;
+    f.components.push_back(p);
+    f.count += s.count[k];
+    f.suggested = (std::isnan(f.suggested) ? 0.0 : f.suggested) + double(s.flips);
+    if (!(f.sigma <= s.first_t_s[k])) f.sigma = s.first_t_s[k];
+    if (s.count[k] > most) {  // the ratio of the platform with most such flips
+      most = s.count[k];
+      f.value = s.median_ratio[k];
+      for (int i = 0; i < 3; ++i) {
+        f.measured_axis[static_cast<std::size_t>(i)] = s.axis_sensor[i];
+        f.header_axis[static_cast<std::size_t>(i)] = s.hinge_sensor[i];
+      }
+    }
+  }
+  if (f.count > 0) add(first, std::move(f));
+}
+
+}  // namespace
+
+void add_flip_check_findings(HealthReport& h, const FlipCheckResult& r, const EstimatorConfig& cfg) {
+  if (r.flips == 0) return;
+  HealthReport first;
+  // a wrong unit or convention makes every number wrong: failed when most flips disagree
+  const HealthVerdict bad = 2 * r.disagree > r.flips ? HealthVerdict::kFailed : HealthVerdict::kDegraded;
+  const bool flip_updates = cfg.self_calibration && cfg.flip_updates;
+  const HealthVerdict selfcal = flip_updates ? HealthVerdict::kDegraded : HealthVerdict::kOk;
+  for (FlipTurn k : {FlipTurn::kGyroRadPerS, FlipTurn::kAngleRadians, FlipTurn::kTimeMs, FlipTurn::kTimeUs}) {
+    add_flip_kind(first, r, k, {1, 2}, bad);
+  }
+  const bool unit_error = !first.findings.empty();
+  // by kind, then platform: a stuck platform's wrong angle also spoils the resting frame in the
+  // other platform's flips (the box's rate leaks into their turn: kOther), so the causes go first
+  for (FlipTurn k : {FlipTurn::kSwapped, FlipTurn::kStuck, FlipTurn::kSign, FlipTurn::kAxis, FlipTurn::kOther}) {
+    for (int p = 1; p <= 2; ++p) add_flip_kind(first, r, k, {p}, bad);
+  }
+  for (int p = 1; p <= 2; ++p) {
+    add_flip_kind(first, r, FlipTurn::kWrapped, {p}, selfcal);
+    // a scale error along the hinge beyond 3 sigma of its prior: the flip gate rejects its flips
+    const PlatformFlipSummary& s = r.platform[static_cast<std::size_t>(p - 1)];
+    const double ratio = s.median_ratio[static_cast<int>(FlipTurn::kAgrees)];
+    if (!unit_error && s.of(FlipTurn::kAgrees) >= 2 && std::fabs(ratio - 1.0) > 3.0 * cfg.scale_misalign_sigma_frac) {
+      HealthFinding f;
+      f.cause = HealthCause::kFlipScale;
+      f.severity = selfcal;
+      f.value = ratio;
+      f.components = {p};
+      f.count = s.of(FlipTurn::kAgrees);
+      f.suggested = double(s.flips);
+      add(first, std::move(f));
+    }
+  }
+  // flips longer than flip_max_s never become flip updates
+  const std::uint64_t slow = r.platform[0].slower_than_max + r.platform[1].slower_than_max;
+  if (flip_updates && !unit_error && slow > 0) {
+    HealthFinding f;
+    f.cause = HealthCause::kFlipsTooSlow;
+    f.severity = 2 * slow >= r.flips ? HealthVerdict::kDegraded : HealthVerdict::kOk;
+    f.value = std::max(r.platform[0].longest_s, r.platform[1].longest_s);
+    f.count = slow;
+    f.suggested = double(r.flips);
+    add(first, std::move(f));
+  }
+  put_first(h, std::move(first));
+}
+
 void add_dead_axis_findings(HealthReport& h, const std::vector<DeadChannel>& dead) {
   if (dead.empty()) return;
   HealthReport first;

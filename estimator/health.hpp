@@ -13,6 +13,7 @@
 
 #include "estimator/clip_detector.hpp"
 #include "estimator/filter.hpp"
+#include "estimator/flip_check.hpp"
 #include "estimator/lag_check.hpp"
 #include "estimator/standstill_gyro.hpp"
 
@@ -69,6 +70,19 @@ enum class HealthCause {
   kPaperRestAngles,      // paper mode: the platforms rest away from +-flip_angle_deg (eq. (5)'s H)
   kPaperSchedule,        // paper mode: the positions did not follow eq. (5)'s sequence
   kLockLost,             // locked once, then a re-lock widened P and it did not lock again
+  // the flip-turn check (flip_check.hpp; components: the platforms, value: the median turn/Δθ,
+  // count: such flips, suggested: the platforms' flips, sigma: the first one's time, s)
+  kFlipGyroUnit,         // turn/Δθ ≈ 1/57.3: gyro columns in rad/s
+  kFlipAngleUnit,        // turn/Δθ ≈ 57.3: angle columns in radians
+  kFlipTimeUnit,         // turn/Δθ ≈ 1e3 or 1e6: stamps in ms or µs
+  kFlipNotSeen,          // the gyro saw no turn where the angle column flipped: stuck platform
+  kFlipAngleSign,        // turn/Δθ ≈ −1: the angle counts against the right-hand rule
+  kFlipWrapped,          // one-way platform, angle wrapped at ±180: the flip updates drop those
+  kFlipSensorsSwapped,   // the resting sensor's column turned about the moving hinge
+  kFlipAxis,             // the turn is about another axis than the header's hinge (measured_axis)
+  kFlipTurnRatio,        // about the hinge by a ratio none of the above
+  kFlipScale,            // 1 ± a few % beyond 3 sigma of the scale prior (value: the median ratio)
+  kFlipsTooSlow,         // flips longer than flip_max_s (value: the longest, s): no flip update
 };
 
 /// One check that did not pass, with the numbers that describe() turns into text.
@@ -95,6 +109,8 @@ struct HealthFinding {
   // kPaperRestAngles: value = the standstills off, suggested = a rest angle read (deg), sigma =
   // flip_angle_deg; kPaperSchedule: value = the standstills off; both: count = paper standstills
   std::uint64_t count = 0;
+  // kFlipAxis: the turn axis measured, and the header's hinge, both in that sensor's axes
+  std::array<double, 3> measured_axis{}, header_axis{};
 };
 
 /// Limits of the verdict (docs/estimator.md section 6.1).
@@ -198,6 +214,13 @@ void add_gyro_standstill_findings(HealthReport& h, const GyroFlipTracker& tracke
 /// `failed` when at least half of the standstills are off (most updates used an H that is not the
 /// box's), else `degraded`. `counters` are the filter's at the end of the pass.
 void add_paper_mode_findings(HealthReport& h, const FilterCounters& counters, double flip_angle_deg);
+
+/// The flip-turn check's findings (flip_check.hpp), ahead of the others (a wrong unit, a stuck
+/// platform or a wrong hinge makes the updates wrong): `failed` when most flips disagree with
+/// their angle columns, else `degraded`; a one-way platform's wrapped flips, a scale error along
+/// a hinge beyond 3 sigma of the prior and flips slower than flip_max_s are `degraded` with
+/// --selfcal (whose flip updates they defeat), notes without it.
+void add_flip_check_findings(HealthReport& h, const FlipCheckResult& r, const EstimatorConfig& cfg);
 
 /// Watches the updates of one pass and gives the verdict at the end.
 class HealthMonitor {

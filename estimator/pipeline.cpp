@@ -8,6 +8,7 @@
 
 #include <Eigen/Cholesky>
 
+#include "estimator/flip_check.hpp"
 #include "estimator/stats.hpp"
 
 namespace driftless::est {
@@ -264,6 +265,16 @@ void note_position(std::vector<std::array<double, 2>>& seen, double p1_deg, doub
 // after an update: is the correction locked (filter_locked at the lock level)? Records the first
 // lock, each gate re-lock and when the lock came back after it.
 // `t_s` is the time of the sample whose push made the update: the first row it corrects.
+// the flip-turn check (flip_check.hpp): one sample of the filter's output; a flip that ended is
+// measured in the frames of its start angles
+void check_flip(FlipCheck& check, const DriftlessFilter& filter) {
+  const SampleOutput& o = filter.output();
+  if (!check.push(o.t_s, o.y1c_dps, o.y2c_dps, o.plat1_deg, o.plat2_deg, o.at_rest)) return;
+  const BoxGeometry& box = filter.geometry();
+  check.close({filter.body_from_sensor(1, check.start_deg(1)), filter.body_from_sensor(2, check.start_deg(2)),
+               box.hinge1_axis.normalized(), box.hinge2_axis.normalized()});
+}
+
 bool lock_step(const DriftlessFilter& filter, double lock_sigma_dps, const UpdateRecord& u, double t_s,
                EstimateSummary& sum) {
   if (u.relocked) sum.relocks.push_back({u.t_s, u.relock_nis, kNaN});
@@ -321,6 +332,7 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
   const bool use_window = have_truth && std::isfinite(opt.eval_start_s);
   HealthMonitor health(opt.health);
   LagCheck lag(filter.geometry().sample_rate_hz);
+  FlipCheck flips(cfg.flip_max_s, cfg.settle_s);
 
   // the lock state changes only at updates (P shrinks there; a gate re-lock widens it)
   bool locked = false;
@@ -352,6 +364,7 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
     const PushStatus st = filter.push(s);
     on_update(st, s);  // first: the row that made an update carries the state after it
     lag.push(s, filter);
+    check_flip(flips, filter);
     sum.samples_locked += locked ? 1 : 0;
     if (sink != nullptr) sink->on_sample(s, filter.output(), locked);
     if (use_window) window.add(filter, s);
@@ -407,6 +420,7 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
   sum.health = health.finish(filter, sum.rows > 0 ? sum.t_last_s - sum.t_first_s : 0.0, lag.finish());
   name_prior_rejection(sum.health, first_update);
   add_input_findings(meta, reader, cfg, filter, positions, sum);
+  add_flip_check_findings(sum.health, flips.finish(), cfg);
   return sum;
 }
 
