@@ -257,6 +257,11 @@ int run_estimate_cmd(const EstimateArgs& a) {
     fmt::print("  attitude: compared from t = {:.1f} s, withheld from t = {:.1f} s (both platforms flipped at once; "
                "see the warning)\n",
                summary.attitude_start_s, summary.attitude_withheld_from_s);
+  } else if (summary.attitude_available && !std::isfinite(summary.final_corrected.angle_deg) &&
+             summary.reference.verdict != est::RefFitVerdict::kFits &&
+             summary.reference.verdict != est::RefFitVerdict::kNotChecked) {
+    fmt::print("  attitude: withheld (ref_q does not turn with the gyros: see the health finding "
+               "reference_mismatch)\n");
   } else if (summary.attitude_available) {
     fmt::print("  attitude drift from t = {:.1f} s: {:.2f} deg/h with DriftLess, {:.2f} deg/h with the bias "
                "fixed at that start, {:.2f} deg/h uncorrected\n",

@@ -35,6 +35,7 @@ const char* cause_key(est::HealthCause c) {
     case est::HealthCause::kDeadAxis: return "dead_axis";
     case est::HealthCause::kPaperRestAngles: return "paper_rest_angles";
     case est::HealthCause::kPaperSchedule: return "paper_schedule";
+    case est::HealthCause::kReferenceMismatch: return "reference_mismatch";
   }
   return "?";
 }
@@ -46,6 +47,46 @@ std::string position_text(const std::vector<std::array<double, 2>>& pairs) {
     o += fmt::format("{}({:g}, {:g})", i == 0 ? "" : i + 1 == pairs.size() ? " and " : ", ", pairs[i][0], pairs[i][1]);
   }
   return o + " deg";
+}
+
+// what to do with ref_q's columns when they were written in convention `c`
+std::string reference_fix(est::RefConvention c) {
+  switch (c) {
+    case est::RefConvention::kBodyFromEnuWxyz:
+      return "conjugate it (negate ref_qx, ref_qy, ref_qz)";
+    case est::RefConvention::kEnuFromBodyXyzw:
+      return "write the scalar first (the columns ref_qw, ref_qx, ref_qy, ref_qz hold x, y, z, w: move the 4th to the 1st)";
+    case est::RefConvention::kBodyFromEnuXyzw:
+      return "write the scalar first and conjugate it (the columns hold x, y, z, w of q_body_from_enu: w, -x, -y, -z)";
+    case est::RefConvention::kEnuFromBodyWxyz: break;
+  }
+  return "nothing";
+}
+
+std::string describe_reference(const est::HealthFinding& f) {
+  constexpr const char* kAxes = "xyz";
+  const int axis = f.components.empty() ? 0 : f.components[0];
+  const auto& ex = f.positions_deg;
+  const std::string example =
+      ex.size() < 2 ? std::string()
+                    : fmt::format(" (at t = {:.1f} s the fused gyros turned the box {:+.1f} deg about {} in {:.2g} s, "
+                                  "ref_q {:+.1f} deg)",
+                                  ex[0][0], ex[1][0], kAxes[axis], ex[0][1], ex[1][1], kAxes[axis]);
+  const std::string head = fmt::format(
+      "ref_q does not turn with the gyros{}: over {} turning windows its misfit is {:.3g} (0 = the same turns, "
+      "4 = turning the other way; a fit is below 0.1)",
+      example, f.count, f.value);
+  if (std::isfinite(f.suggested)) {
+    const auto c = static_cast<est::RefConvention>(static_cast<int>(f.suggested));
+    return fmt::format("{}; the data fit ref_q as {} (misfit {:.3g}), where the log format wants q_enu_from_body, "
+                       "scalar first: {}. The attitude drift and final errors are withheld (attitude.csv holds the "
+                       "errors against ref_q as written); the biases are not affected",
+                       head, est::to_string(c), f.sigma, reference_fix(c));
+  }
+  return fmt::format("{}; no convention fits (conjugate or scalar last: the best misfit is {:.3g}): ref_q is the "
+                     "attitude of another body (a reference IMU mounted turned on the box?), or the gyro columns are "
+                     "not in deg/s. The attitude drift and final errors are withheld; check ref_q against the box axes",
+                     head, f.sigma);
 }
 
 }  // namespace
@@ -186,6 +227,7 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
                          "biases from this log cannot be trusted. Check the sensor",
                          name, exact_number(f.value), f.suggested);
     }
+    case est::HealthCause::kReferenceMismatch: return describe_reference(f);
     case est::HealthCause::kAttitudeWithheld:
       return fmt::format("attitude withheld from t = {:.2f} s: {:g} flip(s) moved both platforms at once, and with "
                          "'standstill: gyro' no sensor then reads the box rate alone (the biases are not affected); "

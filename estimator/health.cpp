@@ -102,6 +102,21 @@ void add_attitude_withheld_finding(HealthReport& h, double t_s, std::uint64_t fl
   add(h, std::move(f));
 }
 
+void add_reference_finding(HealthReport& h, const ReferenceFit& fit) {
+  if (fit.verdict != RefFitVerdict::kOtherConvention && fit.verdict != RefFitVerdict::kNoFit) return;
+  HealthFinding f;
+  f.cause = HealthCause::kReferenceMismatch;
+  f.value = fit.misfit[0];
+  f.sigma = fit.misfit[static_cast<std::size_t>(fit.best)];
+  f.suggested = fit.verdict == RefFitVerdict::kOtherConvention ? double(static_cast<int>(fit.best)) : kNaN;
+  f.count = fit.windows;
+  int axis = 0;
+  fit.example_gyro_deg.cwiseAbs().maxCoeff(&axis);
+  f.components = {axis};
+  f.positions_deg = {{fit.example_t_s, fit.example_span_s}, {fit.example_gyro_deg[axis], fit.example_ref_deg[axis]}};
+  add(h, std::move(f));
+}
+
 const char* to_string(HealthVerdict v) {
   switch (v) {
     case HealthVerdict::kOk: return "ok";

@@ -14,6 +14,7 @@
 #include "estimator/clip_detector.hpp"
 #include "estimator/filter.hpp"
 #include "estimator/lag_check.hpp"
+#include "estimator/reference_check.hpp"
 
 namespace driftless::est {
 
@@ -44,6 +45,11 @@ enum class HealthCause {
                          // rate (value: from when, s; suggested: how many such flips)
   kPaperRestAngles,      // paper mode: the platforms rest away from +-flip_angle_deg (eq. (5)'s H)
   kPaperSchedule,        // paper mode: the positions did not follow eq. (5)'s sequence
+  kReferenceMismatch,    // ref_q does not turn with the gyros (reference_check.hpp): value = the
+                         // misfit of the log's convention, sigma = the best misfit, suggested = the
+                         // best RefConvention (as a number; kNoFit: NaN), count = turning windows,
+                         // components = {the box axis of the example turn}, positions_deg =
+                         // {{its end time s, its span s}, {gyro turn deg, ref_q turn deg about that axis}}
 };
 
 /// One check that did not pass, with the numbers that describe() turns into text.
@@ -126,6 +132,10 @@ void add_dead_axis_findings(HealthReport& h, const std::vector<DeadChannel>& dea
 /// 'standstill: gyro' and `flips` flips of both platforms at once, the first inside the attitude
 /// comparison at `t_s`: the attitude from there on is withheld (degraded; the biases stand).
 void add_attitude_withheld_finding(HealthReport& h, double t_s, std::uint64_t flips);
+
+/// ref_q in another convention than the log's, or fitting none (reference_check.hpp): a degraded
+/// `reference_mismatch` finding (the attitude figures are withheld; the biases stand).
+void add_reference_finding(HealthReport& h, const ReferenceFit& fit);
 
 /// Paper mode builds H from eq. (5)'s positions, +-flip_angle_deg in its fixed order: standstills
 /// that rested elsewhere or out of that order are findings ahead of the others (their cause),

@@ -216,6 +216,18 @@ void withhold_attitude(const DriftlessFilter& filter, EstimateSummary& sum) {
       "platform angles (plat1_deg, plat2_deg)");
 }
 
+// ref_q in another convention than the log's (or of another body): the errors against it say
+// nothing of the drift, so the figures are withheld (attitude.csv stays, for a look)
+void withhold_attitude_reference(EstimateSummary& sum) {
+  const RefFitVerdict v = sum.reference.verdict;
+  if (v != RefFitVerdict::kOtherConvention && v != RefFitVerdict::kNoFit) return;
+  sum.drift_corrected_deg_per_h = sum.drift_raw_deg_per_h = sum.drift_fixed_deg_per_h = kNaN;
+  sum.drift_net_corrected_deg_per_h = sum.drift_net_raw_deg_per_h = sum.drift_net_fixed_deg_per_h = kNaN;
+  AttitudeError none;
+  none.roll_deg = none.pitch_deg = none.heading_deg = none.angle_deg = kNaN;
+  sum.final_corrected = sum.final_raw = sum.final_fixed = none;
+}
+
 // after an update: is the correction locked (filter_locked at the lock level)? Records the first
 // lock, each gate re-lock and when the lock came back after it.
 // `t_s` is the time of the sample whose push made the update: the first row it corrects.
@@ -248,6 +260,7 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
   const bool use_window = have_truth && std::isfinite(opt.eval_start_s);
   HealthMonitor health(opt.health);
   LagCheck lag(filter.geometry().sample_rate_hz);
+  ReferenceCheck ref_check;
 
   // the lock state changes only at updates (P shrinks there; a gate re-lock widens it)
   bool locked = false;
@@ -273,6 +286,7 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
     const PushStatus st = filter.push(s);
     on_update(st, s);  // first: the row that made an update carries the state after it
     lag.push(s, filter);
+    if (sum.attitude_available) ref_check.push(s, filter);
     sum.samples_locked += locked ? 1 : 0;
     if (sink != nullptr) sink->on_sample(s, filter.output(), locked);
     if (use_window) window.add(filter, s);
@@ -324,6 +338,8 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
   sum.stop_angle_sigma_deg = filter.stop_angle_sigma_deg();
   add_attitude_results(att, filter, opt, sum);
   withhold_attitude(filter, sum);
+  sum.reference = ref_check.finish();
+  withhold_attitude_reference(sum);
   score.finish();
   if (use_window) window.finish(filter);
   sum.health = health.finish(filter, sum.rows > 0 ? sum.t_last_s - sum.t_first_s : 0.0, lag.finish());
@@ -333,6 +349,7 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
     add_dead_axis_findings(sum.health, reader->dead_channels());
   }
   add_attitude_withheld_finding(sum.health, sum.attitude_withheld_from_s, sum.counters.simultaneous_flips);
+  add_reference_finding(sum.health, sum.reference);
   return sum;
 }
 

@@ -12,6 +12,7 @@
 
 #include "estimator/attitude.hpp"
 #include "estimator/attitude_comparison.hpp"
+#include "estimator/reference_check.hpp"
 #include "estimator/filter.hpp"
 #include "estimator/health.hpp"
 #include "estimator/log.hpp"
@@ -140,6 +141,9 @@ struct EstimateSummary {
   // s, 'standstill: gyro': the comparison stopped at the first flip of both platforms at once (no
   // sensor read the box rate); the drifts and final errors are withheld (NaN). NaN: not withheld
   double attitude_withheld_from_s = kNaN;
+  // does ref_q turn with the gyros (reference_check.hpp)? When another convention fits, or none,
+  // the drifts and final errors are withheld (NaN) and health names reference_mismatch
+  ReferenceFit reference;
   Vector6d fixed_bias_dps = Vector6d::Constant(kNaN);  // deg/s, the bias held by `fixed`
   AttitudeError final_corrected, final_raw, final_fixed;
   TruthStats truth;
