@@ -152,7 +152,10 @@ void add_stream_warnings(const log::Metadata& meta, EstimateSummary& sum) {
                            "); results cover the rows present");
   }
   if (!std::isfinite(meta.latitude_deg())) {
-    sum.warnings.push_back("no latitude_deg in the log: the Earth rate is removed at latitude 0");
+    sum.warnings.push_back(
+        "no latitude_deg in the log: the Earth rate is removed at latitude 0; the box dwells and --box-at-rest take "
+        "the vertical Earth rate as unknown (0 +- 0.0024 deg/s, 1 sigma, for any latitude, on top of box_rest_rate_sigma_dps). "
+        "Add '# latitude_deg: ...' to the header for both");
   }
 }
 
