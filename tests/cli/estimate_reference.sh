@@ -12,7 +12,7 @@ py=/usr/bin/python3
 t=$(mktemp -d); trap 'rm -rf "$t"' EXIT
 fail() { echo "FAIL: $*"; exit 1; }
 
-"$py" "$src/tests/estimator/navgen.py" --out "$t/car.csv" --sensor bmi088 --motion car --duration 300 --seed 131 > /dev/null
+"$py" "$src/tests/estimator/navgen.py" --out "$t/car.csv" --sensor bmi088 --motion car --duration 300 --seed 131 > /dev/null 2>&1
 # the same log with ref_q conjugated, and with its columns written x, y, z, w
 awk -F, 'BEGIN{OFS=","} /^#/{print;next} !h{h=1;for(i=1;i<=NF;i++){if($i=="ref_qx")x=i;if($i=="ref_qy")y=i;if($i=="ref_qz")z=i}; print;next}
          {$x=sprintf("%.10f",-$x);$y=sprintf("%.10f",-$y);$z=sprintf("%.10f",-$z); print}' "$t/car.csv" > "$t/conj.csv"
