@@ -37,6 +37,7 @@ const char* cause_key(est::HealthCause c) {
     case est::HealthCause::kPaperSchedule: return "paper_schedule";
     case est::HealthCause::kLockLost: return "lock_lost";
     case est::HealthCause::kReferenceMismatch: return "reference_mismatch";
+    case est::HealthCause::kBoxNotAtRest: return "box_not_at_rest";
   }
   return "?";
 }
@@ -62,6 +63,27 @@ std::string reference_fix(est::RefConvention c) {
     case est::RefConvention::kEnuFromBodyWxyz: break;
   }
   return "nothing";
+}
+
+std::string describe_box_motion(const est::HealthFinding& f) {
+  std::string seen;
+  if (f.value > est::BoxMotionLimits{}.ref_rate_dps) {
+    seen = fmt::format("ref_q turned at up to {:.3g} deg/s over a standstill", f.value);
+  }
+  if (f.sigma > est::BoxMotionLimits{}.gyro_change_dps) {
+    seen += fmt::format("{}the fused rate changed by up to {:.3g} deg/s within one (the bias cannot)",
+                        seen.empty() ? "" : " and ", f.sigma);
+  }
+  const bool at_rest = !f.components.empty() && f.components[0] == 1;
+  const std::string claim =
+      at_rest ? std::string("--box-at-rest claims the box turns at the Earth rate only while the platforms rest")
+              : fmt::format("{} box dwells took the box as turning at the Earth rate only", f.count);
+  return fmt::format("the box was not at rest while both platforms rested: {} (e.g. t = {:.1f} s); {}, and the "
+                     "turn entered the biases and the g-sensitivity as if it were theirs. {}",
+                     seen, f.suggested, claim,
+                     at_rest ? "Drop --box-at-rest (a box in a vehicle, on a ship or a turntable turns)"
+                             : "Set box_dwell_updates: false in the configuration (a box in a vehicle, on a ship or "
+                               "a slow turntable)");
 }
 
 std::string describe_reference(const est::HealthFinding& f) {
@@ -298,6 +320,8 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
       return describe_input(f);
     case est::HealthCause::kReferenceMismatch:
       return describe_reference(f);
+    case est::HealthCause::kBoxNotAtRest:
+      return describe_box_motion(f);
   }
   return "?";
 }

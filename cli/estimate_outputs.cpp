@@ -236,6 +236,10 @@ void write_estimate_summary(const fs::path& path, const SummaryContext& ctx, con
   add("  \"locked_from_t_s\": {}, \"rows_locked\": {},\n", json_number(s.locked_from_t_s), s.samples_locked);
   add("  \"attitude_start_s\": {}, \"attitude_withheld_from_s\": {},\n", json_number(s.attitude_start_s),
       json_number(s.attitude_withheld_from_s));
+  add("  \"box_motion_at_rest\": {{\"ref_rate_dps\": {}, \"quiet_ref_rate_dps\": {}, \"fused_rate_change_dps\": {}, "
+      "\"standstills\": {}}},\n",
+      json_number(s.box_motion.ref_rate_dps), json_number(s.box_motion.quiet_ref_rate_dps),
+      json_number(s.box_motion.gyro_change_dps), s.box_motion.standstills);
   add("  \"reference_check\": {{\"verdict\": {}, \"turning_windows\": {}, \"misfit_as_written\": {}, "
       "\"best_fit\": {}, \"best_misfit\": {}}},\n",
       json_string(reference_verdict_key(s.reference.verdict)), s.reference.windows,

@@ -102,6 +102,23 @@ void add_attitude_withheld_finding(HealthReport& h, double t_s, std::uint64_t fl
   add(h, std::move(f));
 }
 
+void add_box_motion_finding(HealthReport& h, const BoxMotion& m, bool box_at_rest, std::uint64_t dwell_updates) {
+  // --box-at-rest claims every standstill; a dwell only the quiet ones (below box_dwell_rate_dps)
+  const bool fired = box_at_rest ? box_turned(m) : dwell_updates > 0 && box_turned_slowly(m);
+  if (!fired) return;
+  HealthFinding f;
+  f.cause = HealthCause::kBoxNotAtRest;
+  f.value = box_at_rest ? m.ref_rate_dps : m.quiet_ref_rate_dps;
+  f.sigma = box_at_rest ? m.gyro_change_dps : kNaN;
+  const bool by_ref = f.value > BoxMotionLimits{}.ref_rate_dps;
+  f.suggested = !box_at_rest ? m.quiet_ref_rate_t_s : by_ref ? m.ref_rate_t_s : m.gyro_change_t_s;
+  f.count = dwell_updates;
+  f.components = {box_at_rest ? 1 : 0};
+  HealthReport first;
+  add(first, std::move(f));
+  put_first(h, std::move(first));
+}
+
 void add_reference_finding(HealthReport& h, const ReferenceFit& fit) {
   if (fit.verdict != RefFitVerdict::kOtherConvention && fit.verdict != RefFitVerdict::kNoFit) return;
   HealthFinding f;

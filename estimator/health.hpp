@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "estimator/box_motion_check.hpp"
 #include "estimator/clip_detector.hpp"
 #include "estimator/filter.hpp"
 #include "estimator/lag_check.hpp"
@@ -46,6 +47,11 @@ enum class HealthCause {
   kPaperRestAngles,      // paper mode: the platforms rest away from +-flip_angle_deg (eq. (5)'s H)
   kPaperSchedule,        // paper mode: the positions did not follow eq. (5)'s sequence
   kLockLost,             // locked once, then a re-lock widened P and it did not lock again
+  kBoxNotAtRest,         // --box-at-rest or box dwells, yet the box turned while both platforms
+                         // rested (box_motion_check.hpp): value = ref_q's largest turn rate over a
+                         // standstill (deg/s; NaN: no ref_q), sigma = the largest change of the fused
+                         // rate within one (deg/s), suggested = when (s), count = box dwell updates,
+                         // components = {1 if --box-at-rest, else 0}
   kReferenceMismatch,    // ref_q does not turn with the gyros (reference_check.hpp): value = the
                          // misfit of the log's convention, sigma = the best misfit, suggested = the
                          // best RefConvention (as a number; kNoFit: NaN), count = turning windows,
@@ -137,6 +143,10 @@ void add_dead_axis_findings(HealthReport& h, const std::vector<DeadChannel>& dea
 /// 'standstill: gyro' and `flips` flips of both platforms at once, the first inside the attitude
 /// comparison at `t_s`: the attitude from there on is withheld (degraded; the biases stand).
 void add_attitude_withheld_finding(HealthReport& h, double t_s, std::uint64_t flips);
+
+/// --box-at-rest, or box dwells used (`dwell_updates` > 0), on a box that turned while the
+/// platforms rested (box_turned): `box_not_at_rest` ahead of the other findings (their cause).
+void add_box_motion_finding(HealthReport& h, const BoxMotion& m, bool box_at_rest, std::uint64_t dwell_updates);
 
 /// ref_q in another convention than the log's, or fitting none (reference_check.hpp): a degraded
 /// `reference_mismatch` finding (the attitude figures are withheld; the biases stand).

@@ -262,6 +262,7 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
   HealthMonitor health(opt.health);
   LagCheck lag(filter.geometry().sample_rate_hz);
   ReferenceCheck ref_check;
+  BoxMotionCheck box_motion;
 
   // the lock state changes only at updates (P shrinks there; a gate re-lock widens it)
   bool locked = false;
@@ -288,6 +289,7 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
     on_update(st, s);  // first: the row that made an update carries the state after it
     lag.push(s, filter);
     if (sum.attitude_available) ref_check.push(s, filter);
+    box_motion.push(s, filter.output());
     sum.samples_locked += locked ? 1 : 0;
     if (sink != nullptr) sink->on_sample(s, filter.output(), locked);
     if (use_window) window.add(filter, s);
@@ -351,6 +353,8 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
   }
   add_attitude_withheld_finding(sum.health, sum.attitude_withheld_from_s, sum.counters.simultaneous_flips);
   add_reference_finding(sum.health, sum.reference);
+  sum.box_motion = box_motion.finish();
+  add_box_motion_finding(sum.health, sum.box_motion, cfg.box_at_rest, sum.counters.box_dwell_updates);
   return sum;
 }
 
