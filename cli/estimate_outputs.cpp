@@ -240,7 +240,7 @@ void write_estimate_summary(const fs::path& path, const SummaryContext& ctx, con
       "\"standstills\": {}}},\n",
       json_number(s.box_motion.ref_rate_dps), json_number(s.box_motion.quiet_ref_rate_dps),
       json_number(s.box_motion.gyro_change_dps), s.box_motion.standstills);
-  add("  \"reference_check\": {{\"verdict\": {}, \"turning_windows\": {}, \"misfit_as_written\": {}, "
+  add("  \"reference_check\": {{\"result\": {}, \"turning_windows\": {}, \"misfit_as_written\": {}, "
       "\"best_fit\": {}, \"best_misfit\": {}}},\n",
       json_string(reference_verdict_key(s.reference.verdict)), s.reference.windows,
       json_number(s.reference.windows > 0 ? s.reference.misfit[0] : kNaN),

@@ -20,7 +20,7 @@ awk -F, 'BEGIN{OFS=","} /^#/{print;next} !h{h=1;for(i=1;i<=NF;i++){if($i=="ref_q
          {a=$w;b=$x;c=$y;d=$z;$w=b;$x=c;$y=d;$z=a; print}' "$t/car.csv" > "$t/xyzw.csv"
 
 "$bin" estimate --log "$t/car.csv" --out "$t/o" --strict > /dev/null 2>&1 || fail "the log's own convention: estimate --strict failed"
-jq -e '.reference_check.verdict == "fits" and .reference_check.turning_windows >= 10
+jq -e '.reference_check.result == "fits" and .reference_check.turning_windows >= 10
        and .reference_check.misfit_as_written < 0.01 and .attitude_drift_deg_per_h.with_driftless < 50' \
   "$t/o/summary.json" > /dev/null || { jq .reference_check "$t/o/summary.json"; fail "as written: not a fit"; }
 
@@ -28,7 +28,7 @@ for case in conj xyzw; do
   rc=0
   "$bin" estimate --log "$t/$case.csv" --out "$t/o_$case" --strict > "$t/$case.txt" 2>&1 || rc=$?
   [[ $rc -ne 0 ]] || fail "$case: --strict exited 0"
-  jq -e '.reference_check.verdict == "other_convention" and .attitude_drift_deg_per_h.with_driftless == null
+  jq -e '.reference_check.result == "other_convention" and .attitude_drift_deg_per_h.with_driftless == null
          and .final_attitude_error_deg.with_driftless == null
          and any(.health.findings[]; .cause == "reference_mismatch")' "$t/o_$case/summary.json" > /dev/null ||
     { jq '.reference_check, .health' "$t/o_$case/summary.json"; fail "$case: not named"; }
