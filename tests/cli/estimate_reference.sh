@@ -7,10 +7,7 @@
 # withheld, and --strict exits non-zero.
 set -euo pipefail
 bin=$1; src=$2
-py=/usr/bin/python3
-"$py" -c 'import numpy' 2>/dev/null || { echo "no numpy for $py: skipped"; exit 77; }
-t=$(mktemp -d); trap 'rm -rf "$t"' EXIT
-fail() { echo "FAIL: $*"; exit 1; }
+source "$src/tests/cli/lib/outsider_log.sh"
 
 "$py" "$src/tests/estimator/navgen.py" --out "$t/car.csv" --sensor bmi088 --motion car --duration 300 --seed 131 > /dev/null 2>&1
 # the same log with ref_q conjugated, and with its columns written x, y, z, w

@@ -10,10 +10,7 @@
 #       the static box (F29's log) is not flagged.
 set -euo pipefail
 bin=$1; src=$2
-py=/usr/bin/python3
-"$py" -c 'import numpy' 2>/dev/null || { echo "no numpy for $py: skipped"; exit 77; }
-t=$(mktemp -d); trap 'rm -rf "$t"' EXIT
-fail() { echo "FAIL: $*"; exit 1; }
+source "$src/tests/cli/lib/outsider_log.sh"
 
 # |final bias - last true_bias| / sigma for the six components: the largest
 max_z() {
