@@ -142,6 +142,27 @@ int report_health(const EstimateArgs& a, const est::EstimatorConfig& cfg, const 
   return kExitOk;
 }
 
+// the console's attitude line: the drifts, or why they are withheld
+void print_attitude_line(const est::EstimateSummary& summary) {
+  if (summary.attitude_available && std::isfinite(summary.attitude_withheld_from_s)) {
+    fmt::print("  attitude: compared from t = {:.1f} s, withheld from t = {:.1f} s ({}; see the warning)\n",
+               summary.attitude_start_s, summary.attitude_withheld_from_s,
+               summary.attitude_withheld_why == est::AttitudeWithheld::kBothFlipping ? "both platforms flipped at once"
+               : summary.attitude_withheld_why == est::AttitudeWithheld::kTimeGap    ? "a time gap"
+                                                                                    : "no sensor gave the box rate");
+  } else if (summary.attitude_available && !std::isfinite(summary.final_corrected.angle_deg) &&
+             summary.reference.verdict != est::RefFitVerdict::kFits &&
+             summary.reference.verdict != est::RefFitVerdict::kNotChecked) {
+    fmt::print("  attitude: withheld (ref_q does not turn with the gyros: see the health finding "
+               "reference_mismatch)\n");
+  } else if (summary.attitude_available) {
+    fmt::print("  attitude drift from t = {:.1f} s: {:.2f} deg/h with DriftLess, {:.2f} deg/h with the bias "
+               "fixed at that start, {:.2f} deg/h uncorrected\n",
+               summary.attitude_start_s, summary.drift_corrected_deg_per_h, summary.drift_fixed_deg_per_h,
+               summary.drift_raw_deg_per_h);
+  }
+}
+
 int run_estimate_cmd(const EstimateArgs& a) {
   est::EstimatorConfig cfg;
   if (!a.config.empty()) {
@@ -263,18 +284,7 @@ int run_estimate_cmd(const EstimateArgs& a) {
              sg[1], sg[2]);
   fmt::print("  b2 = ({:+.5f}, {:+.5f}, {:+.5f}) +- ({:.5f}, {:.5f}, {:.5f}) deg/s\n", b[3], b[4], b[5], sg[3],
              sg[4], sg[5]);
-  if (summary.attitude_available && std::isfinite(summary.attitude_withheld_from_s)) {
-    fmt::print("  attitude: compared from t = {:.1f} s, withheld from t = {:.1f} s ({}; see the warning)\n",
-               summary.attitude_start_s, summary.attitude_withheld_from_s,
-               summary.attitude_withheld_why == est::AttitudeWithheld::kBothFlipping ? "both platforms flipped at once"
-               : summary.attitude_withheld_why == est::AttitudeWithheld::kTimeGap    ? "a time gap"
-                                                                                    : "no sensor gave the box rate");
-  } else if (summary.attitude_available) {
-    fmt::print("  attitude drift from t = {:.1f} s: {:.2f} deg/h with DriftLess, {:.2f} deg/h with the bias "
-               "fixed at that start, {:.2f} deg/h uncorrected\n",
-               summary.attitude_start_s, summary.drift_corrected_deg_per_h, summary.drift_fixed_deg_per_h,
-               summary.drift_raw_deg_per_h);
-  }
+  print_attitude_line(summary);
   if (truth && summary.truth.updates > 0) {
     fmt::print("  against truth: bias error rms {:.5f} deg/s over all updates ({:.5f} over the second half), "
                "mean NEES {:.2f} (95 % band {:.2f}..{:.2f})\n",

@@ -46,6 +46,8 @@ const char* cause_key(est::HealthCause c) {
     case est::HealthCause::kPaperRestAngles: return "paper_rest_angles";
     case est::HealthCause::kPaperSchedule: return "paper_schedule";
     case est::HealthCause::kLockLost: return "lock_lost";
+    case est::HealthCause::kReferenceMismatch: return "reference_mismatch";
+    case est::HealthCause::kBoxNotAtRest: return "box_not_at_rest";
     default: if (is_flip_cause(c)) return flip_cause_key(c);
   }
   return "?";
@@ -73,6 +75,67 @@ std::string position_text(const std::vector<std::array<double, 2>>& pairs) {
     o += fmt::format("{}({:g}, {:g})", i == 0 ? "" : i + 1 == pairs.size() ? " and " : ", ", pairs[i][0], pairs[i][1]);
   }
   return o + " deg";
+}
+
+// what to do with ref_q's columns when they were written in convention `c`
+std::string reference_fix(est::RefConvention c) {
+  switch (c) {
+    case est::RefConvention::kBodyFromEnuWxyz:
+      return "conjugate it (negate ref_qx, ref_qy, ref_qz)";
+    case est::RefConvention::kEnuFromBodyXyzw:
+      return "write the scalar first (the columns ref_qw, ref_qx, ref_qy, ref_qz hold x, y, z, w: move the 4th to the 1st)";
+    case est::RefConvention::kBodyFromEnuXyzw:
+      return "write the scalar first and conjugate it (the columns hold x, y, z, w of q_body_from_enu: w, -x, -y, -z)";
+    case est::RefConvention::kEnuFromBodyWxyz: break;
+  }
+  return "nothing";
+}
+
+std::string describe_box_motion(const est::HealthFinding& f) {
+  std::string seen;
+  if (f.value > est::BoxMotionLimits{}.ref_rate_dps) {
+    seen = fmt::format("ref_q turned at up to {:.3g} deg/s over a standstill", f.value);
+  }
+  if (f.sigma > est::BoxMotionLimits{}.gyro_change_dps) {
+    seen += fmt::format("{}the fused rate changed by up to {:.3g} deg/s within one (the bias cannot)",
+                        seen.empty() ? "" : " and ", f.sigma);
+  }
+  const bool at_rest = !f.components.empty() && f.components[0] == 1;
+  const std::string claim =
+      at_rest ? std::string("--box-at-rest claims the box turns at the Earth rate only while the platforms rest")
+              : fmt::format("{} box dwells took the box as turning at the Earth rate only", f.count);
+  return fmt::format("the box was not at rest while both platforms rested: {} (e.g. t = {:.1f} s); {}, and the "
+                     "turn entered the biases and the g-sensitivity as if it were theirs. {}",
+                     seen, f.suggested, claim,
+                     at_rest ? "Drop --box-at-rest (a box in a vehicle, on a ship or a turntable turns)"
+                             : "Set box_dwell_updates: false in the configuration (a box in a vehicle, on a ship or "
+                               "a slow turntable)");
+}
+
+std::string describe_reference(const est::HealthFinding& f) {
+  constexpr const char* kAxes = "xyz";
+  const int axis = f.components.empty() ? 0 : f.components[0];
+  const auto& ex = f.positions_deg;
+  const std::string example =
+      ex.size() < 2 ? std::string()
+                    : fmt::format(" (at t = {:.1f} s the fused gyros turned the box {:+.1f} deg about {} in {:.2g} s, "
+                                  "ref_q {:+.1f} deg)",
+                                  ex[0][0], ex[1][0], kAxes[axis], ex[0][1], ex[1][1], kAxes[axis]);
+  const std::string head = fmt::format(
+      "ref_q does not turn with the gyros{}: over {} turning windows its misfit is {:.3g} (0 = the same turns, "
+      "4 = turning the other way; a fit is below 0.1)",
+      example, f.count, f.value);
+  if (std::isfinite(f.suggested)) {
+    const auto c = static_cast<est::RefConvention>(static_cast<int>(f.suggested));
+    return fmt::format("{}; the data fit ref_q as {} (misfit {:.3g}), where the log format wants q_enu_from_body, "
+                       "scalar first: {}. The attitude drift and final errors are withheld (attitude.csv holds the "
+                       "errors against ref_q as written); the biases are not affected",
+                       head, est::to_string(c), f.sigma, reference_fix(c));
+  }
+  return fmt::format("{}; no convention fits (conjugate or scalar last: the best misfit is {:.3g}): ref_q is the "
+                     "attitude of another body (a reference IMU mounted turned on the box?), or the gyro columns are "
+                     "not in deg/s. The attitude drift and final errors are withheld; check ref_q against the box axes",
+                     head, f.sigma);
 }
 
 }  // namespace
@@ -359,6 +422,10 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
     case est::HealthCause::kNeverFlipped:
     case est::HealthCause::kGyroGapPositions:
       return describe_input_checks(f, cfg);
+    case est::HealthCause::kReferenceMismatch:
+      return describe_reference(f);
+    case est::HealthCause::kBoxNotAtRest:
+      return describe_box_motion(f);
     default: break;  // the flip-turn check's causes: describe_flip() above
   }
   return "?";

@@ -74,6 +74,16 @@ void format_corrected(io::OutputFile& f, const std::vector<EstimateFiles::Correc
 using report::json_number;
 using report::json_string;
 
+const char* reference_verdict_key(est::RefFitVerdict v) {
+  switch (v) {
+    case est::RefFitVerdict::kNotChecked: return "not_checked";
+    case est::RefFitVerdict::kFits: return "fits";
+    case est::RefFitVerdict::kOtherConvention: return "other_convention";
+    case est::RefFitVerdict::kNoFit: return "no_fit";
+  }
+  return "?";
+}
+
 std::string json_vec(const est::Vector6d& v) {
   return fmt::format("[{}, {}, {}, {}, {}, {}]", json_number(v[0]), json_number(v[1]), json_number(v[2]),
                      json_number(v[3]), json_number(v[4]), json_number(v[5]));
@@ -226,6 +236,16 @@ void write_estimate_summary(const fs::path& path, const SummaryContext& ctx, con
   add("  \"locked_from_t_s\": {}, \"rows_locked\": {},\n", json_number(s.locked_from_t_s), s.samples_locked);
   add("  \"attitude_start_s\": {}, \"attitude_withheld_from_s\": {},\n", json_number(s.attitude_start_s),
       json_number(s.attitude_withheld_from_s));
+  add("  \"box_motion_at_rest\": {{\"ref_rate_dps\": {}, \"quiet_ref_rate_dps\": {}, \"fused_rate_change_dps\": {}, "
+      "\"standstills\": {}}},\n",
+      json_number(s.box_motion.ref_rate_dps), json_number(s.box_motion.quiet_ref_rate_dps),
+      json_number(s.box_motion.gyro_change_dps), s.box_motion.standstills);
+  add("  \"reference_check\": {{\"result\": {}, \"turning_windows\": {}, \"misfit_as_written\": {}, "
+      "\"best_fit\": {}, \"best_misfit\": {}}},\n",
+      json_string(reference_verdict_key(s.reference.verdict)), s.reference.windows,
+      json_number(s.reference.windows > 0 ? s.reference.misfit[0] : kNaN),
+      json_string(est::to_string(s.reference.best)),
+      json_number(s.reference.windows > 0 ? s.reference.misfit[static_cast<std::size_t>(s.reference.best)] : kNaN));
   add("  \"attitude_drift_deg_per_h\": {{\"with_driftless\": {}, \"bias_fixed_at_start\": {}, "
       "\"without_driftless\": {}}},\n",
       json_number(s.drift_corrected_deg_per_h), json_number(s.drift_fixed_deg_per_h),

@@ -653,7 +653,11 @@ bool DriftlessFilter::rest_row(const StandstillSegment& s, const Eigen::Matrix3d
   else if (s.n_up > 0) up = s.sum_up_box;
   if (!(up.norm() > 0.0) || !up.allFinite()) return false;
   up.normalize();
-  const double earth_up_dps = geo::earth_rate_enu_radps(box_.latitude_deg).z() * kDegPerRad;
+  // the vertical Earth rate Omega sin(lat); a log without latitude_deg: none is assumed, the row
+  // takes sin(lat) uniform on [-1, 1] (mean 0, variance 1/3: Omega^2 / 3 enters var_z)
+  const bool latitude_known = std::isfinite(box_.latitude_deg);
+  const double earth_up_dps = latitude_known ? geo::earth_rate_enu_radps(box_.latitude_deg).z() * kDegPerRad : 0.0;
+  const double earth_up_var_dps2 = latitude_known ? 0.0 : std::pow(kEarthRateRadps * kDegPerRad, 2) / 3.0;
   z = 0.5 * up.dot(M1 * s.mean_gyro1_dps() + M2 * s.mean_gyro2_dps()) - earth_up_dps;
   h.setZero();
   h.segment<3>(kBias1.start) = 0.5 * up.transpose() * M1;
@@ -666,7 +670,7 @@ bool DriftlessFilter::rest_row(const StandstillSegment& s, const Eigen::Matrix3d
     h.segment<9>(kScale1.start) = 0.5 * up.transpose() * gsens_jacobian(M1, last_w_dps_[0]);
     h.segment<9>(kScale2.start) = 0.5 * up.transpose() * gsens_jacobian(M2, last_w_dps_[1]);
   }
-  var_z = 0.25 * var_r + cfg_.box_rest_rate_sigma_dps * cfg_.box_rest_rate_sigma_dps;
+  var_z = 0.25 * var_r + cfg_.box_rest_rate_sigma_dps * cfg_.box_rest_rate_sigma_dps + earth_up_var_dps2;
   return true;
 }
 

@@ -292,6 +292,38 @@ void add_gyro_standstill_findings(HealthReport& h, const GyroFlipTracker& tracke
   put_first(h, std::move(first));
 }
 
+void add_box_motion_finding(HealthReport& h, const BoxMotion& m, bool box_at_rest, std::uint64_t dwell_updates) {
+  // --box-at-rest claims every standstill; a dwell only the quiet ones (below box_dwell_rate_dps)
+  const bool fired = box_at_rest ? box_turned(m) : dwell_updates > 0 && box_turned_slowly(m);
+  if (!fired) return;
+  HealthFinding f;
+  f.cause = HealthCause::kBoxNotAtRest;
+  f.value = box_at_rest ? m.ref_rate_dps : m.quiet_ref_rate_dps;
+  f.sigma = box_at_rest ? m.gyro_change_dps : kNaN;
+  const bool by_ref = f.value > BoxMotionLimits{}.ref_rate_dps;
+  f.suggested = !box_at_rest ? m.quiet_ref_rate_t_s : by_ref ? m.ref_rate_t_s : m.gyro_change_t_s;
+  f.count = dwell_updates;
+  f.components = {box_at_rest ? 1 : 0};
+  HealthReport first;
+  add(first, std::move(f));
+  put_first(h, std::move(first));
+}
+
+void add_reference_finding(HealthReport& h, const ReferenceFit& fit) {
+  if (fit.verdict != RefFitVerdict::kOtherConvention && fit.verdict != RefFitVerdict::kNoFit) return;
+  HealthFinding f;
+  f.cause = HealthCause::kReferenceMismatch;
+  f.value = fit.misfit[0];
+  f.sigma = fit.misfit[static_cast<std::size_t>(fit.best)];
+  f.suggested = fit.verdict == RefFitVerdict::kOtherConvention ? double(static_cast<int>(fit.best)) : kNaN;
+  f.count = fit.windows;
+  int axis = 0;
+  fit.example_gyro_deg.cwiseAbs().maxCoeff(&axis);
+  f.components = {axis};
+  f.positions_deg = {{fit.example_t_s, fit.example_span_s}, {fit.example_gyro_deg[axis], fit.example_ref_deg[axis]}};
+  add(h, std::move(f));
+}
+
 const char* to_string(HealthVerdict v) {
   switch (v) {
     case HealthVerdict::kOk: return "ok";

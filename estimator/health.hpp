@@ -11,10 +11,12 @@
 #include <utility>
 #include <vector>
 
+#include "estimator/box_motion_check.hpp"
 #include "estimator/clip_detector.hpp"
 #include "estimator/filter.hpp"
 #include "estimator/flip_check.hpp"
 #include "estimator/lag_check.hpp"
+#include "estimator/reference_check.hpp"
 #include "estimator/standstill_gyro.hpp"
 
 namespace driftless::est {
@@ -83,6 +85,16 @@ enum class HealthCause {
   kFlipTurnRatio,        // about the hinge by a ratio none of the above
   kFlipScale,            // 1 ± a few % beyond 3 sigma of the scale prior (value: the median ratio)
   kFlipsTooSlow,         // flips longer than flip_max_s (value: the longest, s): no flip update
+  kBoxNotAtRest,         // --box-at-rest or box dwells, yet the box turned while both platforms
+                         // rested (box_motion_check.hpp): value = ref_q's largest turn rate over a
+                         // standstill (deg/s; NaN: no ref_q), sigma = the largest change of the fused
+                         // rate within one (deg/s), suggested = when (s), count = box dwell updates,
+                         // components = {1 if --box-at-rest, else 0}
+  kReferenceMismatch,    // ref_q does not turn with the gyros (reference_check.hpp): value = the
+                         // misfit of the log's convention, sigma = the best misfit, suggested = the
+                         // best RefConvention (as a number; kNoFit: NaN), count = turning windows,
+                         // components = {the box axis of the example turn}, positions_deg =
+                         // {{its end time s, its span s}, {gyro turn deg, ref_q turn deg about that axis}}
 };
 
 /// One check that did not pass, with the numbers that describe() turns into text.
@@ -208,6 +220,14 @@ void add_attitude_withheld_finding(HealthReport& h, AttitudeWithheld why, double
 /// their positions were snapped to the wrong stops; failed when at least half of the flips), and a
 /// time gap after which the positions were recovered (a note) or not (degraded).
 void add_gyro_standstill_findings(HealthReport& h, const GyroFlipTracker& tracker, double flip_angle_deg);
+
+/// --box-at-rest, or box dwells used (`dwell_updates` > 0), on a box that turned while the
+/// platforms rested (box_turned): `box_not_at_rest` ahead of the other findings (their cause).
+void add_box_motion_finding(HealthReport& h, const BoxMotion& m, bool box_at_rest, std::uint64_t dwell_updates);
+
+/// ref_q in another convention than the log's, or fitting none (reference_check.hpp): a degraded
+/// `reference_mismatch` finding (the attitude figures are withheld; the biases stand).
+void add_reference_finding(HealthReport& h, const ReferenceFit& fit);
 
 /// Paper mode builds H from eq. (5)'s positions, +-flip_angle_deg in its fixed order: standstills
 /// that rested elsewhere or out of that order are findings ahead of the others (their cause),

@@ -164,7 +164,10 @@ void add_stream_warnings(const log::Metadata& meta, EstimateSummary& sum) {
                            "); results cover the rows present");
   }
   if (!std::isfinite(meta.latitude_deg())) {
-    sum.warnings.push_back("no latitude_deg in the log: the Earth rate is removed at latitude 0");
+    sum.warnings.push_back(
+        "no latitude_deg in the log: the Earth rate is removed at latitude 0; the box dwells and --box-at-rest take "
+        "the vertical Earth rate as unknown (0 +- 0.0024 deg/s, 1 sigma, for any latitude, on top of box_rest_rate_sigma_dps). "
+        "Add '# latitude_deg: ...' to the header for both");
   }
 }
 
@@ -262,6 +265,18 @@ void note_position(std::vector<std::array<double, 2>>& seen, double p1_deg, doub
   if (seen.size() < 16) seen.push_back({p1_deg, p2_deg});
 }
 
+// ref_q in another convention than the log's (or of another body): the errors against it say
+// nothing of the drift, so the figures are withheld (attitude.csv stays, for a look)
+void withhold_attitude_reference(EstimateSummary& sum) {
+  const RefFitVerdict v = sum.reference.verdict;
+  if (v != RefFitVerdict::kOtherConvention && v != RefFitVerdict::kNoFit) return;
+  sum.drift_corrected_deg_per_h = sum.drift_raw_deg_per_h = sum.drift_fixed_deg_per_h = kNaN;
+  sum.drift_net_corrected_deg_per_h = sum.drift_net_raw_deg_per_h = sum.drift_net_fixed_deg_per_h = kNaN;
+  AttitudeError none;
+  none.roll_deg = none.pitch_deg = none.heading_deg = none.angle_deg = kNaN;
+  sum.final_corrected = sum.final_raw = sum.final_fixed = none;
+}
+
 // after an update: is the correction locked (filter_locked at the lock level)? Records the first
 // lock, each gate re-lock and when the lock came back after it.
 // `t_s` is the time of the sample whose push made the update: the first row it corrects.
@@ -333,6 +348,8 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
   HealthMonitor health(opt.health);
   LagCheck lag(filter.geometry().sample_rate_hz);
   FlipCheck flips(cfg.flip_max_s, cfg.settle_s);
+  ReferenceCheck ref_check;
+  BoxMotionCheck box_motion;
 
   // the lock state changes only at updates (P shrinks there; a gate re-lock widens it)
   bool locked = false;
@@ -365,6 +382,8 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
     on_update(st, s);  // first: the row that made an update carries the state after it
     lag.push(s, filter);
     check_flip(flips, filter);
+    if (sum.attitude_available) ref_check.push(s, filter);
+    box_motion.push(s, filter.output());
     sum.samples_locked += locked ? 1 : 0;
     if (sink != nullptr) sink->on_sample(s, filter.output(), locked);
     if (use_window) window.add(filter, s);
@@ -415,12 +434,17 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
   sum.stop_angle_sigma_deg = filter.stop_angle_sigma_deg();
   add_attitude_results(att, filter, opt, sum);
   withhold_attitude(filter, sum);
+  sum.reference = ref_check.finish();
+  withhold_attitude_reference(sum);
   score.finish();
   if (use_window) window.finish(filter);
   sum.health = health.finish(filter, sum.rows > 0 ? sum.t_last_s - sum.t_first_s : 0.0, lag.finish());
   name_prior_rejection(sum.health, first_update);
   add_input_findings(meta, reader, cfg, filter, positions, sum);
   add_flip_check_findings(sum.health, flips.finish(), cfg);
+  add_reference_finding(sum.health, sum.reference);
+  sum.box_motion = box_motion.finish();
+  add_box_motion_finding(sum.health, sum.box_motion, cfg.box_at_rest, sum.counters.box_dwell_updates);
   return sum;
 }
 

@@ -12,6 +12,8 @@
 
 #include "estimator/attitude.hpp"
 #include "estimator/attitude_comparison.hpp"
+#include "estimator/box_motion_check.hpp"
+#include "estimator/reference_check.hpp"
 #include "estimator/filter.hpp"
 #include "estimator/health.hpp"
 #include "estimator/log.hpp"
@@ -143,6 +145,11 @@ struct EstimateSummary {
   double attitude_withheld_from_s = kNaN;
   AttitudeWithheld attitude_withheld_why = AttitudeWithheld::kNo;
   double attitude_withheld_gap_s = kNaN;  // s, the gap's length (kTimeGap)
+  // does ref_q turn with the gyros (reference_check.hpp)? When another convention fits, or none,
+  // the drifts and final errors are withheld (NaN) and health names reference_mismatch
+  ReferenceFit reference;
+  // did the box turn while both platforms rested (box_motion_check.hpp)?
+  BoxMotion box_motion;
   Vector6d fixed_bias_dps = Vector6d::Constant(kNaN);  // deg/s, the bias held by `fixed`
   AttitudeError final_corrected = kAttitudeErrorUnknown, final_raw = kAttitudeErrorUnknown,
                 final_fixed = kAttitudeErrorUnknown;  // NaN while no comparison was made

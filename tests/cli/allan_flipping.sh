@@ -8,11 +8,8 @@
 # usage: allan_flipping.sh <path-to-driftless> <source-dir>
 set -uo pipefail
 bin=$1; src=$2
-py=/usr/bin/python3
+source "$src/tests/cli/lib/outsider_log.sh"
 gen=$src/tests/diagnose/independent_log.py
-"$py" -c 'import numpy' 2>/dev/null || { echo "no numpy for $py: skipped"; exit 77; }
-t=$(mktemp -d); trap 'rm -rf "$t"' EXIT
-fail() { echo "FAIL: $*"; exit 1; }
 
 # GIVEN a static box whose platforms flip between +-90 deg, and a single IMU that never flips
 "$py" "$gen" --out "$t/flip.csv" --seed 5 --duration 300 --motion static > /dev/null || fail "generator"

@@ -8,10 +8,7 @@
 # usage: convert_dual_gyro.sh <path-to-driftless> <source-dir>
 set -uo pipefail
 bin=$1; src=$2
-py=/usr/bin/python3
-"$py" -c 'import numpy' 2>/dev/null || { echo "no numpy for $py: skipped"; exit 77; }
-t=$(mktemp -d); trap 'rm -rf "$t"' EXIT
-fail() { echo "FAIL: $*"; exit 1; }
+source "$src/tests/cli/lib/outsider_log.sh"
 
 "$py" "$src/tests/diagnose/independent_log.py" --out "$t/log.csv" --seed 9 --duration 60 > /dev/null || fail "generator"
 # GIVEN the recording with a foreign header: no format line, its own column names

@@ -8,11 +8,8 @@
 # usage: estimate_lag.sh <path-to-driftless> <source-dir>
 set -uo pipefail
 bin=$1; src=$2
-py=/usr/bin/python3
+source "$src/tests/cli/lib/outsider_log.sh"
 gen=$src/tests/diagnose/independent_log.py
-"$py" -c 'import numpy' 2>/dev/null || { echo "no numpy for $py: skipped"; exit 77; }
-t=$(mktemp -d); trap 'rm -rf "$t"' EXIT
-fail() { echo "FAIL: $*"; exit 1; }
 field() { "$py" -c "import json,sys; d=json.load(open(sys.argv[1]))['health']; print(eval(sys.argv[2]))" "$1/summary.json" "$2"; }
 
 "$py" "$gen" --out "$t/lag2.csv" --seed 3 --duration 300 --motion pan_tilt --lag 2:0.015 > /dev/null || fail "generator"
