@@ -70,9 +70,13 @@ void write_selfcal_files(const EstimateArgs& a, const log::Metadata& meta, const
     sc.temp_coef_sigma_dps_per_degc[iu] = s.temp_coef_sigma_dps_per_degc.segment<3>(3 * i);
   }
   sc.temp_ref_c = s.temp_ref_c;
+  sc.stop_states = s.stop_states;
+  sc.end_stop_deg = s.stop_angle_deg;
+  sc.end_stop_sigma_deg = s.stop_angle_sigma_deg;
   calib::save_selfcal_calib(a.calib_out, sc);
-  fmt::print("  wrote {} (g-sensitivity{}{} with 1-sigma; M nominal)\n", a.calib_out,
-             sc.scale_states ? ", scale/misalignment" : "", sc.temp_states ? " and bias temperature coefficients" : "");
+  fmt::print("  wrote {} (g-sensitivity{}{}{} with 1-sigma; M nominal)\n", a.calib_out,
+             sc.scale_states ? ", scale/misalignment" : "", sc.stop_states ? ", end-stop angles" : "",
+             sc.temp_states ? " and bias temperature coefficients" : "");
   if (a.prior_out.empty()) return;
   io::write_file(a.prior_out, calib::model_prior_yaml(calib::load_calib(a.calib_out)));
   fmt::print("  wrote {} (model prior for the twin)\n", a.prior_out);
@@ -302,12 +306,13 @@ const bool registered = register_command(30, [](CLI::App& app) {
                   "end stop replace the hinge rotations) or from 'estimate --selfcal --calib-out'. Its G "
                   "(deg/s per g) and scale/misalignment E (fraction): with --selfcal the start value and "
                   "1-sigma of their states, else fixed corrections; the temperature states start at its "
-                  "coefficients (deg/s per degC); docs/calibration.md")
+                  "coefficients (deg/s per degC), the end-stop states at its end_stops (deg); docs/calibration.md")
       ->check(CLI::ExistingFile);
   auto* calib_out = cmd->add_option(
       "--calib-out", a->calib_out,
       "With --selfcal: write the estimated g-sensitivity (deg/s per g), scale/misalignment "
-      "(fraction) and bias temperature coefficients (deg/s per degC), each with its 1-sigma, as "
+      "(fraction), bias temperature coefficients (deg/s per degC) and end-stop angle errors (deg), "
+      "each with its 1-sigma, as "
       "calib.yaml for --calib on the next log of the same sensors (M stays nominal); docs/calibration.md");
   cmd->add_option("--prior-out", a->prior_out,
                   "With --calib-out: the same as a twin model-config file (a scenario's model: block; "
