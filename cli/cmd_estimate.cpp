@@ -1,12 +1,16 @@
 // driftless estimate: run the DriftLess filter over a measurement log and write the bias
 // estimates, corrected outputs, attitude drift and (for simulated logs) errors against truth.
 // Formats: docs/estimator.md.
+#include <chrono>
 #include <cmath>
+#include <cstdint>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <memory>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <fmt/core.h>
@@ -82,6 +86,26 @@ void write_selfcal_files(const EstimateArgs& a, const log::Metadata& meta, const
   fmt::print("  wrote {} (model prior for the twin)\n", a.prior_out);
 }
 
+// For tests/cli/estimate_smooth_stop.sh: with DRIFTLESS_TEST_SMOOTH_HOLD=FILE the second pass, once
+// it has handed kHoldAfterRows rows to corrected.csv, creates FILE and waits (at most 120 s) for a
+// stop, so that a signal lands inside the pass at a known row on any machine load. Unset: nothing.
+class SmoothHold {
+ public:
+  static constexpr std::uint64_t kHoldAfterRows = 100;
+  SmoothHold() {
+    if (const char* p = std::getenv("DRIFTLESS_TEST_SMOOTH_HOLD")) path_ = p;
+  }
+  void after_row() {
+    if (path_.empty() || ++rows_ != kHoldAfterRows) return;
+    io::write_file(path_, std::to_string(rows_) + "\n");
+    for (int i = 0; i < 12000 && !stop_requested().load(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+
+ private:
+  std::string path_;
+  std::uint64_t rows_ = 0;
+};
+
 // --smooth: the backward pass over the updates, then the log again with the smoothed correction
 // into corrected.csv (docs/estimator.md section 6.3). Every row is marked locked when the forward
 // filter locked at all: the smoothed correction at any time uses the whole log
@@ -93,12 +117,14 @@ double write_smoothed(const EstimateArgs& a, const log::ReaderOptions& read_opt,
   log::LogReader again(a.log, read_opt);
   const bool locked = std::isfinite(s.locked_from_t_s);
   double last_t_s = kNaN;
+  SmoothHold hold;
   est::smoothed_outputs(
       cfg, est::box_geometry_from_metadata(again.metadata()),
       [&again](Sample& x) { return !stop_requested().load() && again.next(x); }, sm,
       [&](const Sample& x, const est::SampleOutput& o) {
         files.on_smoothed_sample(x, o, locked);
         last_t_s = x.t_s;
+        hold.after_row();
       });
   return last_t_s;
 }
