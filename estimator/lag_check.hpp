@@ -18,8 +18,11 @@ namespace driftless::est {
 /// What the check measured over the standstills of one pass.
 struct LagCheckResult {
   std::uint64_t samples = 0;      // standstill samples in the fit
-  double lag_s = kNaN;            // s, D: > 0 sensor 2 reads the box rate later than sensor 1
-  double lag_sigma_s = kNaN;      // s, its 1 sigma (white residual assumed)
+  double lag_s = kNaN;            // s, D: > 0 sensor 2 reads the box rate later than sensor 1;
+                                  // NaN when the angular acceleration at rest is mostly the
+                                  // sensors' own noise (a still box): not measurable
+  double lag_sigma_s = kNaN;      // s, its 1 sigma (white residual, the regressor's noise included)
+  double signal_share = kNaN;     // the share of sum |dw/dt|^2 that is motion, not noise
   double residual_var_dps2 = kNaN;  // (deg/s)^2 per axis and sample, what D leaves
   // what D puts into the standstill means against the white noise's share of their variance:
   // sum |D mean(dw/dt)|^2 / sum 3 var / n over the standstills (0.25: the innovations' variance
@@ -35,6 +38,7 @@ struct LagCheckLimits {
   double diff_half_s = 0.02;    // s, dw/dt by the central difference over +-this
   double end_margin_s = 0.25;   // s, dropped before each standstill's end (motion onset)
   std::uint64_t min_segment = 10;  // samples a standstill needs to enter the fit
+  double min_signal_share = 0.1;   // below this share of motion in sum |dw/dt|^2: not measurable
 };
 
 /// Fed every sample after DriftlessFilter::push() (its output: corrected rates, rest, angles).
@@ -53,6 +57,7 @@ class LagCheck {
 
   LagCheckLimits limits_;
   int half_ = 1, margin_ = 25;  // samples
+  double span_s_ = 0.04;        // s, the central difference's span, 2 half_ / rate
   std::vector<Entry> ring_;     // the newest 2 half_ + 1 + margin_ samples of the standstill
   std::size_t head_ = 0, count_ = 0;
   double p1_deg_ = kNaN, p2_deg_ = kNaN;

@@ -156,8 +156,10 @@ void LogReader::map_columns() {
          "; see docs/log-format.md)" +
          (meta_.has("format") ? std::string()
                               : std::string("; the file has no '# format: driftless-log 1' line: a recording from "
-                                            "another tool? make a log of it with 'driftless convert --in FILE --out "
-                                            "LOG.csv' (docs/import.md)")));
+                                            "another tool? a single IMU's: make a log of it with 'driftless convert "
+                                            "--in FILE --out LOG.csv' (docs/import.md); a dual-gyro box's: rename "
+                                            "its columns to t, gyro1_x..gyro2_z (deg/s), plat1_deg, plat2_deg (deg) "
+                                            "and add that line (docs/log-format.md)")));
   }
   if (single) {
     fields_ |= kLayoutSingleSensor;

@@ -624,6 +624,34 @@ void pick_time_unit(TextLayout& L, const ImportOptions& opt, const std::vector<s
 
 }  // namespace
 
+// the header's columns that are neither the time nor a picked channel: said, not silently dropped.
+// A second gyro triad among them is a dual-gyro box's recording, which the two-sensor log form
+// (not convert's single-IMU output) holds
+void say_unused_columns(TextLayout& L) {
+  std::vector<bool> used(L.header.size(), false);
+  if (L.time_index >= 0 && std::size_t(L.time_index) < used.size()) used[std::size_t(L.time_index)] = true;
+  for (const auto& p : L.picks) {
+    if (p.index >= 0 && std::size_t(p.index) < used.size()) used[std::size_t(p.index)] = true;
+  }
+  std::string names;
+  int gyro_like = 0;
+  for (std::size_t i = 0; i < L.header.size(); ++i) {
+    if (used[i] || L.header[i].empty()) continue;
+    names += (names.empty() ? "" : ", ") + L.header[i];
+    std::string lower(L.header[i]);
+    for (char& c : lower) c = char(std::tolower(static_cast<unsigned char>(c)));
+    if (lower.find("gyr") != std::string::npos || lower.find("rate") != std::string::npos) ++gyro_like;
+  }
+  if (names.empty()) return;
+  std::string a = "columns not used: " + names;
+  if (gyro_like >= 3) {
+    a += " (a second gyro triad? convert writes one IMU; for a dual-gyro box write the log form itself: columns t, "
+         "gyro1_x..gyro2_z (deg/s), plat1_deg, plat2_deg (deg) and a '# format: driftless-log 1' line, "
+         "docs/log-format.md)";
+  }
+  L.assumptions.push_back(a);
+}
+
 TextLayout detect_text_layout(std::string_view head, const std::string& file, const ImportOptions& opt, bool euroc) {
   TextLayout L;
   const auto lines = lines_of(head);
@@ -662,6 +690,7 @@ TextLayout detect_text_layout(std::string_view head, const std::string& file, co
   pick_time_unit(L, opt, rows, euroc);  // first: the rate checks the unit of the rates
   pick_units(L, opt, rows, euroc);
   if (L.time_index < 0) L.assumptions.push_back("no time column: the rate must come from the file or --rate");
+  say_unused_columns(L);
   return L;
 }
 
