@@ -62,6 +62,13 @@ struct Calibration {
   bool has_scale_misalign = false;
   std::array<Eigen::Matrix3d, 2> E_frac{Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero()};
   std::array<Eigen::Matrix3d, 2> E_sigma_frac{Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero()};
+  /// end-stop angle errors (deg, actual - read rest angle about the hinge; [platform 1 at -, at +,
+  /// platform 2 at -, at +] like kStopAngle) and their 1-sigma, from a self-calibration's calib.yaml:
+  /// the end-stop states (when on) start here instead of at 0 +- flip_angle_sigma_deg; without them
+  /// each sensor's M turns to the stop's angle, Rot(a, plat + d)
+  bool has_end_stops = false;
+  Eigen::Vector4d end_stop_deg = Eigen::Vector4d::Zero();
+  Eigen::Vector4d end_stop_sigma_deg = Eigen::Vector4d::Zero();
   bool empty() const { return sensor1.empty() && sensor2.empty(); }
   bool has_g_sensitivity() const { return !G_dps_per_g[0].isZero(0.0) || !G_dps_per_g[1].isZero(0.0); }
   /// Throws std::invalid_argument when a matrix is singular or not finite.

@@ -48,6 +48,12 @@ void Calibration::validate() const {
     if (!(E_frac[iu].cwiseAbs().maxCoeff() < 0.5))
       throw std::invalid_argument(who + " has a scale/misalignment element of 0.5 (50 %) or more: not a small error");
   }
+  // an end stop is off by hundredths of a degree; +-10 deg is the twin's limit too (model.box)
+  if (has_end_stops && (!end_stop_deg.allFinite() || !end_stop_sigma_deg.allFinite() ||
+                        (end_stop_sigma_deg.array() < 0.0).any() || (end_stop_deg.array().abs() > 10.0).any()))
+    throw std::invalid_argument("calibration: an end-stop angle error beyond +-10 deg, not finite, or a negative sigma (deg)");
+  if (has_end_stops && !empty())
+    throw std::invalid_argument("calibration: end-stop angle errors with calibrated matrices, which hold the stop angles already");
   auto check = [&](const std::vector<CalibratedPosition>& list, int sensor) {
     for (const auto& p : list) {
       if (!finite(p.plat_deg) || !p.M_body_from_sensor.allFinite()) {
@@ -226,6 +232,12 @@ void DriftlessFilter::use_calibration_prior() {
     fixed_E_inv_[iu] = fixed_e_ ? Eigen::Matrix3d((Eigen::Matrix3d::Identity() + cal.E_frac[iu]).inverse())
                                 : Eigen::Matrix3d::Identity();
   }
+  // the end stops: the states start at the file's angles with its sigma, else M turns to them
+  fixed_stops_ = cal.has_end_stops && !has_stop_states();
+  if (has_stop_states() && cal.has_end_stops) {
+    x_.segment<4>(kStopAngle.start) = cal.end_stop_deg;
+    P_.diagonal().segment<4>(kStopAngle.start) = cal.end_stop_sigma_deg.cwiseAbs2();
+  }
 }
 
 void DriftlessFilter::on_source_switch(const BoxGeometry* box) {
@@ -251,7 +263,9 @@ Eigen::Matrix3d DriftlessFilter::body_from_sensor(int sensor, double plat_deg) c
   const std::size_t i = sensor == 1 ? 0 : 1;
   if (cache_deg_[i] == plat_deg) return cache_M_[i];
   const auto& list = sensor == 1 ? cfg_.calibration.sensor1 : cfg_.calibration.sensor2;
-  Eigen::Matrix3d M = geo::rot_about_axis_deg(sensor == 1 ? box_.hinge1_axis : box_.hinge2_axis, plat_deg);
+  // fixed end-stop errors from --calib (no end-stop states): the sensor rests at plat + d
+  const double d_deg = fixed_stops_ ? cfg_.calibration.end_stop_deg[stop_index(sensor, plat_deg) - kStopAngle.start] : 0.0;
+  Eigen::Matrix3d M = geo::rot_about_axis_deg(sensor == 1 ? box_.hinge1_axis : box_.hinge2_axis, plat_deg + d_deg);
   double best = cfg_.calibration.match_tolerance_deg;
   for (const auto& p : list) {
     const double d = std::fabs(p.plat_deg - plat_deg);

@@ -311,7 +311,7 @@ class DriftlessFilter {
   BoxGeometry box_;
   double q_rate_dps2_per_s_ = 0.0;
   // --calib terms without states of their own: fixed corrections (use_calibration_prior)
-  bool fixed_g_ = false, fixed_e_ = false;
+  bool fixed_g_ = false, fixed_e_ = false, fixed_stops_ = false;
   UpdateObserver* observer_ = nullptr;
   const StateVector* output_x_ = nullptr;
   const std::array<double, 2>* output_temp_ref_ = nullptr;
