@@ -440,8 +440,10 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
   if (use_window) window.finish(filter);
   sum.health = health.finish(filter, sum.rows > 0 ? sum.t_last_s - sum.t_first_s : 0.0, lag.finish());
   name_prior_rejection(sum.health, first_update);
-  add_input_findings(meta, reader, cfg, filter, positions, sum);
+  // the flip check's findings first: the input findings put first lead them (a clipping gyro or
+  // rests away from the stops make the flip turns disagree with the angles)
   add_flip_check_findings(sum.health, flips.finish(), cfg);
+  add_input_findings(meta, reader, cfg, filter, positions, sum);
   add_reference_finding(sum.health, sum.reference);
   sum.box_motion = box_motion.finish();
   add_box_motion_finding(sum.health, sum.box_motion, cfg.box_at_rest, sum.counters.box_dwell_updates);
