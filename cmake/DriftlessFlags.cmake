@@ -8,15 +8,36 @@ target_compile_options(driftless_flags INTERFACE -Wall -Wextra -Werror)
 target_compile_options(driftless_flags INTERFACE $<$<CONFIG:Release>:-O2>)
 if(DRIFTLESS_SANITIZE)
   # -g1 (after the build type's -g, so it wins): line tables for the reports' stack traces at
-  # 20 % less compile time. -Og: GCC's debugging level inlines Eigen's small functions, which -O0
-  # calls one by one (the suite under the sanitizers spent ~20 min of CPU at -O0), and compiles as
-  # fast as -O0 (measured: estimator/filter.cpp 23 s against 25 s, diagnose/channel_fit.cpp 30 s
-  # against 27 s; -O1 took 30 s and 39 s)
-  # -gz: the line tables compressed (zlib) in objects and programs (the sanitizer build took 4 GB);
-  # the sanitizers' symbolizer reads them as before
+  # 20 % less compile time. -gz: the line tables compressed (zlib) in objects and programs (the
+  # sanitizer build took 4 GB); the sanitizers' symbolizer reads them as before
   target_compile_options(driftless_flags INTERFACE
-    -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer -g1 -Og -gz)
+    -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer -g1 -gz)
   target_link_options(driftless_flags INTERFACE -fsanitize=address,undefined -gz)
+  if(CMAKE_CXX_COMPILER_ID MATCHES "Clang")
+    # clang (CI's instrumented build, which is also the fuzz harnesses' build): -O1, the level
+    # the sanitizers' authors recommend; it inlines Eigen's small functions as GCC's -Og does
+    target_compile_options(driftless_flags INTERFACE -O1)
+  else()
+    # -Og: GCC's debugging level inlines Eigen's small functions, which -O0 calls one by one
+    # (the suite under the sanitizers spent ~20 min of CPU at -O0), and compiles as fast as -O0
+    # (measured: estimator/filter.cpp 23 s against 25 s, diagnose/channel_fit.cpp 30 s against
+    # 27 s; -O1 took 30 s and 39 s)
+    target_compile_options(driftless_flags INTERFACE -Og)
+  endif()
+endif()
+# DRIFTLESS_FUZZ (clang, with DRIFTLESS_SANITIZE): the libraries' objects carry libFuzzer's
+# coverage instrumentation (-fsanitize=fuzzer-no-link), so the one instrumented build gives both
+# the sanitizer suite's programs and the fuzz harnesses (tests/fuzz), which link libFuzzer itself.
+# Executables (the tests, the driftless program) are not instrumented for coverage: nothing fuzzes
+# them, and the counters would only slow the sanitizer suite.
+if(DRIFTLESS_FUZZ)
+  if(NOT CMAKE_CXX_COMPILER_ID MATCHES "Clang" OR NOT DRIFTLESS_SANITIZE)
+    message(FATAL_ERROR "DRIFTLESS_FUZZ needs clang and DRIFTLESS_SANITIZE=ON (libFuzzer, ASan, UBSan): "
+                        "CC=clang CXX=clang++ cmake -DDRIFTLESS_SANITIZE=ON -DDRIFTLESS_FUZZ=ON ...; got "
+                        "${CMAKE_CXX_COMPILER_ID} with DRIFTLESS_SANITIZE=${DRIFTLESS_SANITIZE}")
+  endif()
+  target_compile_options(driftless_flags INTERFACE
+    $<$<IN_LIST:$<TARGET_PROPERTY:TYPE>,STATIC_LIBRARY;SHARED_LIBRARY;MODULE_LIBRARY>:-fsanitize=fuzzer-no-link>)
 endif()
 
 # the repository root is the include root, so an include names its folder:
@@ -64,14 +85,27 @@ function(driftless_add_test name)
     WORKING_DIRECTORY ${PROJECT_BINARY_DIR})
 endfunction()
 
-# driftless_add_tests_in_folder(LIBS ...): every test_*.cpp / slow_test_*.cpp here or in a subfolder is one binary.
+# driftless_add_tests_in_folder(LIBS ... [ALONE stem ...]): the test_*.cpp files here and in the
+# subfolders make one GoogleTest program, <folder>_tests; the slow_test_*.cpp files another,
+# <folder>_slow_tests (label 'slow'). A file named in ALONE (its stem) is a program of its own,
+# <folder>_<stem>, for flags the others do not share. The tests' names (Suite.Name) and labels are
+# the same as with one program per file; CTest runs each test as before.
+# One program per folder instead of one per file: ~100 links and ~100 test listings (each run at
+# build time) become ~20, and the files of a program compile in unity batches
+# (DRIFTLESS_TEST_UNITY_BATCH files per translation unit): GoogleTest's and Eigen's templates are
+# instantiated once a batch instead of once a file. A file whose names clash with another's in a
+# batch is named in the folder's NOT_UNITY list: it compiles on its own, in the same program.
+set(DRIFTLESS_TEST_UNITY_BATCH 8 CACHE STRING "test files per translation unit (unity build); 1: one per file")
 function(driftless_add_tests_in_folder)
-  cmake_parse_arguments(ARG "" "" "LIBS" ${ARGN})
+  cmake_parse_arguments(ARG "" "" "LIBS;ALONE;NOT_UNITY" ${ARGN})
   # subfolders mirror the source's (tests/twin/sensor/ for twin/sensor/); the label and the
   # target prefix stay the top folder's
   file(GLOB_RECURSE files CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/test_*.cpp
        ${CMAKE_CURRENT_SOURCE_DIR}/slow_test_*.cpp)
+  list(SORT files)
   get_filename_component(folder ${CMAKE_CURRENT_SOURCE_DIR} NAME)
+  set(fast "")
+  set(slow "")
   foreach(f ${files})
     get_filename_component(stem ${f} NAME_WE)
     # one label per test: a list would be split into separate PROPERTIES arguments by
@@ -83,7 +117,29 @@ function(driftless_add_tests_in_folder)
       endif()
       set(labels slow)
     endif()
-    driftless_add_test(${folder}_${stem} SOURCES ${f} LIBS ${ARG_LIBS} LABELS "${labels}")
+    if(stem IN_LIST ARG_ALONE)
+      driftless_add_test(${folder}_${stem} SOURCES ${f} LIBS ${ARG_LIBS} LABELS "${labels}")
+    elseif(stem MATCHES "^slow_")
+      list(APPEND slow ${f})
+    else()
+      list(APPEND fast ${f})
+    endif()
+    if(stem IN_LIST ARG_NOT_UNITY)
+      set_source_files_properties(${f} PROPERTIES SKIP_UNITY_BUILD_INCLUSION ON)
+    endif()
+  endforeach()
+  foreach(kind tests slow_tests)
+    set(sources ${fast})
+    set(labels ${folder})
+    if(kind STREQUAL "slow_tests")
+      set(sources ${slow})
+      set(labels slow)
+    endif()
+    if(sources)
+      driftless_add_test(${folder}_${kind} SOURCES ${sources} LIBS ${ARG_LIBS} LABELS "${labels}")
+      set_target_properties(${folder}_${kind} PROPERTIES UNITY_BUILD ON
+                            UNITY_BUILD_BATCH_SIZE ${DRIFTLESS_TEST_UNITY_BATCH})
+    endif()
   endforeach()
 endfunction()
 
