@@ -40,6 +40,16 @@ if(DRIFTLESS_FUZZ)
     $<$<IN_LIST:$<TARGET_PROPERTY:TYPE>,STATIC_LIBRARY;SHARED_LIBRARY;MODULE_LIBRARY>:-fsanitize=fuzzer-no-link>)
 endif()
 
+# driftless_pch_for_ccache(target): a target that builds or uses a precompiled header. clang writes
+# the time stamps of the headers into the header it precompiles: every fresh clone's header then
+# differs, and ccache, which hashes it, would compile every file that uses it again (ccache manual,
+# "Precompiled headers"). GCC needs nothing (scripts/build.sh sets ccache's pch sloppiness).
+function(driftless_pch_for_ccache target)
+  if(CMAKE_CXX_COMPILER_ID MATCHES "Clang")
+    target_compile_options(${target} PRIVATE "SHELL:-Xclang -fno-pch-timestamp")
+  endif()
+endfunction()
+
 # the repository root is the include root, so an include names its folder:
 #   #include "estimator/log.hpp"   (and estimator/ never includes twin/, hil_bridge/ or renders/)
 set(DRIFTLESS_SOURCE_ROOT ${PROJECT_SOURCE_DIR})
@@ -65,6 +75,7 @@ function(driftless_add_test name)
   set_target_properties(${name} PROPERTIES CROSSCOMPILING_EMULATOR ${DRIFTLESS_TEST_RUNNER})
   # GoogleTest, Eigen and the standard library parsed once for every test (tests/CMakeLists.txt)
   target_precompile_headers(${name} REUSE_FROM driftless_test_pch)
+  driftless_pch_for_ccache(${name})
   # with the standard library from a precompiled header, GCC 12 at -O2 inlines std::string's
   # operator+ chains further and reports false -Warray-bounds, -Wrestrict and -Wstringop-overflow
   # on them (GCC bugs 105329, 105651); test code only, the product keeps these warnings as errors
