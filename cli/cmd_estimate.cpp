@@ -122,7 +122,9 @@ int report_health(const EstimateArgs& a, const est::EstimatorConfig& cfg, const 
   if (h.verdict == est::HealthVerdict::kFailed) {
     // the first finding is the cause (never locked, clipping, a schedule paper mode does not fit, ...)
     fmt::print(stderr, "driftless estimate: health failed{}: the estimates are not usable (exit 1)\n",
-               h.locked ? "" : ", the filter never locked");
+               !h.locked          ? ", the filter never locked"
+               : h.locked_at_end ? ""
+                                 : ", the filter lost its lock and did not lock again");
     return kExitFailed;
   }
   if (h.verdict == est::HealthVerdict::kDegraded && a.strict) {

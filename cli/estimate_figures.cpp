@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include <fmt/core.h>
 
@@ -37,6 +38,18 @@ void FigureSeries::add_update(const est::UpdateRecord& r, const Sample& s) {
   updates.push_back({r.t_s, r.bias_dps - truth, r.sigma_dps});
 }
 
+int estimate_column(std::string_view name) {
+  int col = 1;
+  for (std::string_view list : {kEstimateColumns, kEstimateTruthColumns}) {
+    for (std::size_t at = 0; at <= list.size(); ++col) {
+      const std::size_t end = std::min(list.find(',', at), list.size());
+      if (list.substr(at, end - at) == name) return col;
+      at = end + 1;
+    }
+  }
+  throw std::logic_error("estimate.csv has no column '" + std::string(name) + "'");
+}
+
 namespace {
 
 constexpr const char* kAxisColour[3] = {"#d62728", "#2ca02c", "#1f77b4"};  // x, y, z
@@ -44,10 +57,10 @@ constexpr const char* kAxisColour[3] = {"#d62728", "#2ca02c", "#1f77b4"};  // x,
 const std::string kUtf8 = "  set encoding utf8\n";
 constexpr double kMinAllanSpanS = 10.0;  // s of data after lock that Fig. 5 needs (a few octaves of tau)
 
-// estimate.csv columns (1-based, docs/estimator.md section 6)
-int col_bias(int sensor, int axis) { return 2 + 3 * (sensor - 1) + axis; }
-int col_sigma(int sensor, int axis) { return 8 + 3 * (sensor - 1) + axis; }
-int col_truth(int sensor, int axis) { return 21 + 3 * (sensor - 1) + axis; }
+// estimate.csv columns (1-based), by name from the header the writer uses
+int col_bias(int sensor, int axis) { return estimate_column(fmt::format("b{}_{}", sensor, "xyz"[axis])); }
+int col_sigma(int sensor, int axis) { return estimate_column(fmt::format("sigma{}_{}", sensor, "xyz"[axis])); }
+int col_truth(int sensor, int axis) { return estimate_column(fmt::format("true_bias{}_{}", sensor, "xyz"[axis])); }
 
 // a dashed vertical line where the filter locked on
 std::string lock_marker(double lock_s) {

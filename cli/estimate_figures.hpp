@@ -9,6 +9,7 @@
 #include <array>
 #include <filesystem>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <Eigen/Core>
@@ -17,6 +18,17 @@
 #include "estimator/sample.hpp"
 
 namespace driftless::cli {
+
+/// estimate.csv's columns (docs/estimator.md section 6), then the truth columns a log with
+/// true_bias adds: the writer's header and the figures' column numbers both come from here
+inline constexpr std::string_view kEstimateColumns =
+    "t,b1_x,b1_y,b1_z,b2_x,b2_y,b2_z,sigma1_x,sigma1_y,sigma1_z,sigma2_x,sigma2_y,sigma2_z,"
+    "nis,nis_gate,dim,samples,plat1_deg,plat2_deg,accepted,locked";
+inline constexpr std::string_view kEstimateTruthColumns =
+    "true_bias1_x,true_bias1_y,true_bias1_z,true_bias2_x,true_bias2_y,true_bias2_z";
+/// The 1-based (gnuplot) column of `name` in estimate.csv with its truth columns; throws
+/// std::logic_error for a name that is not there.
+int estimate_column(std::string_view name);
 
 /// What the figures need beyond the files, collected while the filter runs.
 class FigureSeries {

@@ -35,6 +35,7 @@ const char* cause_key(est::HealthCause c) {
     case est::HealthCause::kDeadAxis: return "dead_axis";
     case est::HealthCause::kPaperRestAngles: return "paper_rest_angles";
     case est::HealthCause::kPaperSchedule: return "paper_schedule";
+    case est::HealthCause::kLockLost: return "lock_lost";
   }
   return "?";
 }
@@ -56,7 +57,10 @@ std::string component_names(const std::vector<int>& components) {
   return o;
 }
 
-std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cfg) {
+namespace {
+
+// the lock: whether the filter locked, kept it, and what stayed unobserved
+std::string describe_lock(const est::HealthFinding& f, const est::EstimatorConfig& cfg) {
   switch (f.cause) {
     case est::HealthCause::kNoUpdate:
       if (f.suggested > 0.5) {
@@ -86,15 +90,48 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
                                                     "about the box vertical looks like a bias common to both "
                                                     "sensors; if the box stands still, add --box-at-rest"
                                                   : "record more flips (both platforms, both directions) or a longer log");
+    case est::HealthCause::kUnobservable:
+      return fmt::format("{} kept most of the prior sigma (largest sigma {:.3g} deg/s): the flips in this "
+                         "log do not observe them; flip both platforms",
+                         component_names(f.components), f.value);
+    case est::HealthCause::kLockLost:
+      return fmt::format("the filter locked, then lost the lock at t = {:.1f} s (a gate re-lock widened its sigma) and "
+                         "did not lock again before the end: the largest bias sigma at the end is {:.3g} deg/s, above "
+                         "the lock level {:g} deg/s, so the final biases are not usable (corrected.csv: locked = 0 from "
+                         "there). The findings above name why the updates stopped fitting; a bias jump, or noise and "
+                         "bias wander larger than configured (--tune auto), are the common causes",
+                         f.suggested, f.value, f.sigma);
+    case est::HealthCause::kRelocks:
+      return fmt::format("the filter lost lock and re-locked {:g} time(s) (see relocks): a bias jump, a new "
+                         "sensor, or a model that does not fit; check the log around those times",
+                         f.value);
+    case est::HealthCause::kLateLock:
+      return fmt::format("locked only at t = {:.1f} s, with {:g} accepted update(s) after it: too few to check "
+                         "the NIS against its band or to compare the attitude; record a longer log or more "
+                         "flips after the lock",
+                         f.value, f.suggested);
+    default: break;
+  }
+  return "?";
+}
+
+// how the updates fit the model: the NIS, the gate's rejections, the signal chain
+std::string describe_fit(const est::HealthFinding& f, const est::EstimatorConfig& cfg) {
+  switch (f.cause) {
     case est::HealthCause::kNoiseUnderstated:
       return fmt::format("NIS mean {:.3g} above its 95 % band{}: the innovations are {:.2g}x larger than the "
                          "filter expects, its sigma too small (data noisier or bias wandering more than "
-                         "noise_density_dps_rthz {:.3g} and the bias instability say); use --tune auto",
+                         "noise_density_dps_rthz {:.3g} and the bias instability say); {}",
                          f.value,
                          f.severity == est::HealthVerdict::kOk
                              ? " (inside the 99.9 % band: one consistent run in 40 lands here)"
                              : " and its 99.9 % band",
-                         std::sqrt(f.suggested), cfg.noise_density_dps_rthz);
+                         std::sqrt(f.suggested), cfg.noise_density_dps_rthz,
+                         cfg.noise_from_log
+                             ? "the density and the wander were already measured from this log (--tune auto), so the "
+                               "excess is not white noise: a sensor error the model lacks (g-sensitivity, scale or "
+                               "misalignment on a moving box: --selfcal) or a signal-chain mismatch between the sensors"
+                             : "use --tune auto");
     case est::HealthCause::kNoiseOverstated:
       return fmt::format("NIS mean {:.3g} below its 95 % band: the innovations are {:.2g}x smaller than the "
                          "filter expects, its sigma too large (data quieter or the bias steadier than configured): "
@@ -120,19 +157,6 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
                          "which the gate is there to remove; the estimate is unaffected. Repeated rejections "
                          "would mean noise or bias wander larger than configured (--tune auto)",
                          f.suggested, f.value);
-    case est::HealthCause::kUnobservable:
-      return fmt::format("{} kept most of the prior sigma (largest sigma {:.3g} deg/s): the flips in this "
-                         "log do not observe them; flip both platforms",
-                         component_names(f.components), f.value);
-    case est::HealthCause::kRelocks:
-      return fmt::format("the filter lost lock and re-locked {:g} time(s) (see relocks): a bias jump, a new "
-                         "sensor, or a model that does not fit; check the log around those times",
-                         f.value);
-    case est::HealthCause::kLateLock:
-      return fmt::format("locked only at t = {:.1f} s, with {:g} accepted update(s) after it: too few to check "
-                         "the NIS against its band or to compare the attitude; record a longer log or more "
-                         "flips after the lock",
-                         f.value, f.suggested);
     case est::HealthCause::kSignalChainLag:
       return fmt::format("the residual follows the box's angular acceleration: sensor {} reads the rate {:.2f} ms "
                          "(+-{:.2f}) later than sensor {}, which adds {:.2g}x the white noise's variance to the "
@@ -142,6 +166,15 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
                          "to measure each sensor's chain",
                          f.value > 0.0 ? 2 : 1, 1e3 * std::fabs(f.value), 1e3 * f.sigma, f.value > 0.0 ? 1 : 2,
                          f.suggested);
+    default: break;
+  }
+  return "?";
+}
+
+// what the log itself holds against the model: paper mode's positions, clipping, dead axes,
+// the attitude withheld
+std::string describe_input(const est::HealthFinding& f) {
+  switch (f.cause) {
     case est::HealthCause::kPaperRestAngles:
       return fmt::format("the platforms rested {:g} deg from the paper's positions in {:g} of {} standstills "
                          "(plat*_deg read {:g} deg), while paper mode builds H from +-{:g} deg (flip_angle_deg){}; "
@@ -192,6 +225,36 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
                          "flip one platform at a time, or log the platform angles (plat1_deg, plat2_deg) and use "
                          "'standstill: platform'",
                          f.value, f.suggested);
+    default: break;
+  }
+  return "?";
+}
+
+}  // namespace
+
+std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cfg) {
+  switch (f.cause) {
+    case est::HealthCause::kNoUpdate:
+    case est::HealthCause::kAllRejected:
+    case est::HealthCause::kNeverLocked:
+    case est::HealthCause::kUnobservable:
+    case est::HealthCause::kLockLost:
+    case est::HealthCause::kRelocks:
+    case est::HealthCause::kLateLock:
+      return describe_lock(f, cfg);
+    case est::HealthCause::kNoiseUnderstated:
+    case est::HealthCause::kNoiseOverstated:
+    case est::HealthCause::kRejectionsAtPosition:
+    case est::HealthCause::kRejections:
+    case est::HealthCause::kLoneRejection:
+    case est::HealthCause::kSignalChainLag:
+      return describe_fit(f, cfg);
+    case est::HealthCause::kPaperRestAngles:
+    case est::HealthCause::kPaperSchedule:
+    case est::HealthCause::kSaturation:
+    case est::HealthCause::kDeadAxis:
+    case est::HealthCause::kAttitudeWithheld:
+      return describe_input(f);
   }
   return "?";
 }
@@ -210,13 +273,15 @@ std::string health_json(const est::HealthReport& h, const est::EstimatorConfig& 
   }
   findings += h.findings.empty() ? "]" : "\n  ]";
   return fmt::format(
-      "  \"health\": {{\"verdict\": \"{}\", \"locked\": {}, \"lock_t_s\": {}, \"updates\": {}, \"rejected\": {}, "
+      "  \"health\": {{\"verdict\": \"{}\", \"locked\": {}, \"lock_t_s\": {}, \"locked_at_end\": {}, \"lock_lost_t_s\": {}, "
+      "\"updates\": {}, \"rejected\": {}, "
       "\"rejected_fraction\": {}, \"nis_updates\": {}, \"nis_dof_mean\": {}, \"nis_mean\": {}, "
       "\"nis_mean_band_95\": [{}, {}], \"nis_mean_degraded_above\": {}, \"relocks\": {}, \"unobservable\": {},\n"
       "  \"signal_chain\": {{\"samples\": {}, \"lag_s\": {}, \"lag_sigma_s\": {}, \"update_excess\": {}, "
       "\"significant\": {}}},\n"
       "  \"findings\": {}}}",
-      est::to_string(h.verdict), h.locked ? "true" : "false", json_number(h.lock_t_s), h.updates, h.rejected,
+      est::to_string(h.verdict), h.locked ? "true" : "false", json_number(h.lock_t_s),
+      h.locked_at_end ? "true" : "false", json_number(h.lock_lost_t_s), h.updates, h.rejected,
       json_number(h.rejected_fraction), h.nis_updates, json_number(h.nis_dof_mean), json_number(h.nis_mean), json_number(h.nis_mean_band_lo),
       json_number(h.nis_mean_band_hi), json_number(h.nis_mean_degraded_above), h.relocks, unobs, h.signal_chain.samples,
       json_number(h.signal_chain.lag_s), json_number(h.signal_chain.lag_sigma_s), json_number(h.signal_chain.update_excess),
@@ -233,11 +298,21 @@ std::string tune_json(const est::TuneResult* t) {
                      json_number(t->q_dps2_per_s));
 }
 
+namespace {
+// "locked at t = 57.0 s", "locked at t = 57.0 s, lost at t = 518.9 s", "never locked"
+std::string lock_text(const est::HealthReport& h) {
+  if (!h.locked) return "never locked";
+  std::string o = fmt::format("locked at t = {:.1f} s", h.lock_t_s);
+  if (!h.locked_at_end) o += fmt::format(", lost at t = {:.1f} s", h.lock_lost_t_s);
+  return o;
+}
+}  // namespace
+
 std::vector<std::string> health_lines(const est::HealthReport& h, const est::EstimatorConfig& cfg) {
   std::vector<std::string> lines;
   lines.push_back(fmt::format(
       "health: {}: {}, {} of {} updates rejected ({:.1f} %), NIS mean {:.3g} (95 % band {:.3g}..{:.3g}), {} re-lock(s)",
-      est::to_string(h.verdict), h.locked ? fmt::format("locked at t = {:.1f} s", h.lock_t_s) : "never locked",
+      est::to_string(h.verdict), lock_text(h),
       h.rejected, h.updates, std::isfinite(h.rejected_fraction) ? 100.0 * h.rejected_fraction : 0.0, h.nis_mean,
       h.nis_mean_band_lo, h.nis_mean_band_hi, h.relocks));
   for (const auto& f : h.findings) lines.push_back(fmt::format("  {}: {}", est::to_string(f.severity), describe(f, cfg)));

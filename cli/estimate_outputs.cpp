@@ -101,11 +101,8 @@ EstimateFiles::EstimateFiles(const fs::path& dir, const EstimateFilesOptions& op
     corrected_writer_ = std::make_unique<io::BackgroundWriter<CorrectedRow>>(
         [this](const std::vector<CorrectedRow>& rows) { format_corrected(*corrected_, rows); });
   }
-  estimate_.write(
-      "t,b1_x,b1_y,b1_z,b2_x,b2_y,b2_z,sigma1_x,sigma1_y,sigma1_z,sigma2_x,sigma2_y,sigma2_z,"
-      "nis,nis_gate,dim,samples,plat1_deg,plat2_deg,accepted,locked");
-  estimate_.write(opt_.truth ? ",true_bias1_x,true_bias1_y,true_bias1_z,true_bias2_x,true_bias2_y,true_bias2_z\n"
-                             : "\n");
+  estimate_.write(std::string(kEstimateColumns));
+  estimate_.write(opt_.truth ? "," + std::string(kEstimateTruthColumns) + "\n" : std::string("\n"));
   attitude_.write(kAttitudeHeader);
 }
 

@@ -45,6 +45,9 @@ struct AttitudeError {
   double heading_deg = 0.0;
   double angle_deg = 0.0;
 };
+/// No comparison was made (no ref_q, never locked, withheld): every angle unknown, so that
+/// summary.json says null, not a perfect 0
+inline constexpr AttitudeError kAttitudeErrorUnknown{kNaN, kNaN, kNaN, kNaN};
 AttitudeError attitude_error(const Eigen::Quaterniond& q_est, const Eigen::Quaterniond& q_ref);
 
 /// Accumulated (unwrapped) attitude error: the sum of the error rotation's increments between

@@ -89,6 +89,7 @@ struct EstimatorConfig {
 
   // tuning. R: per-axis white noise of one sample = noise_density^2 * sample rate
   double noise_density_dps_rthz = 0.005;   // deg/s/sqrt(Hz), MPU6050 data sheet (paper sec. 4)
+  bool noise_from_log = false;             // set by --tune auto (apply_tune): the density was measured
   // Q: the bias wanders like a random walk that reaches the bias-instability level B at tau_B:
   // K = 0.664 B sqrt(3 / tau_B), Q = K^2 dt per axis
   double bias_instability_dps = 0.01;      // deg/s (36 deg/h)

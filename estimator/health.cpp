@@ -113,6 +113,10 @@ const char* to_string(HealthVerdict v) {
 
 void HealthMonitor::on_update(const UpdateRecord& rec, const DriftlessFilter& filter) {
   ++updates_;
+  // the lock now (a gate re-lock widens P inside a rejected or an accepted update alike)
+  const bool now = filter.correction_sigma_dps().maxCoeff() < limits_.lock_sigma_dps;
+  if (locked_ && locked_now_ && !now) lost_t_s_ = rec.t_s;
+  locked_now_ = now;
   PositionCount& pc = by_position_[{tenth_deg(rec.plat1_deg), tenth_deg(rec.plat2_deg)}];
   ++pc.updates;
   if (!rec.accepted) {
@@ -131,7 +135,7 @@ void HealthMonitor::on_update(const UpdateRecord& rec, const DriftlessFilter& fi
     sums.dof += rec.dim;
     ++sums.n;
   }
-  if (!locked_ && filter.correction_sigma_dps().maxCoeff() < limits_.lock_sigma_dps) {
+  if (!locked_ && now) {
     locked_ = true;
     lock_t_s_ = rec.t_s;
   }
@@ -206,6 +210,19 @@ std::vector<std::array<double, 2>> HealthMonitor::positions_if_never_apart() con
   return pairs;
 }
 
+// locked once, then lost it and did not lock again before the end: the estimates at the end carry
+// the widened sigma of the re-lock, not a bias a script may use (failed, as never locked)
+void HealthMonitor::add_lock_lost_finding(HealthReport& h, const DriftlessFilter& filter) const {
+  if (h.locked_at_end) return;
+  HealthFinding f;
+  f.cause = HealthCause::kLockLost;
+  f.severity = HealthVerdict::kFailed;
+  f.value = filter.correction_sigma_dps().maxCoeff();
+  f.suggested = lost_t_s_;
+  f.sigma = limits_.lock_sigma_dps;
+  add(h, std::move(f));
+}
+
 // never locked (failed) and the components that kept their prior sigma
 void HealthMonitor::add_lock_findings(HealthReport& h, const DriftlessFilter& filter, double duration_s) const {
   const EstimatorConfig& cfg = filter.config();
@@ -233,6 +250,7 @@ void HealthMonitor::add_lock_findings(HealthReport& h, const DriftlessFilter& fi
     add(h, f);
     return;
   }
+  add_lock_lost_finding(h, filter);
   if (h.nis_updates < limits_.min_updates_after_lock) {
     HealthFinding f;
     f.cause = HealthCause::kLateLock;
@@ -254,6 +272,8 @@ HealthReport HealthMonitor::finish(const DriftlessFilter& filter, double duratio
   h.signal_chain = lag;
   h.locked = locked_;
   h.lock_t_s = lock_t_s_;
+  h.locked_at_end = locked_ && locked_now_;
+  h.lock_lost_t_s = h.locked_at_end ? kNaN : lost_t_s_;
   h.updates = updates_;
   h.rejected = rejected_;
   h.rejected_fraction = updates_ > 0 ? double(rejected_) / double(updates_) : kNaN;

@@ -44,6 +44,7 @@ enum class HealthCause {
                          // rate (value: from when, s; suggested: how many such flips)
   kPaperRestAngles,      // paper mode: the platforms rest away from +-flip_angle_deg (eq. (5)'s H)
   kPaperSchedule,        // paper mode: the positions did not follow eq. (5)'s sequence
+  kLockLost,             // locked once, then a re-lock widened P and it did not lock again
 };
 
 /// One check that did not pass, with the numbers that describe() turns into text.
@@ -56,7 +57,9 @@ struct HealthFinding {
                               // innovation variance exceeds (or falls short of) what S predicts;
                               // kNeverLocked: the rejected fraction; kLoneRejection: its time, s;
                               // kLateLock: the accepted updates after the lock (value: lock time, s);
-                              // kSignalChainLag: update_excess (value: the lag, s; sigma: its sigma)
+                              // kSignalChainLag: update_excess (value: the lag, s; sigma: its sigma);
+                              // kLockLost: when the lock was lost, s (value: the largest bias sigma
+                              // at the end, deg/s; sigma: the lock level, deg/s)
   double sigma = kNaN;
   // kRejectionsAtPosition: the (plat1, plat2) angle pairs (deg) where most updates were rejected;
   // kNeverLocked: the pairs that occurred, when both platforms rested on both sides but some
@@ -96,6 +99,8 @@ struct HealthReport {
   HealthVerdict verdict = HealthVerdict::kOk;
   bool locked = false;
   double lock_t_s = kNaN;              // s, first update after which every bias sigma < lock level
+  bool locked_at_end = false;          // every bias sigma < lock level after the last update
+  double lock_lost_t_s = kNaN;         // s, the update after which it was last above the lock level
   std::uint64_t updates = 0, rejected = 0;
   double rejected_fraction = kNaN;
   std::uint64_t nis_updates = 0;       // accepted updates in the NIS mean: those after the lock
@@ -150,11 +155,12 @@ class HealthMonitor {
   void add_gate_findings(HealthReport& h) const;
   void add_nis_findings(HealthReport& h) const;
   void add_lock_findings(HealthReport& h, const DriftlessFilter& filter, double duration_s) const;
+  void add_lock_lost_finding(HealthReport& h, const DriftlessFilter& filter) const;
   std::vector<std::array<double, 2>> positions_if_never_apart() const;
 
   HealthLimits limits_;
-  bool locked_ = false;
-  double lock_t_s_ = kNaN;
+  bool locked_ = false, locked_now_ = false;
+  double lock_t_s_ = kNaN, lost_t_s_ = kNaN;
   std::uint64_t updates_ = 0, rejected_ = 0;
   struct NisSums {
     std::uint64_t n = 0;

@@ -205,9 +205,7 @@ void withhold_attitude(const DriftlessFilter& filter, EstimateSummary& sum) {
   if (std::isnan(sum.attitude_withheld_from_s)) return;
   sum.drift_corrected_deg_per_h = sum.drift_raw_deg_per_h = sum.drift_fixed_deg_per_h = kNaN;
   sum.drift_net_corrected_deg_per_h = sum.drift_net_raw_deg_per_h = sum.drift_net_fixed_deg_per_h = kNaN;
-  AttitudeError none;
-  none.roll_deg = none.pitch_deg = none.heading_deg = none.angle_deg = kNaN;
-  sum.final_corrected = sum.final_raw = sum.final_fixed = none;
+  sum.final_corrected = sum.final_raw = sum.final_fixed = kAttitudeErrorUnknown;
   sum.warnings.push_back(
       "attitude withheld from t = " + std::to_string(sum.attitude_withheld_from_s) + " s: with 'standstill: gyro' " +
       std::to_string(filter.counters().simultaneous_flips) +

@@ -141,7 +141,8 @@ struct EstimateSummary {
   // sensor read the box rate); the drifts and final errors are withheld (NaN). NaN: not withheld
   double attitude_withheld_from_s = kNaN;
   Vector6d fixed_bias_dps = Vector6d::Constant(kNaN);  // deg/s, the bias held by `fixed`
-  AttitudeError final_corrected, final_raw, final_fixed;
+  AttitudeError final_corrected = kAttitudeErrorUnknown, final_raw = kAttitudeErrorUnknown,
+                final_fixed = kAttitudeErrorUnknown;  // NaN while no comparison was made
   TruthStats truth;
   WindowStats window;  // with EstimateRunOptions::eval_start_s
   bool log_complete = true;

@@ -185,6 +185,7 @@ void apply_tune(const TuneResult& t, EstimatorConfig& cfg) {
   if (t.noise_estimated) {
     cfg.noise_density_dps_rthz = t.noise_density_dps_rthz;
     cfg.r_override_dps2 = 0.0;
+    cfg.noise_from_log = true;
   }
   if (t.q_estimated) cfg.q_override_dps2_per_s = t.q_dps2_per_s;
 }

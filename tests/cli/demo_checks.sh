@@ -31,6 +31,20 @@ if grep -q "Look at:" "$work/out.txt"; then fail "a failed demo still lists outp
 [ ! -e "$work/demo/estimate/fig9_attitude.png" ] || fail "a stale fig9_attitude.png survived"
 [ ! -e "$work/demo/estimate/fig5_allan.png" ] || fail "fig5_allan.png was written without lock"
 [ -s "$work/demo/estimate/fig4_bias.png" ] || fail "fig4_bias.png missing"
+# AND Fig. 4's truth lines and 'estimate - truth' panels read the columns estimate.csv names
+# true_bias* and b*: each column number its gnuplot script uses is looked up in the file's header
+# (since estimate.csv gained 'locked', numbers fixed in the code drew the lock flag as a truth)
+python3 - "$work/demo/estimate/estimate.csv" "$work/demo/estimate/fig4_bias.gp" <<'PY' || fail "fig4_bias.gp reads the wrong columns"
+import re, sys
+header = open(sys.argv[1]).readline().strip().split(",")
+gp = open(sys.argv[2]).read()
+name = lambda c: header[int(c) - 1]
+truth = re.findall(r"using 1:(\d+) with linespoints dt 2", gp)
+diffs = re.findall(r"using 1:\(\$(\d+)-\$(\d+)\)", gp)
+assert len(truth) == 6 and len(diffs) == 6, (truth, diffs)
+for c in truth: assert name(c).startswith("true_bias"), name(c)
+for b, t in diffs: assert name(t) == "true_" + name(b).replace("b", "bias", 1), (name(b), name(t))
+PY
 grep -q '"name": "fig9_attitude", "written": false, "reason": "the filter never locked on' \
   "$work/demo/estimate/summary.json" || fail "summary.json does not say why Fig. 9 is missing"
 echo "demo checks passed"

@@ -104,6 +104,12 @@ TEST(HealthTest, AFilterThatNeverLocksFailsAndNamesTheUnobservableComponents) {
   ASSERT_TRUE(has(h, HealthCause::kNeverLocked));
   EXPECT_FALSE(h.unobservable.empty());
   EXPECT_EQ(h.findings.front().components, h.unobservable);
+  // and no attitude comparison was made: its final errors are unknown (summary.json null), not a
+  // perfect 0 that a script would read as a result
+  EXPECT_TRUE(std::isnan(s.attitude_start_s));
+  EXPECT_TRUE(std::isnan(s.final_corrected.angle_deg));
+  EXPECT_TRUE(std::isnan(s.final_fixed.angle_deg));
+  EXPECT_TRUE(std::isnan(s.final_raw.angle_deg));
 }
 
 TEST(HealthTest, PlatformsThatOnlyFlipTogetherAreNamedWithThePositionsThatOccurred) {
@@ -304,6 +310,40 @@ TEST(HealthTest, ANisMeanAboveThe95BandIsANoteUntilThe999Band) {
     }
   }
   EXPECT_TRUE(has(bad, HealthCause::kNoiseUnderstated));
+}
+
+TEST(HealthTest, ALockLostForGoodFailsAndSaysWhen) {
+  // GIVEN the healthy 900 s log (81 updates, 11 s cycle), and the same log with gyro 1's x bias
+  // jumping by 3 deg/s at 860 s: the gate rejects the next updates (NIS ~ 9/3e-5), the filter
+  // re-locks by widening P by the innovation (sigma ~ 3 deg/s), and the one update left before the
+  // end cannot bring all six sigma back below the lock level (each observes 3 of the 6 directions)
+  auto p = mpu_like(12);
+  p.gm_sigma_dps = 0.0;
+  EstimatorConfig cfg;
+  cfg.q_override_dps2_per_s = 1e-14;
+  const HealthReport steady = run_synth(p, "lock_kept.csv", cfg).health;
+  p.before_quantise = [](Sample& s) {
+    if (s.t_s > 860.0) s.gyro1_dps.x() += 3.0;
+  };
+  const HealthReport jump = run_synth(p, "lock_lost.csv", cfg).health;
+  // THEN the steady log is locked at its end, with no lock_lost finding
+  EXPECT_TRUE(steady.locked_at_end);
+  EXPECT_FALSE(has(steady, HealthCause::kLockLost)) << causes(steady);
+  // and the jump: locked once (at the same update as the steady log), re-locked, not locked at the
+  // end: failed with the time the lock went, after the jump and before the end
+  EXPECT_TRUE(jump.locked);
+  EXPECT_DOUBLE_EQ(jump.lock_t_s, steady.lock_t_s);
+  EXPECT_GE(jump.relocks, 1u);
+  EXPECT_FALSE(jump.locked_at_end);
+  EXPECT_EQ(jump.verdict, HealthVerdict::kFailed) << causes(jump);
+  ASSERT_TRUE(has(jump, HealthCause::kLockLost)) << causes(jump);
+  const auto lost = *std::find_if(jump.findings.begin(), jump.findings.end(),
+                                  [](const HealthFinding& f) { return f.cause == HealthCause::kLockLost; });
+  EXPECT_EQ(lost.severity, HealthVerdict::kFailed);
+  EXPECT_DOUBLE_EQ(lost.suggested, jump.lock_lost_t_s);
+  EXPECT_GT(jump.lock_lost_t_s, 860.0);
+  EXPECT_LT(jump.lock_lost_t_s, 900.0);
+  EXPECT_GT(lost.value, HealthLimits{}.lock_sigma_dps);  // the sigma at the end, above the lock level
 }
 
 TEST(HealthTest, ALockAtTheEndOfTheLogIsDegradedNotOk) {
