@@ -8,36 +8,15 @@ target_compile_options(driftless_flags INTERFACE -Wall -Wextra -Werror)
 target_compile_options(driftless_flags INTERFACE $<$<CONFIG:Release>:-O2>)
 if(DRIFTLESS_SANITIZE)
   # -g1 (after the build type's -g, so it wins): line tables for the reports' stack traces at
-  # 20 % less compile time. -gz: the line tables compressed (zlib) in objects and programs (the
-  # sanitizer build took 4 GB); the sanitizers' symbolizer reads them as before
+  # 20 % less compile time. -Og: GCC's debugging level inlines Eigen's small functions, which -O0
+  # calls one by one (the suite under the sanitizers spent ~20 min of CPU at -O0), and compiles as
+  # fast as -O0 (measured: estimator/filter.cpp 23 s against 25 s, diagnose/channel_fit.cpp 30 s
+  # against 27 s; -O1 took 30 s and 39 s)
+  # -gz: the line tables compressed (zlib) in objects and programs (the sanitizer build took 4 GB);
+  # the sanitizers' symbolizer reads them as before
   target_compile_options(driftless_flags INTERFACE
-    -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer -g1 -gz)
+    -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer -g1 -Og -gz)
   target_link_options(driftless_flags INTERFACE -fsanitize=address,undefined -gz)
-  if(CMAKE_CXX_COMPILER_ID MATCHES "Clang")
-    # clang (CI's instrumented build, which is also the fuzz harnesses' build): -O1, the level
-    # the sanitizers' authors recommend; it inlines Eigen's small functions as GCC's -Og does
-    target_compile_options(driftless_flags INTERFACE -O1)
-  else()
-    # -Og: GCC's debugging level inlines Eigen's small functions, which -O0 calls one by one
-    # (the suite under the sanitizers spent ~20 min of CPU at -O0), and compiles as fast as -O0
-    # (measured: estimator/filter.cpp 23 s against 25 s, diagnose/channel_fit.cpp 30 s against
-    # 27 s; -O1 took 30 s and 39 s)
-    target_compile_options(driftless_flags INTERFACE -Og)
-  endif()
-endif()
-# DRIFTLESS_FUZZ (clang, with DRIFTLESS_SANITIZE): the libraries' objects carry libFuzzer's
-# coverage instrumentation (-fsanitize=fuzzer-no-link), so the one instrumented build gives both
-# the sanitizer suite's programs and the fuzz harnesses (tests/fuzz), which link libFuzzer itself.
-# Executables (the tests, the driftless program) are not instrumented for coverage: nothing fuzzes
-# them, and the counters would only slow the sanitizer suite.
-if(DRIFTLESS_FUZZ)
-  if(NOT CMAKE_CXX_COMPILER_ID MATCHES "Clang" OR NOT DRIFTLESS_SANITIZE)
-    message(FATAL_ERROR "DRIFTLESS_FUZZ needs clang and DRIFTLESS_SANITIZE=ON (libFuzzer, ASan, UBSan): "
-                        "CC=clang CXX=clang++ cmake -DDRIFTLESS_SANITIZE=ON -DDRIFTLESS_FUZZ=ON ...; got "
-                        "${CMAKE_CXX_COMPILER_ID} with DRIFTLESS_SANITIZE=${DRIFTLESS_SANITIZE}")
-  endif()
-  target_compile_options(driftless_flags INTERFACE
-    $<$<IN_LIST:$<TARGET_PROPERTY:TYPE>,STATIC_LIBRARY;SHARED_LIBRARY;MODULE_LIBRARY>:-fsanitize=fuzzer-no-link>)
 endif()
 
 # driftless_pch_for_ccache(target): a target that builds or uses a precompiled header. clang writes

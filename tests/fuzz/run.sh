@@ -1,12 +1,10 @@
 #!/usr/bin/env bash
-# Builds the libFuzzer harnesses (clang, ASan, UBSan: the main project configured with
-# -DDRIFTLESS_SANITIZE=ON -DDRIFTLESS_FUZZ=ON, tests/fuzz/CMakeLists.txt) and runs each for a
+# Builds the libFuzzer harnesses with clang (only the sources each needs) and runs each for a
 # bounded time on a copy of its corpus (tests/fuzz/corpus/<name>). Any crash, sanitizer report,
 # timeout or out-of-memory is a finding: the script prints it and exits 1.
 # Usage: tests/fuzz/run.sh [BUILD_DIR] [SECONDS_PER_HARNESS] [all|build|run]
-#   all (default): build, then run; build: only configure and build the harnesses and the
-#   libraries they link; run: only run the harnesses already built in BUILD_DIR (BUILD_DIR/fuzz/).
-#   CI builds them in its sanitizer build folder (.ci/run), with the sanitizer suite's programs.
+#   all (default): build, then run; build: only configure and build (CI builds the harnesses beside
+#   the Release pass); run: only run the harnesses already built in BUILD_DIR
 set -euo pipefail
 root=$(cd "$(dirname "$0")/../.." && pwd)
 build=${1:-"$root/build-fuzz"}
@@ -18,15 +16,10 @@ case $step in
 esac
 if [[ $step != run ]]; then
   command -v clang++ >/dev/null || { echo "fuzz: clang++ not found (scripts/setup.sh installs clang)"; exit 1; }
-  # the flags of CI's instrumented build (.ci/run), so the objects are shared through ccache
-  # a folder configured by the harnesses' former project of their own (tests/fuzz alone) is rebuilt
-  if grep -qs "^CMAKE_HOME_DIRECTORY:INTERNAL=$root/tests/fuzz\$" "$build/CMakeCache.txt"; then
-    echo "fuzz: $build was configured from tests/fuzz alone (before the harnesses joined the main project): starting it afresh"
-    rm -rf "$build"
-  fi
-  CC=clang CXX=clang++ BUILD_TYPE=Debug BUILD_TARGET=fuzzers bash "$root/scripts/build.sh" "$build" \
-    -DDRIFTLESS_SANITIZE=ON -DDRIFTLESS_FUZZ=ON -DBUILD_SHARED_LIBS=ON -DDRIFTLESS_BUILD_BENCHMARKS=OFF \
-    -DDRIFTLESS_BUILD_TESTS=OFF
+  export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$root} CCACHE_NOHASHDIR=${CCACHE_NOHASHDIR:-1}
+  export CCACHE_MAXSIZE=${CCACHE_MAXSIZE:-1G}   # bounded, as in scripts/build.sh
+  CC=clang CXX=clang++ cmake -S "$root/tests/fuzz" -B "$build" -DCMAKE_BUILD_TYPE=None >/dev/null
+  cmake --build "$build" -j "$(nproc 2>/dev/null || echo 2)"
 fi
 [[ $step == build ]] && exit 0
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
@@ -36,11 +29,11 @@ export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 # how many at once (CI: 1, beside the sanitizer suite, which keeps the other core)
 fuzz_one() {
   local name=$1 corpus=$2
-  local work="$build/fuzz/work/$name" log="$build/fuzz/$name.log"
+  local work="$build/work/$name" log="$build/$name.log"
   mkdir -p "$work"
   # new inputs go to the work folder; the committed corpus is read, never written
-  if "$build/fuzz/fuzz_$name" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
-       -artifact_prefix="$build/fuzz/$name-" "$work" "$corpus" > "$log" 2>&1; then
+  if "$build/fuzz_$name" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
+       -artifact_prefix="$build/$name-" "$work" "$corpus" > "$log" 2>&1; then
     echo "fuzz $name: $(grep -m1 'stat::number_of_executed_units' "$log" | awk '{print $2}') runs, no finding"
     # the inputs it made are not kept (CI's disk is shared; the committed corpus is what a run reads)
     rm -rf "$work"
