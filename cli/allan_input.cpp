@@ -115,6 +115,20 @@ void add_corrected_notes(const est::DriftlessFilter& filter, double lock_t_s, do
   }
 }
 
+// the smallest and largest angle each platform column read
+struct PlatformSpan {
+  std::array<double, 2> lo{kNaN, kNaN}, hi{kNaN, kNaN};
+  void add(const Sample& s) {
+    const double a[2] = {s.plat1_deg, s.plat2_deg};
+    for (int p = 0; p < 2; ++p) {
+      if (!std::isfinite(a[p])) continue;
+      lo[p] = std::isnan(lo[p]) ? a[p] : std::min(lo[p], a[p]);
+      hi[p] = std::isnan(hi[p]) ? a[p] : std::max(hi[p], a[p]);
+    }
+  }
+  std::array<double, 2> span_deg() const { return {hi[0] - lo[0], hi[1] - lo[1]}; }
+};
+
 Loaded load_log(const InputArgs& a) {
   // the single-sensor form is read too; --corrected runs the filter, which needs both triads
   log::ReaderOptions ro;
@@ -145,7 +159,9 @@ Loaded load_log(const InputArgs& a) {
   bool pending_break = false;
   // the corrected channels start at lock: before it the correction is the filter's start value
   double lock_t_s = kNaN;
+  PlatformSpan span;
   while (reader.next(s)) {
+    span.add(s);
     if (filter) {
       filter->push(s);
       if (std::isnan(lock_t_s) && est::filter_locked(*filter, a.corrected_lock_sigma_dps)) lock_t_s = s.t_s;
@@ -176,6 +192,7 @@ Loaded load_log(const InputArgs& a) {
     }
   }
   if (first_t.size() < 4096) mon.learn(first_t);
+  out.platform_span_deg = span.span_deg();
   if (!reader.metadata().complete()) out.notes.push_back("the log says 'complete: false'; using the rows present");
   if (skipped > 0) out.notes.push_back(fmt::format("{} rows with a missing value were left out (a segment break each)", skipped));
   if (filter) add_corrected_notes(*filter, lock_t_s, a.corrected_lock_sigma_dps, out.notes);

@@ -3,6 +3,7 @@
 // Either in memory (exact at every tau) or streamed into octave accumulators (bounded memory).
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <span>
 #include <string>
@@ -52,6 +53,9 @@ struct Loaded {
   std::string format;                     // "log", "text", "euroc", "npy", "bag"
   std::vector<std::string> notes;         // assumptions, stamp findings, dropped rows, gap policy
   importers::StampReport stamps;
+  // a DriftLess log: the range each platform's angle column spans (deg; NaN: no such column or no
+  // value), which says whether the platforms flipped while the record ran
+  std::array<double, 2> platform_span_deg{std::nan(""), std::nan("")};
 };
 
 /// Reads every channel into memory.

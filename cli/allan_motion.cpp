@@ -83,8 +83,42 @@ std::vector<std::string> motion_warnings(const std::vector<std::string>& names, 
   return out;
 }
 
+namespace {
+
+// deg: a platform whose angle column spans more than this flipped (end-stop and encoder scatter is
+// well below a degree; a flip is 90 or 180)
+constexpr double kFlipSpanDeg = 10.0;
+constexpr double kEarthRateDps = 15.041067 / 3600.0;  // deg/s, sidereal
+
+// a platform that flips turns every axis of its sensor: the Earth rate's share along each axis
+// changes at every flip, a square wave in the channels the motion check does not flag (the hinge
+// axis reads the flip itself). A FOG's bias instability is 1e-5 deg/s; this is up to 4e-3.
+void add_flip_warnings(const Loaded& in, std::vector<std::string>& out) {
+  for (int p = 0; p < 2; ++p) {
+    if (!(in.platform_span_deg[p] > kFlipSpanDeg)) continue;
+    const std::string prefix = fmt::format("gyro{}_", p + 1);
+    std::string named;
+    for (const auto& c : in.channels) {
+      const bool of_sensor = c.name.rfind(prefix, 0) == 0 || c.name.rfind("corrected_" + prefix, 0) == 0;
+      if (of_sensor) named += (named.empty() ? "" : ", ") + c.name;
+    }
+    if (named.empty()) continue;
+    out.push_back(fmt::format(
+        "platform {0} flips (plat{0}_deg spans {1:.0f} deg): every axis of sensor {0} turns with it, so the Earth rate "
+        "along each ({2:.2g} deg/s in all) changes at every flip, a square wave that the B and K of {3} hold on top "
+        "of the sensor's own (above a tactical gyro's B by 100x); for the sensor's noise analyse a record with the "
+        "platforms held, or run 'driftless estimate --tune auto', which measures N and K from r = M1 y1 - M2 y2, "
+        "where the Earth rate cancels",
+        p + 1, in.platform_span_deg[p], kEarthRateDps, named));
+  }
+}
+
+}  // namespace
+
 std::vector<std::string> motion_warnings(const Loaded& in) {
-  if (!(in.rate_hz > 0.0)) return {};
+  std::vector<std::string> out;
+  add_flip_warnings(in, out);
+  if (!(in.rate_hz > 0.0)) return out;
   std::vector<std::string> names;
   std::vector<BlockMeans> means;
   for (const auto& c : in.channels) {
@@ -93,7 +127,8 @@ std::vector<std::string> motion_warnings(const Loaded& in) {
     means.emplace_back(in.rate_hz);
     means.back().push(c.x);
   }
-  return motion_warnings(names, means, in.rate_hz);
+  for (auto& w : motion_warnings(names, means, in.rate_hz)) out.push_back(std::move(w));
+  return out;
 }
 
 bool watched_for_motion(const std::string& name, importers::Quantity q) {

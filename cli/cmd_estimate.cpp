@@ -99,6 +99,15 @@ double write_smoothed(const EstimateArgs& a, const log::ReaderOptions& read_opt,
   return last_t_s;
 }
 
+// what --tune auto did with Q: measured, bounded (and applied), or kept
+std::string q_text(const est::TuneResult& t) {
+  if (t.q_upper_bound) {
+    return fmt::format("at most {:.4g} (deg/s)^2/s (no wander above the noise: the revisits' upper bound){}",
+                       t.q_dps2_per_s, t.q_estimated ? "" : ", above the configured value, which is kept");
+  }
+  return t.q_estimated ? fmt::format("{:.4g} (deg/s)^2/s", t.q_dps2_per_s) : "not measured, configured value kept";
+}
+
 // --tune auto: a first pass over the log measures N and K (docs/estimator.md section 6.2)
 est::TuneResult tune_config(const EstimateArgs& a, est::EstimatorConfig& cfg) {
   log::LogReader first(a.log);
@@ -109,8 +118,7 @@ est::TuneResult tune_config(const EstimateArgs& a, est::EstimatorConfig& cfg) {
              t.noise_estimated ? fmt::format("{:.4g} deg/s/sqrt(Hz)", t.noise_density_dps_rthz)
                                : "not measured, configured value kept",
              t.noise_block_pairs, t.block_s,
-             t.q_estimated ? fmt::format("{:.4g} (deg/s)^2/s", t.q_dps2_per_s) : "not measured, configured value kept",
-             t.wander_pairs);
+             q_text(t), t.wander_pairs);
   return t;
 }
 

@@ -292,10 +292,10 @@ std::string tune_json(const est::TuneResult* t) {
   if (t == nullptr) return "null";
   return fmt::format("{{\"block_s\": {}, \"noise_block_pairs\": {}, \"noise_estimated\": {}, "
                      "\"noise_density_dps_rthz\": {}, \"wander_pairs\": {}, \"q_estimated\": {}, "
-                     "\"q_dps2_per_s\": {}}}",
+                     "\"q_dps2_per_s\": {}, \"q_upper_bound\": {}}}",
                      json_number(t->block_s), t->noise_block_pairs, t->noise_estimated ? "true" : "false",
                      json_number(t->noise_density_dps_rthz), t->wander_pairs, t->q_estimated ? "true" : "false",
-                     json_number(t->q_dps2_per_s));
+                     json_number(t->q_dps2_per_s), t->q_upper_bound ? "true" : "false");
 }
 
 namespace {

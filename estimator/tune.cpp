@@ -24,7 +24,7 @@ EstimatorConfig block_config(EstimatorConfig cfg, const TuneLimits& limits) {
 }  // namespace
 
 NoiseTuner::NoiseTuner(const EstimatorConfig& cfg, const BoxGeometry& box, const TuneLimits& limits)
-    : limits_(limits), geometry_(block_config(cfg, limits), box), detector_(block_config(cfg, limits), box) {
+    : limits_(limits), configured_q_dps2_per_s_(cfg.q_dps2_per_s()), geometry_(block_config(cfg, limits), box), detector_(block_config(cfg, limits), box) {
   if (!(limits_.block_s > 0.0)) throw std::invalid_argument("tune: block_s must be > 0 s");
 }
 
@@ -41,6 +41,14 @@ void NoiseTuner::push(const Sample& s) {
 constexpr std::uint64_t kPairsPerCoefficient = 4;
 // a motion fit is used when noise alone would remove as much in 1 position pair of 1000
 constexpr double kMotionFitSignificance = 0.999;
+// and when its rate coefficients are a relative scale and misalignment a gyro can have (|c| below
+// 0.2; uncalibrated MEMS parts: a few %). On a still box the fused rate x = (n1 + n2)/2 is the two
+// sensors' noise, correlated with r's n1 - n2 unless sigma1 = sigma2: a fit there finds
+// c = 2 (sigma1^2 - sigma2^2) / (sigma1^2 + sigma2^2), up to 2, and removes the louder sensor's noise
+// (a 0.002 + 0.014 deg/s/sqrt(Hz) pair was tuned to 0.0028 instead of 0.0100)
+constexpr double kMaxRateCoefficient = 0.2;
+// the upper bound of K^2 when the revisits show no wander above the noise: one-sided 97.5 %
+constexpr double kWanderBoundZ = 1.96;
 
 // the block's fused body rate and specific force in box axes (zero force without accel columns:
 // that coefficient is then not identified and the rank-revealing solve drops it)
@@ -128,6 +136,7 @@ void NoiseTuner::MotionFit::solve() {
   // the noise variance measured in what is left
   const double removed = (rr - ss_fit) / (ss_fit / dof_fit);
   if (!(removed > chi2_quantile(kMotionFitSignificance, 3.0 * double(rank)))) return;
+  if (!(c.topRows<3>().cwiseAbs().maxCoeff() < kMaxRateCoefficient)) return;
   fitted = true;
   coef = c;
   xx_inv = scale.asDiagonal() * cod.pseudoInverse() * scale.asDiagonal();
@@ -155,7 +164,7 @@ TuneResult NoiseTuner::finish() {
   // K^2 = sum(|dr - coef^T dx|^2 - 6 sigma^2 w) / sum(6 dt)
   t.wander_pairs = wander_.size();
   if (wander_.size() < limits_.min_wander_pairs) return t;
-  double num = 0.0, den = 0.0;
+  double num = 0.0, den = 0.0, num_var = 0.0;
   for (const auto& p : wander_) {
     const auto m = motion_.find(p.key);
     Eigen::Vector3d motion = Eigen::Vector3d::Zero();
@@ -166,11 +175,19 @@ TuneResult NoiseTuner::finish() {
     }
     num += (p.dr - motion).squaredNorm() - 6.0 * sigma2 * p.inv_n - coef_error;
     den += 6.0 * p.dt_s;
+    // without wander |dr|^2 is v chi-square(3), v = 2 sigma^2 inv_n per axis: variance 6 v^2
+    const double v = 2.0 * sigma2 * p.inv_n;
+    num_var += 6.0 * v * v;
   }
-  if (den > 0.0 && num > 0.0) {
-    t.q_estimated = true;
-    t.q_dps2_per_s = num / den;
-  }
+  if (!(den > 0.0)) return t;
+  const double bound = kWanderBoundZ * std::sqrt(num_var);
+  // a wander the noise could have made (a FOG's, below a MEMS default by 1e4) is not measured:
+  // its upper bound is, and the filter's sigma then follows the data, not the configured part. A
+  // bound above the configured Q does not contradict it (noise inflated by a signal-chain lag gives
+  // such bounds): the configured Q is kept
+  t.q_upper_bound = !(num > bound);
+  t.q_dps2_per_s = (t.q_upper_bound ? std::max(num, 0.0) + bound : num) / den;
+  t.q_estimated = !t.q_upper_bound || t.q_dps2_per_s < configured_q_dps2_per_s_;
   return t;
 }
 

@@ -38,6 +38,9 @@ struct TuneResult {
   std::uint64_t wander_pairs = 0;            // same-position visit pairs used
   bool q_estimated = false;
   double q_dps2_per_s = kNaN;                // (deg/s)^2/s, K^2 per axis
+  bool q_upper_bound = false;                // the revisits showed no wander above the noise:
+                                             // q_dps2_per_s is their one-sided 97.5 % upper bound,
+                                             // applied (q_estimated) only when below the configured Q
   double sample_rate_hz = kNaN;              // Hz, used for N
 };
 
@@ -86,6 +89,7 @@ class NoiseTuner {
   void close_visit();
 
   TuneLimits limits_;
+  double configured_q_dps2_per_s_;  // the Q a bound must be below to replace
   DriftlessFilter geometry_;  // only for its M_body_from_sensor (rotations or calibrated)
   StandstillDetector detector_;
   double last_t_s_ = kNaN;

@@ -2,6 +2,8 @@
 // and the bias random walk K of seeded synthetic logs, and a filter tuned with them is consistent
 // where the defaults were not.
 #include <cmath>
+#include <memory>
+#include <random>
 
 #include <gtest/gtest.h>
 
@@ -114,6 +116,73 @@ TEST(TuneTest, NoiseOfAnUncalibratedSensorOnATurningBoxIsItsOwn) {
   if (t.q_estimated) {
     EXPECT_LT(t.q_dps2_per_s, 0.1 * EstimatorConfig{}.q_dps2_per_s());
   }
+}
+
+// a still box whose two gyros differ: sensor 1 a FOG-like 0.002 deg/s/sqrt(Hz), sensor 2 a BMI088's
+// 0.014 (extra white noise on it), no wander; `seed` for the draws
+test::SynthParams unlike_pair(std::uint64_t seed) {
+  test::SynthParams p;
+  p.duration_s = 1200.0;
+  p.noise_sigma_dps = 0.002 * std::sqrt(p.rate_hz);
+  const double extra = std::sqrt(0.014 * 0.014 - 0.002 * 0.002) * std::sqrt(p.rate_hz);
+  auto rng = std::make_shared<std::mt19937_64>(seed + 1000);
+  p.extra_noise_dps = [rng, extra](int sensor, std::size_t) {
+    std::normal_distribution<double> n(0.0, extra);
+    return sensor == 2 ? Eigen::Vector3d(n(*rng), n(*rng), n(*rng)) : Eigen::Vector3d::Zero();
+  };
+  p.seed = seed;
+  return p;
+}
+
+TEST(TuneTest, AnUnlikePairIsTunedToThePairsNoiseNotTheQuieterOnes) {
+  // GIVEN 20 min of the unlike pair on a still box
+  const test::SynthParams p = unlike_pair(41);
+  NoiseTuner tuner(EstimatorConfig{}, test::synth_geometry(p));
+  test::synth_samples(p, [&](const Sample& s) { tuner.push(s); });
+  const TuneResult t = tuner.finish();
+  // THEN N is the density whose R = 2 N^2 rate matches r = y1 - y2's noise, sigma1^2 + sigma2^2:
+  // sqrt((0.002^2 + 0.014^2) / 2) = 0.0100, within 3 % (about 2000 block pairs: 1.6 % standard
+  // error). The fused rate's noise, correlated with r's, is no motion to fit (it was: 0.0028)
+  ASSERT_TRUE(t.noise_estimated);
+  const double pair = std::sqrt((0.002 * 0.002 + 0.014 * 0.014) / 2.0);
+  EXPECT_NEAR(t.noise_density_dps_rthz, pair, 0.03 * pair);
+}
+
+TEST(TuneTest, NoWanderAboveTheNoiseGivesAnUpperBoundOfQNotTheDefault) {
+  // GIVEN the quiet FOG-like gyro on both sides (0.002 deg/s/sqrt(Hz)) and biases that hold still
+  test::SynthParams p;
+  p.duration_s = 1200.0;
+  p.noise_sigma_dps = 0.002 * std::sqrt(p.rate_hz);
+  p.seed = 42;
+  NoiseTuner tuner(EstimatorConfig{}, test::synth_geometry(p));
+  test::synth_samples(p, [&](const Sample& s) { tuner.push(s); });
+  const TuneResult t = tuner.finish();
+  // THEN Q is not measured as a wander but bounded: the bound is the one-sided 97.5 % limit of the
+  // revisits' noise, 1.96 sqrt(sum 6 v^2) / sum 6 dt, with v = 2 sigma^2 (1/n_a + 1/n_b) per axis and
+  // pair. Closed form here: sigma^2 = 0.002^2 * 100 = 4e-4, n ~ 1000 per visit (v = 1.6e-6), ~105
+  // revisits 44 s apart: 1.96 sqrt(105 * 6) 1.6e-6 / (105 * 264) = 2.8e-9; the estimate adds the
+  // measured part below the bound (at most as much again): 2e-9 .. 8e-9 (deg/s)^2/s, where the
+  // MPU6050 default 1.3e-6 was kept before
+  ASSERT_TRUE(t.q_estimated);
+  EXPECT_TRUE(t.q_upper_bound);
+  EXPECT_GT(t.q_dps2_per_s, 2e-9);
+  EXPECT_LT(t.q_dps2_per_s, 8e-9);
+  // AND the filter tuned with it is safe (nothing rejected, NIS not above its band, >= 95 % of the
+  // updates within 3 sigma of the truth) and its sigma follows the data: below a fifth of the sigma
+  // with the default Q
+  const auto path = test::temp_path("fog_tuned.csv");
+  test::synth_log(p, path);
+  auto run = [&](const EstimatorConfig& cfg) {
+    log::LogReader reader(path);
+    return run_estimate(reader, cfg, nullptr);
+  };
+  EstimatorConfig tuned;
+  apply_tune(t, tuned);
+  const EstimateSummary s = run(tuned), dflt = run(EstimatorConfig{});
+  EXPECT_EQ(s.health.rejected, 0u);
+  EXPECT_LT(s.health.nis_mean, s.health.nis_mean_band_hi);
+  EXPECT_GE(s.truth.within_3sigma_fraction, 0.95);
+  EXPECT_LT(s.sigma_dps.maxCoeff(), 0.2 * dflt.sigma_dps.maxCoeff());
 }
 
 }  // namespace
