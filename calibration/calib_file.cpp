@@ -77,6 +77,17 @@ struct SensorBlock {
   TempBlock temp;
 };
 
+// end_stops.platformN: the rest angle errors at its two stops (deg, actual - read about the hinge)
+// and their 1-sigma; a self-calibration with end-stop states writes them
+struct StopPair {
+  double minus90_deg = 0.0, minus90_sigma_deg = 0.0;
+  double plus90_deg = 0.0, plus90_sigma_deg = 0.0;
+};
+
+struct EndStopsBlock {
+  std::array<StopPair, 2> platform;
+};
+
 enum class Matrices { kCalibrated, kNominal };
 
 struct CalibDoc {
@@ -88,6 +99,8 @@ struct CalibDoc {
   Vec3 hinge2_axis = Vec3::UnitX();
   RigBlock rig;
   std::array<SensorBlock, 2> sensor;
+  bool has_end_stops = false;
+  EndStopsBlock end_stops;
 };
 
 // ---- the tables ----
@@ -253,6 +266,44 @@ fields::Row<SensorBlock> temperature_row() {
   return fields::optional_row(std::move(row), &SensorBlock::has_temp);
 }
 
+const Table<StopPair>& stop_pair_table() {
+  using P = StopPair;
+  static const Table<P> t = {
+      fields::number<P>("minus90", "deg", &P::minus90_deg),
+      fields::number<P>("minus90_sigma", "deg", &P::minus90_sigma_deg),
+      fields::number<P>("plus90", "deg", &P::plus90_deg),
+      fields::number<P>("plus90_sigma", "deg", &P::plus90_sigma_deg),
+  };
+  return t;
+}
+
+// one platform's stops: all four keys, each angle within +-10 deg (the twin's limit), sigma >= 0
+fields::Row<EndStopsBlock> platform_row(std::size_t i) {
+  const char* stem = i == 0 ? "platform1" : "platform2";
+  fields::Row<EndStopsBlock> row = fields::block<EndStopsBlock>(
+      stem, [i](auto& b) -> auto& { return b.platform[i]; }, &stop_pair_table,
+      {"minus90_deg", "minus90_sigma_deg", "plus90_deg", "plus90_sigma_deg"});
+  auto read = row.read;
+  row.read = [read, i](EndStopsBlock& b, const fields::Node& n, const fields::Reading& r) {
+    read(b, n, r);
+    const StopPair& p = b.platform[i];
+    const auto fail = [&](const char* key, const char* what) {
+      const fields::Node* at = n.find(key);
+      r.ctx.fail(at != nullptr ? *at : n, r.ctx.key(key), what);
+    };
+    if (!(std::abs(p.minus90_deg) <= 10.0)) fail("minus90_deg", "an end-stop angle error within +-10 deg");
+    if (!(std::abs(p.plus90_deg) <= 10.0)) fail("plus90_deg", "an end-stop angle error within +-10 deg");
+    if (!(p.minus90_sigma_deg >= 0.0)) fail("minus90_sigma_deg", "a sigma must be >= 0 deg");
+    if (!(p.plus90_sigma_deg >= 0.0)) fail("plus90_sigma_deg", "a sigma must be >= 0 deg");
+  };
+  return row;
+}
+
+const Table<EndStopsBlock>& end_stops_table() {
+  static const Table<EndStopsBlock> t = {platform_row(0), platform_row(1)};
+  return t;
+}
+
 const Table<SensorBlock>& sensor_table() {
   using S = SensorBlock;
   static const Table<S> t = {
@@ -280,6 +331,8 @@ const Table<CalibDoc>& calib_table() {
       fields::block<D>("rig", &D::rig, &rig_table),
       fields::block<D>("sensor1", [](auto& d) -> auto& { return d.sensor[0]; }, &sensor_table, {"minus90", "plus90"}),
       fields::block<D>("sensor2", [](auto& d) -> auto& { return d.sensor[1]; }, &sensor_table, {"minus90", "plus90"}),
+      fields::optional_row(fields::block<D>("end_stops", &D::end_stops, &end_stops_table, {"platform1", "platform2"}),
+                           &D::has_end_stops),
   };
   return t;
 }
@@ -344,11 +397,17 @@ void save_selfcal_calib(const std::filesystem::path& path, const SelfCalibration
     s.has_temp = sc.temp_states;
     s.temp = TempBlock{sc.temp_coef_dps_per_degc[i], sc.temp_coef_sigma_dps_per_degc[i], sc.temp_ref_c[i]};
   }
+  doc.has_end_stops = sc.stop_states;
+  for (std::size_t p = 0; p < 2; ++p) {
+    const Eigen::Index o = 2 * static_cast<Eigen::Index>(p);
+    doc.end_stops.platform[p] = StopPair{sc.end_stop_deg[o], sc.end_stop_sigma_deg[o], sc.end_stop_deg[o + 1],
+                                         sc.end_stop_sigma_deg[o + 1]};
+  }
   write_doc(path, doc,
             "driftless estimate --selfcal output (docs/calibration.md). Convention as driftless calibrate's:\n"
             "y_i = (I + E_i) M^-1 w_box + b_i + G_i f_i + k_i (T_i - T_ref); M here are the nominal rotations\n"
-            "(not calibrated), E_i the scale/misalignment error. Units: deg/s, deg, deg/s per g, fraction,\n"
-            "deg/s per degC, degC.");
+            "(not calibrated), E_i the scale/misalignment error, end_stops each platform's rest angle error\n"
+            "(actual - read, about its hinge). Units: deg/s, deg, deg/s per g, fraction, deg/s per degC, degC.");
 }
 
 est::CalibMatrices CalibFile::matrices_with_scale() const {
@@ -374,6 +433,9 @@ est::Calibration CalibFile::to_filter_calibration() const {
   cal.has_temp_coef = has_temp_coef;
   cal.temp_coef_dps_per_degc = temp_coef_dps_per_degc;
   cal.temp_coef_sigma_dps_per_degc = temp_coef_sigma_dps_per_degc;
+  cal.has_end_stops = has_end_stops;
+  cal.end_stop_deg = end_stop_deg;
+  cal.end_stop_sigma_deg = end_stop_sigma_deg;
   return cal;
 }
 
@@ -413,6 +475,17 @@ CalibFile parse_calib(const std::string& yaml_text, const std::string& file) {
     c.has_temp_coef = c.has_temp_coef || s.has_temp;
     c.temp_coef_dps_per_degc[i] = s.temp.tc_dps_per_degc;
     c.temp_coef_sigma_dps_per_degc[i] = s.temp.tc_sigma_dps_per_degc;
+  }
+  // calibrated M hold the stops' true angles: a second set of stop errors would count them twice
+  if (doc.has_end_stops && !c.matrices_nominal)
+    ctx.fail(*root.find("end_stops"), "end_stops", "end_stops only with 'matrices: nominal' (a self-calibration): "
+                                                   "calibrated matrices hold the stop angles already");
+  c.has_end_stops = doc.has_end_stops;
+  for (std::size_t p = 0; p < 2; ++p) {
+    const StopPair& s = doc.end_stops.platform[p];
+    const Eigen::Index o = 2 * static_cast<Eigen::Index>(p);
+    c.end_stop_deg.segment<2>(o) << s.minus90_deg, s.plus90_deg;
+    c.end_stop_sigma_deg.segment<2>(o) << s.minus90_sigma_deg, s.plus90_sigma_deg;
   }
   with_location(file, 0, "", [&] { c.M.validate(); });
   return c;

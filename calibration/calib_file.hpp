@@ -57,14 +57,21 @@ struct CalibFile {
   bool has_temp_coef = false;
   std::array<Eigen::Vector3d, 2> temp_coef_dps_per_degc{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
   std::array<Eigen::Vector3d, 2> temp_coef_sigma_dps_per_degc{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  /// end-stop angle errors (end_stops.platformN, deg, actual - read rest angle about the hinge;
+  /// [platform 1 at -90, at +90, platform 2 at -90, at +90]) with their 1-sigma; a self-calibration
+  /// with end-stop states writes them (only with matrices_nominal)
+  bool has_end_stops = false;
+  Eigen::Vector4d end_stop_deg = Eigen::Vector4d::Zero();
+  Eigen::Vector4d end_stop_sigma_deg = Eigen::Vector4d::Zero();
   /// M as the twin should plant it: the file's M with E folded in, M (I + E)^-1 (M alone without E)
   est::CalibMatrices matrices_with_scale() const;
   /// what the estimator uses: M, G, E (each with its sigma) and the temperature coefficients
   est::Calibration to_filter_calibration() const;
 };
 
-/// What `driftless estimate --selfcal --calib-out` writes: the g-sensitivity, scale/misalignment
-/// and temperature coefficients the filter estimated, each with its 1-sigma; M stays nominal.
+/// What `driftless estimate --selfcal --calib-out` writes: the g-sensitivity, scale/misalignment,
+/// temperature coefficients and end-stop angle errors the filter estimated, each with its 1-sigma;
+/// M stays nominal.
 struct SelfCalibration {
   std::string source;  // "estimate --selfcal on FILE"
   double latitude_deg = driftless::kNaN;
@@ -80,6 +87,9 @@ struct SelfCalibration {
   std::array<Eigen::Vector3d, 2> temp_coef_dps_per_degc{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
   std::array<Eigen::Vector3d, 2> temp_coef_sigma_dps_per_degc{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
   std::array<double, 2> temp_ref_c{driftless::kNaN, driftless::kNaN};  // degC, of the final bias
+  bool stop_states = false;  // the end-stop angles below were states (docs/estimator.md section 1g)
+  Eigen::Vector4d end_stop_deg = Eigen::Vector4d::Zero();        // deg, [p1 -90, p1 +90, p2 -90, p2 +90]
+  Eigen::Vector4d end_stop_sigma_deg = Eigen::Vector4d::Zero();  // deg, 1-sigma
 };
 
 /// Writes a self-calibration as calib.yaml (same format; method selfcal, matrices nominal).

@@ -53,7 +53,7 @@ struct PriorEffects {
 struct PriorBox {
   Eigen::Vector3d hinge1_axis = Eigen::Vector3d::UnitZ();
   Eigen::Vector3d hinge2_axis = Eigen::Vector3d::UnitX();
-  bool has_stops = false;  // nominal matrices (a self-calibration) say nothing about the stops
+  bool has_stops = false;  // a rig's M, or a self-calibration's end_stops (nominal M alone say nothing)
   std::array<Eigen::Vector2d, 2> stop_error_deg{Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};
 };
 
@@ -157,13 +157,15 @@ std::string model_prior_yaml(const CalibFile& c) {
   PriorModel m;
   m.box.hinge1_axis = c.hinge1_axis;
   m.box.hinge2_axis = c.hinge2_axis;
-  m.box.has_stops = !c.matrices_nominal;
+  // a rig's M give the travel between the stops; a self-calibration gives the stops themselves
+  m.box.has_stops = !c.matrices_nominal || c.has_end_stops;
   // a self-calibration's E (nominal M) plants its scale factor, misalignment and mounting too
   const est::CalibMatrices M = c.matrices_with_scale();
   for (std::size_t i = 0; i < 2; ++i) {
     PriorEffects& e = m.effects[i];
     e.s = sensor_prior(M, static_cast<int>(i), i == 0 ? c.hinge1_axis : c.hinge2_axis);
-    m.box.stop_error_deg[i] = e.s.stop_error_deg;
+    m.box.stop_error_deg[i] = c.has_end_stops ? Eigen::Vector2d(c.end_stop_deg.segment<2>(2 * static_cast<Eigen::Index>(i)))
+                                              : e.s.stop_error_deg;
     e.matrices = !c.matrices_nominal || c.has_scale_misalign;
     e.has_g = c.has_g_sensitivity;
     e.G_dps_per_g = c.G_dps_per_g[i];

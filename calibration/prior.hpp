@@ -24,7 +24,7 @@ struct SensorPrior {
 SensorPrior sensor_prior(const est::CalibMatrices& m, int sensor, const Eigen::Vector3d& hinge_axis);
 
 /// The model-config YAML (a file holding only `model:`) that plants the calibrated errors:
-/// box hinge axes and stop errors, each sensor's scale_factor, misalignment and
+/// box hinge axes and stop errors (a self-calibration's end_stops as they are), each sensor's scale_factor, misalignment and
 /// mounting_misalignment with their run-to-run sigmas set to 0.
 std::string model_prior_yaml(const CalibFile& c);
 

@@ -8,6 +8,7 @@
 #include <fmt/core.h>
 
 #include "cli/command.hpp"
+#include "estimator/health.hpp"
 #include "estimator/log.hpp"
 #include "estimator/numbers.hpp"
 
@@ -34,6 +35,13 @@ std::string groups_text(std::uint32_t fields) {
 
 void print_findings(const log::LogReader& reader) {
   for (const auto& e : reader.events()) fmt::print("  event (line {}): {}\n", e.line, e.text);
+  const double stated_hz = reader.metadata().sample_rate_hz();
+  if (est::stamp_rate_off(stated_hz, reader.stamp_rate_median_hz(), reader.stamp_rate_mean_hz())) {
+    fmt::print("  warning: sample_rate_hz says {:g} Hz, but the stamps step {:.6g} s ({:.6g} Hz; {:.6g} Hz from their "
+               "mean interval): fix the sample_rate_hz line, or convert t to seconds\n",
+               stated_hz, 1.0 / reader.stamp_rate_median_hz(), reader.stamp_rate_median_hz(),
+               reader.stamp_rate_mean_hz());
+  }
   if (reader.gap_count() > 0) {
     const auto& g = reader.gaps();
     const auto largest = std::max_element(g.begin(), g.end(), [](const auto& a, const auto& b) {

@@ -1,12 +1,16 @@
 // driftless estimate: run the DriftLess filter over a measurement log and write the bias
 // estimates, corrected outputs, attitude drift and (for simulated logs) errors against truth.
 // Formats: docs/estimator.md.
+#include <chrono>
 #include <cmath>
+#include <cstdint>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <memory>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <fmt/core.h>
@@ -70,13 +74,37 @@ void write_selfcal_files(const EstimateArgs& a, const log::Metadata& meta, const
     sc.temp_coef_sigma_dps_per_degc[iu] = s.temp_coef_sigma_dps_per_degc.segment<3>(3 * i);
   }
   sc.temp_ref_c = s.temp_ref_c;
+  sc.stop_states = s.stop_states;
+  sc.end_stop_deg = s.stop_angle_deg;
+  sc.end_stop_sigma_deg = s.stop_angle_sigma_deg;
   calib::save_selfcal_calib(a.calib_out, sc);
-  fmt::print("  wrote {} (g-sensitivity{}{} with 1-sigma; M nominal)\n", a.calib_out,
-             sc.scale_states ? ", scale/misalignment" : "", sc.temp_states ? " and bias temperature coefficients" : "");
+  fmt::print("  wrote {} (g-sensitivity{}{}{} with 1-sigma; M nominal)\n", a.calib_out,
+             sc.scale_states ? ", scale/misalignment" : "", sc.stop_states ? ", end-stop angles" : "",
+             sc.temp_states ? " and bias temperature coefficients" : "");
   if (a.prior_out.empty()) return;
   io::write_file(a.prior_out, calib::model_prior_yaml(calib::load_calib(a.calib_out)));
   fmt::print("  wrote {} (model prior for the twin)\n", a.prior_out);
 }
+
+// For tests/cli/estimate_smooth_stop.sh: with DRIFTLESS_TEST_SMOOTH_HOLD=FILE the second pass, once
+// it has handed kHoldAfterRows rows to corrected.csv, creates FILE and waits (at most 120 s) for a
+// stop, so that a signal lands inside the pass at a known row on any machine load. Unset: nothing.
+class SmoothHold {
+ public:
+  static constexpr std::uint64_t kHoldAfterRows = 100;
+  SmoothHold() {
+    if (const char* p = std::getenv("DRIFTLESS_TEST_SMOOTH_HOLD")) path_ = p;
+  }
+  void after_row() {
+    if (path_.empty() || ++rows_ != kHoldAfterRows) return;
+    io::write_file(path_, std::to_string(rows_) + "\n");
+    for (int i = 0; i < 12000 && !stop_requested().load(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+
+ private:
+  std::string path_;
+  std::uint64_t rows_ = 0;
+};
 
 // --smooth: the backward pass over the updates, then the log again with the smoothed correction
 // into corrected.csv (docs/estimator.md section 6.3). Every row is marked locked when the forward
@@ -89,12 +117,14 @@ double write_smoothed(const EstimateArgs& a, const log::ReaderOptions& read_opt,
   log::LogReader again(a.log, read_opt);
   const bool locked = std::isfinite(s.locked_from_t_s);
   double last_t_s = kNaN;
+  SmoothHold hold;
   est::smoothed_outputs(
       cfg, est::box_geometry_from_metadata(again.metadata()),
       [&again](Sample& x) { return !stop_requested().load() && again.next(x); }, sm,
       [&](const Sample& x, const est::SampleOutput& o) {
         files.on_smoothed_sample(x, o, locked);
         last_t_s = x.t_s;
+        hold.after_row();
       });
   return last_t_s;
 }
@@ -145,9 +175,11 @@ int report_health(const EstimateArgs& a, const est::EstimatorConfig& cfg, const 
 // the console's attitude line: the drifts, or why they are withheld
 void print_attitude_line(const est::EstimateSummary& summary) {
   if (summary.attitude_available && std::isfinite(summary.attitude_withheld_from_s)) {
-    fmt::print("  attitude: compared from t = {:.1f} s, withheld from t = {:.1f} s (both platforms flipped at once; "
-               "see the warning)\n",
-               summary.attitude_start_s, summary.attitude_withheld_from_s);
+    fmt::print("  attitude: compared from t = {:.1f} s, withheld from t = {:.1f} s ({}; see the warning)\n",
+               summary.attitude_start_s, summary.attitude_withheld_from_s,
+               summary.attitude_withheld_why == est::AttitudeWithheld::kBothFlipping ? "both platforms flipped at once"
+               : summary.attitude_withheld_why == est::AttitudeWithheld::kTimeGap    ? "a time gap"
+                                                                                    : "no sensor gave the box rate");
   } else if (summary.attitude_available && !std::isfinite(summary.final_corrected.angle_deg) &&
              summary.reference.verdict != est::RefFitVerdict::kFits &&
              summary.reference.verdict != est::RefFitVerdict::kNotChecked) {
@@ -322,12 +354,13 @@ const bool registered = register_command(30, [](CLI::App& app) {
                   "end stop replace the hinge rotations) or from 'estimate --selfcal --calib-out'. Its G "
                   "(deg/s per g) and scale/misalignment E (fraction): with --selfcal the start value and "
                   "1-sigma of their states, else fixed corrections; the temperature states start at its "
-                  "coefficients (deg/s per degC); docs/calibration.md")
+                  "coefficients (deg/s per degC), the end-stop states at its end_stops (deg); docs/calibration.md")
       ->check(CLI::ExistingFile);
   auto* calib_out = cmd->add_option(
       "--calib-out", a->calib_out,
       "With --selfcal: write the estimated g-sensitivity (deg/s per g), scale/misalignment "
-      "(fraction) and bias temperature coefficients (deg/s per degC), each with its 1-sigma, as "
+      "(fraction), bias temperature coefficients (deg/s per degC) and end-stop angle errors (deg), "
+      "each with its 1-sigma, as "
       "calib.yaml for --calib on the next log of the same sensors (M stays nominal); docs/calibration.md");
   cmd->add_option("--prior-out", a->prior_out,
                   "With --calib-out: the same as a twin model-config file (a scenario's model: block; "

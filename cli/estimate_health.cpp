@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include "cli/estimate_health_flip.hpp"
 #include "estimator/log.hpp"
 #include "estimator/numbers.hpp"
 #include "report/json.hpp"
@@ -32,14 +33,39 @@ const char* cause_key(est::HealthCause c) {
     case est::HealthCause::kSignalChainLag: return "signal_chain_lag";
     case est::HealthCause::kSaturation: return "saturation";
     case est::HealthCause::kAttitudeWithheld: return "attitude_withheld";
+    case est::HealthCause::kAttitudeWithheldNoRate: return "attitude_withheld_no_rate";
+    case est::HealthCause::kAttitudeWithheldGap: return "attitude_withheld_gap";
+    case est::HealthCause::kGyroFlipAngle: return "gyro_flip_angle";
+    case est::HealthCause::kGyroGapPositions: return "gyro_gap_positions";
+    case est::HealthCause::kStampRate: return "stamp_rate";
+    case est::HealthCause::kParallelHinges: return "parallel_hinges";
+    case est::HealthCause::kNeverFlipped: return "never_flipped";
+    case est::HealthCause::kAngleJitter: return "angle_jitter";
+    case est::HealthCause::kPriorRejected: return "prior_rejected";
     case est::HealthCause::kDeadAxis: return "dead_axis";
     case est::HealthCause::kPaperRestAngles: return "paper_rest_angles";
     case est::HealthCause::kPaperSchedule: return "paper_schedule";
     case est::HealthCause::kLockLost: return "lock_lost";
     case est::HealthCause::kReferenceMismatch: return "reference_mismatch";
     case est::HealthCause::kBoxNotAtRest: return "box_not_at_rest";
+    default: if (is_flip_cause(c)) return flip_cause_key(c);
   }
   return "?";
+}
+
+// the stamps against sample_rate_hz: what they step at, and the likely unit mistake
+std::string stamp_rate_text(const est::HealthFinding& f) {
+  const double ratio = f.suggested / f.value;  // stated / stamps: 1000 for ms stamps read as s
+  const std::string unit = std::fabs(ratio / 1000.0 - 1.0) < 0.2  ? " (stamps in milliseconds?)"
+                           : std::fabs(ratio / 1e6 - 1.0) < 0.2   ? " (stamps in microseconds?)"
+                           : std::fabs(ratio * 1000.0 - 1.0) < 0.2 ? " (a rate in kHz, or stamps in ks?)"
+                                                                   : "";
+  return fmt::format("sample_rate_hz says {:g} Hz, but the stamps step {:.6g} s ({:.6g} Hz; {:.6g} Hz from their "
+                     "mean interval){}: standstill durations, the noise per sample and the gap threshold use the "
+                     "stated rate{}; fix the sample_rate_hz line, or convert t to seconds",
+                     f.suggested, 1.0 / f.value, f.value, f.sigma, unit,
+                     f.severity == est::HealthVerdict::kFailed ? ", so the results of this run are not the sensors'"
+                                                               : "");
 }
 
 // "(90, -90) and (-90, 90) deg" (plat1, plat2)
@@ -293,9 +319,77 @@ std::string describe_input(const est::HealthFinding& f) {
   return "?";
 }
 
+// the inputs' findings of stop 27: the attitude withheld, the gyro tracker's, the stamps, the
+// flip set-up, the angle columns' jitter, a rejected first update
+std::string describe_input_checks(const est::HealthFinding& f, const est::EstimatorConfig& cfg) {
+  switch (f.cause) {
+    case est::HealthCause::kAttitudeWithheldNoRate:
+      return fmt::format("attitude withheld from t = {:.2f} s: no platform rested with a known angle there and no "
+                         "moving one had its angle read, so no sensor gave the box rate (the biases are not "
+                         "affected); log plat1_deg and plat2_deg while the platforms move, or flip one at a time",
+                         f.value);
+    case est::HealthCause::kAttitudeWithheldGap:
+      return fmt::format("attitude withheld from t = {:.2f} s: the log has no rows for {:.3g} s there (a time gap), "
+                         "and how far the box turned in it is unknown; log without gaps, or compare the pieces "
+                         "between gaps as separate logs",
+                         f.value, f.sigma);
+    case est::HealthCause::kGyroFlipAngle:
+      return fmt::format("with 'standstill: gyro' the first flip turned {:.1f} deg ({} of {:g} flips were unlike "
+                         "the configured turn), but flip_angle_deg is {:g}, which makes a flip turn {:g} deg: the "
+                         "platforms rest at about +-{:.1f} deg, not +-{:g}, so their positions were snapped to the "
+                         "wrong stops{}; set flip_angle_deg to the rest angle (about {:.1f}) in the log header, and "
+                         "initial_plat1_deg/initial_plat2_deg to the start positions in the configuration",
+                         2.0 * f.value, f.count, f.suggested, f.sigma, 2.0 * f.sigma, f.value, f.sigma,
+                         f.severity == est::HealthVerdict::kFailed ? " and the updates used an H the box did not have"
+                                                                  : "",
+                         f.value);
+    case est::HealthCause::kStampRate:
+      return stamp_rate_text(f);
+    case est::HealthCause::kAngleJitter:
+      return fmt::format("no standstill was found: plat1_deg/plat2_deg move by small steps, up to {:.3g} deg between "
+                         "samples, in {:.0f} % of the rows, more than angle_tolerance_deg {:g} (an encoder's noise?), "
+                         "so the platforms never counted as resting; set angle_tolerance_deg: {:.2g} in the "
+                         "configuration, or standstill: gyro",
+                         f.value, 100.0 * f.suggested, f.sigma, 3.0 * f.value);
+    case est::HealthCause::kPriorRejected:
+      return fmt::format("the first update (t = {:.2f} s, NIS {:.3g}) was rejected: its residual, up to {:.3g} deg/s, "
+                         "lies outside the prior (initial_sigma_dps {:g}): the biases are larger than the "
+                         "configuration allows, not an outlier; that standstill was lost and the later ones brought "
+                         "the estimate in. Set initial_sigma_dps to at least {:.2g}",
+                         f.suggested, f.value, f.sigma, cfg.initial_sigma_dps, f.sigma);
+    case est::HealthCause::kParallelHinges:
+      return fmt::format("hinge1_axis and hinge2_axis are {:.1f} deg from parallel: the bias along the line both "
+                         "platforms turn about can never be observed, whatever the flips; the platforms must flip "
+                         "about different axes (the paper: orthogonal), or check the hinge axes in the log header",
+                         f.value);
+    case est::HealthCause::kNeverFlipped:
+      return fmt::format("the platforms never moved: all {} standstill(s) were at {}, which measure only "
+                         "R1 b1 - R2 b2 (3 of the 6 bias directions); flip each platform (eq. (5): (+,+) (+,-) "
+                         "(-,-) (-,+)), or check plat1_deg/plat2_deg",
+                         f.count, position_text(f.positions_deg));
+    case est::HealthCause::kGyroGapPositions:
+      if (std::isnan(f.suggested)) {
+        return fmt::format("with 'standstill: gyro' a time gap of {:.3g} s from t = {:.2f} s may have hidden a flip, "
+                           "and the platform positions after it could not be recovered: the box never turned enough "
+                           "at rest to tell the four position pairs apart, so no standstill was used from there on "
+                           "(the biases are those from before the gap); log without gaps, or log the platform "
+                           "angles (plat1_deg, plat2_deg)",
+                           f.sigma, f.value);
+      }
+      return fmt::format("with 'standstill: gyro' a time gap of {:.3g} s from t = {:.2f} s hid the platforms; their "
+                         "positions were recovered at t = {:.2f} s from the one position pair that fits both sensors "
+                         "on the turning box{}",
+                         f.sigma, f.value, f.suggested,
+                         f.count > 0 ? ": a flip was lost in the gap" : " (no flip was lost in it)");
+    default: break;
+  }
+  return "?";
+}
+
 }  // namespace
 
 std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cfg) {
+  if (is_flip_cause(f.cause)) return describe_flip(f, cfg);
   switch (f.cause) {
     case est::HealthCause::kNoUpdate:
     case est::HealthCause::kAllRejected:
@@ -318,10 +412,21 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
     case est::HealthCause::kDeadAxis:
     case est::HealthCause::kAttitudeWithheld:
       return describe_input(f);
+    case est::HealthCause::kAttitudeWithheldNoRate:
+    case est::HealthCause::kAttitudeWithheldGap:
+    case est::HealthCause::kGyroFlipAngle:
+    case est::HealthCause::kStampRate:
+    case est::HealthCause::kAngleJitter:
+    case est::HealthCause::kPriorRejected:
+    case est::HealthCause::kParallelHinges:
+    case est::HealthCause::kNeverFlipped:
+    case est::HealthCause::kGyroGapPositions:
+      return describe_input_checks(f, cfg);
     case est::HealthCause::kReferenceMismatch:
       return describe_reference(f);
     case est::HealthCause::kBoxNotAtRest:
       return describe_box_motion(f);
+    default: break;  // the flip-turn check's causes: describe_flip() above
   }
   return "?";
 }

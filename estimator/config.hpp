@@ -62,6 +62,13 @@ struct Calibration {
   bool has_scale_misalign = false;
   std::array<Eigen::Matrix3d, 2> E_frac{Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero()};
   std::array<Eigen::Matrix3d, 2> E_sigma_frac{Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero()};
+  /// end-stop angle errors (deg, actual - read rest angle about the hinge; [platform 1 at -, at +,
+  /// platform 2 at -, at +] like kStopAngle) and their 1-sigma, from a self-calibration's calib.yaml:
+  /// the end-stop states (when on) start here instead of at 0 +- flip_angle_sigma_deg; without them
+  /// each sensor's M turns to the stop's angle, Rot(a, plat + d)
+  bool has_end_stops = false;
+  Eigen::Vector4d end_stop_deg = Eigen::Vector4d::Zero();
+  Eigen::Vector4d end_stop_sigma_deg = Eigen::Vector4d::Zero();
   bool empty() const { return sensor1.empty() && sensor2.empty(); }
   bool has_g_sensitivity() const { return !G_dps_per_g[0].isZero(0.0) || !G_dps_per_g[1].isZero(0.0); }
   /// Throws std::invalid_argument when a matrix is singular or not finite.
@@ -91,8 +98,11 @@ struct EstimatorConfig {
   double noise_density_dps_rthz = 0.005;   // deg/s/sqrt(Hz), MPU6050 data sheet (paper sec. 4)
   bool noise_from_log = false;             // set by --tune auto (apply_tune): the density was measured
   // Q: the bias wanders like a random walk that reaches the bias-instability level B at tau_B:
-  // K = 0.664 B sqrt(3 / tau_B), Q = K^2 dt per axis
-  double bias_instability_dps = 0.01;      // deg/s (36 deg/h)
+  // K = 0.664 B sqrt(3 / tau_B), Q = K^2 dt per axis. The default B is the MPU6050's wander as the
+  // twin's preset draws it (a Gauss-Markov of 0.1 deg/s over 3 h, driven at 2 sigma^2 / tau =
+  // 1.85e-6 (deg/s)^2/s): K^2 = 1.85e-6 at tau_B = 100 s. With the windowed update (docs/estimator.md
+  // section 1h) it puts NIS and NEES at 1 on Fig. 4, Fig. 9 and the demo (docs/results.md, the q decision)
+  double bias_instability_dps = 0.01183;   // deg/s (42.6 deg/h)
   double bias_instability_tau_s = 100.0;   // s, where the Allan minimum lies (paper: ~100 s)
   double q_override_dps2_per_s = 0.0;      // (deg/s)^2/s, > 0 replaces the spec-derived Q rate
   double r_override_dps2 = 0.0;            // (deg/s)^2 per sample and axis, > 0 replaces R

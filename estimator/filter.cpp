@@ -48,6 +48,12 @@ void Calibration::validate() const {
     if (!(E_frac[iu].cwiseAbs().maxCoeff() < 0.5))
       throw std::invalid_argument(who + " has a scale/misalignment element of 0.5 (50 %) or more: not a small error");
   }
+  // an end stop is off by hundredths of a degree; +-10 deg is the twin's limit too (model.box)
+  if (has_end_stops && (!end_stop_deg.allFinite() || !end_stop_sigma_deg.allFinite() ||
+                        (end_stop_sigma_deg.array() < 0.0).any() || (end_stop_deg.array().abs() > 10.0).any()))
+    throw std::invalid_argument("calibration: an end-stop angle error beyond +-10 deg, not finite, or a negative sigma (deg)");
+  if (has_end_stops && !empty())
+    throw std::invalid_argument("calibration: end-stop angle errors with calibrated matrices, which hold the stop angles already");
   auto check = [&](const std::vector<CalibratedPosition>& list, int sensor) {
     for (const auto& p : list) {
       if (!finite(p.plat_deg) || !p.M_body_from_sensor.allFinite()) {
@@ -226,6 +232,12 @@ void DriftlessFilter::use_calibration_prior() {
     fixed_E_inv_[iu] = fixed_e_ ? Eigen::Matrix3d((Eigen::Matrix3d::Identity() + cal.E_frac[iu]).inverse())
                                 : Eigen::Matrix3d::Identity();
   }
+  // the end stops: the states start at the file's angles with its sigma, else M turns to them
+  fixed_stops_ = cal.has_end_stops && !has_stop_states();
+  if (has_stop_states() && cal.has_end_stops) {
+    x_.segment<4>(kStopAngle.start) = cal.end_stop_deg;
+    P_.diagonal().segment<4>(kStopAngle.start) = cal.end_stop_sigma_deg.cwiseAbs2();
+  }
 }
 
 void DriftlessFilter::on_source_switch(const BoxGeometry* box) {
@@ -251,7 +263,9 @@ Eigen::Matrix3d DriftlessFilter::body_from_sensor(int sensor, double plat_deg) c
   const std::size_t i = sensor == 1 ? 0 : 1;
   if (cache_deg_[i] == plat_deg) return cache_M_[i];
   const auto& list = sensor == 1 ? cfg_.calibration.sensor1 : cfg_.calibration.sensor2;
-  Eigen::Matrix3d M = geo::rot_about_axis_deg(sensor == 1 ? box_.hinge1_axis : box_.hinge2_axis, plat_deg);
+  // fixed end-stop errors from --calib (no end-stop states): the sensor rests at plat + d
+  const double d_deg = fixed_stops_ ? cfg_.calibration.end_stop_deg[stop_index(sensor, plat_deg) - kStopAngle.start] : 0.0;
+  Eigen::Matrix3d M = geo::rot_about_axis_deg(sensor == 1 ? box_.hinge1_axis : box_.hinge2_axis, plat_deg + d_deg);
   double best = cfg_.calibration.match_tolerance_deg;
   for (const auto& p : list) {
     const double d = std::fabs(p.plat_deg - plat_deg);
@@ -364,12 +378,35 @@ Vector6d DriftlessFilter::correction_sigma_dps() const {
   return (J * P_ * J.transpose()).diagonal().cwiseSqrt();
 }
 
+// a window [t_first, t_last] averaged by a measurement made at t_update >= t_last: the mean is
+// b(t_update) - u with u = (1/T) int (b(t_update) - b(t)) dt, so Var(u) = q (T/3 + g) and
+// Cov(u, J) = q (T/2 + g) with g = t_update - t_last and J the walk since t_first, which the
+// prior's error holds: no update inside the window observed the residual's directions (a box
+// dwell inside a standstill measures the sum of the two sensors' rates, the standstill their
+// difference; section 1h)
+DriftlessFilter::WindowWander DriftlessFilter::window_wander(double t_first_s, double t_last_s, double t_update_s) {
+  const double T = t_last_s - t_first_s;
+  if (!(T > 0.0)) return {};
+  const double g = finite(t_update_s) ? std::max(0.0, t_update_s - t_last_s) : 0.0;
+  return {0.5 * T + g, T / 3.0 + g};
+}
+
 template <int D>
 bool DriftlessFilter::update(const Eigen::Matrix<double, D, 1>& r, const Eigen::Matrix<double, D, kFullStateDim>& H,
-                             const Eigen::Matrix<double, D, D>& R, UpdateRecord& rec, bool may_relock) {
-  // P here is P_k + Q_k (predict_to ran); the recursion of section 2, S^-1 through a Cholesky solve
-  const Eigen::Matrix<double, kFullStateDim, D> PHt = P_ * H.transpose();
-  const Eigen::Matrix<double, D, D> S = R + H * PHt;
+                             const Eigen::Matrix<double, D, D>& R, UpdateRecord& rec, bool may_relock,
+                             WindowWander wander) {
+  // P here is P_k + Q_k (predict_to ran); the recursion of section 2, S^-1 through a Cholesky solve.
+  // A window average (section 1h): the noise -H_b u is correlated with the prior's error,
+  // C = Cov(e, n) = -q c H_b^T, so P H^T + C replaces P H^T and S = H P H^T + H C + C^T H^T + R
+  // + q v H_b H_b^T; the gain and both covariance forms below take them as they are
+  Eigen::Matrix<double, kFullStateDim, D> PHt = P_ * H.transpose();
+  Eigen::Matrix<double, D, D> S = R;
+  if (wander.c_s > 0.0 || wander.v_s > 0.0) {
+    const Eigen::Matrix<double, D, kStateDim> Hb = H.template leftCols<kStateDim>();
+    PHt.template topRows<kStateDim>() -= (q_rate_dps2_per_s_ * wander.c_s) * Hb.transpose();
+    S += (q_rate_dps2_per_s_ * (wander.v_s - wander.c_s)) * Hb * Hb.transpose();  // + C^T H^T here, H C below
+  }
+  S += H * PHt;
   Eigen::LLT<Eigen::Matrix<double, D, D>> llt(S);
   const Eigen::Matrix<double, D, 1> innov = r - H * x_;
   rec.dim = D;
@@ -397,7 +434,7 @@ bool DriftlessFilter::update(const Eigen::Matrix<double, D, 1>& r, const Eigen::
     // one try on the widened P: the part of the innovation outside H's range (a rank-deficient
     // stacked H, a residual the model cannot explain) does not shrink with P, so a second re-lock
     // from here would recurse without end
-    return update<D>(r, H, R, rec, /*may_relock=*/false);
+    return update<D>(r, H, R, rec, /*may_relock=*/false, wander);
   }
   consecutive_rejections_ = 0;
   // an offline smoother keeps the state before the gain (the prediction) and after it
@@ -412,7 +449,8 @@ bool DriftlessFilter::update(const Eigen::Matrix<double, D, 1>& r, const Eigen::
     const StateMatrix WHP = W * PHt.transpose();
     P_ += W * S * W.transpose() - WHP - WHP.transpose();
   } else {
-    P_ = (StateMatrix::Identity() - W * H) * P_;  // as printed
+    if (wander.c_s > 0.0) P_ -= W * PHt.transpose();  // (I - W H) P - W C^T
+    else P_ = (StateMatrix::Identity() - W * H) * P_;  // as printed
   }
   P_ = (0.5 * (P_ + P_.transpose())).eval();  // eval: no aliasing with the transpose
   for (int i = 0; i < kStateDim; ++i) P_(i, i) = std::max(P_(i, i), cfg_.variance_floor_dps2);
@@ -477,12 +515,16 @@ int DriftlessFilter::use_segment(const StandstillSegment& s) {
   rec.plat1_deg = p1;
   rec.plat2_deg = p2;
   rec.at_end = s.end == SegmentEnd::kFinish;
-  // the average measures the bias at the standstill's midpoint: update there, then carry P on.
-  // Its temperature part is k (mean T - reference T) exactly (linear in T): the state moves to
-  // the standstill's mean temperatures and stays referred to them after the update
-  const double t_mid = 0.5 * (s.t_first_s + s.t_last_s);
+  // general mode: the average measures the bias's mean over the standstill; the update is made at
+  // its end with the window's wander and its correlation with P (section 1h). Paper mode, as
+  // printed: at the midpoint, with the wander about it (q T / 12) in R. The temperature part is
+  // k (mean T - reference T) exactly (linear in T): the state moves to the standstill's mean
+  // temperatures and stays referred to them after the update
+  const bool windowed = cfg_.mode == FilterMode::kGeneral;
+  const double t_upd = windowed ? s.t_last_s : 0.5 * (s.t_first_s + s.t_last_s);
   if (s.n_temp > 0) predict_temperature(s.sum_temp1_c / double(s.n_temp), s.sum_temp2_c / double(s.n_temp));
-  predict_to(std::max(t_mid, finite(t_filter_s_) ? t_filter_s_ : t_mid));
+  predict_to(std::max(t_upd, finite(t_filter_s_) ? t_filter_s_ : t_upd));
+  const WindowWander wander = windowed ? window_wander(s.t_first_s, s.t_last_s, t_filter_s_) : WindowWander{};
   int result = 0;
   Eigen::Matrix<double, 1, kFullStateDim> h;
   double z = 0.0, var_z = 0.0;
@@ -495,11 +537,11 @@ int DriftlessFilter::use_segment(const StandstillSegment& s) {
     Eigen::Matrix<double, 4, 4> R4 = Eigen::Matrix<double, 4, 4>::Zero();
     R4.topLeftCorner<3, 3>() = cur.R;
     R4(3, 3) = var_z;
-    const bool ok = update<4>(r4, H4, R4, rec);
+    const bool ok = update<4>(r4, H4, R4, rec, true, wander);
     emit_update(rec, ok);
     result = ok ? 1 : -1;
   } else if (cfg_.mode == FilterMode::kGeneral) {
-    const bool ok = update<3>(cur.r, cur.H, cur.R, rec);
+    const bool ok = update<3>(cur.r, cur.H, cur.R, rec, true, wander);
     emit_update(rec, ok);
     result = ok ? 1 : -1;
   } else if (prev_res_.valid && ((prev_res_.pattern + 1) % 4) == pattern) {
@@ -538,9 +580,11 @@ void DriftlessFilter::residual_rows(const StandstillSegment& s, const Eigen::Mat
     cur.H.block<3, 9>(0, kGSens1.start) = gsens_jacobian(M1, last_f_g_[0]);
     cur.H.block<3, 9>(0, kGSens2.start) = -gsens_jacobian(M2, last_f_g_[1]);
   }
-  // eq. (2)'s noise R1 n1 - R2 n2, averaged over n samples; the bias random walk adds q T / 12
-  // (its mean over the standstill scatters about its value at the midpoint)
-  const double var = cfg_.sample_variance_dps2(rate_hz) / double(s.n) + q_rate_dps2_per_s_ * s.span_s() / 12.0;
+  // eq. (2)'s noise R1 n1 - R2 n2, averaged over n samples; in paper mode the bias random walk adds
+  // q T / 12 (its mean over the standstill scatters about its value at the midpoint; general mode
+  // carries that wander in the update itself, section 1h)
+  const double wander = cfg_.mode == FilterMode::kPaper ? q_rate_dps2_per_s_ * s.span_s() / 12.0 : 0.0;
+  const double var = cfg_.sample_variance_dps2(rate_hz) / double(s.n) + wander;
   cur.R = var * (M1 * M1.transpose() + M2 * M2.transpose());
   // the end-stop rows need the box rate, so the bias, known first (as for the flips and dwells): a
   // rate from a bias not yet known would pass its error into the end-stop states; until then the
@@ -685,6 +729,22 @@ void DriftlessFilter::fuse_rate(const Sample& s, const StandstillStep& st) {
     raw += M2 * s.gyro2_dps;
     fixed += M2 * (s.gyro2_dps - fixed_bias_.segment<3>(kBias2.start));
     ++n;
+  }
+  // no platform rests (both flip at once): a moving sensor whose angle and hinge rate the platform
+  // columns give reads M(theta) y = w + theta' a, so w = M(theta) y - theta' a (a turned by M stays a)
+  const auto moving = [&](int i, double deg, double rate_dps, const Eigen::Vector3d& yc, const Eigen::Vector3d& y) {
+    if (!finite(deg) || !finite(rate_dps)) return;
+    const Eigen::Matrix3d M = body_from_sensor(i, deg);
+    const Eigen::Vector3d hinge = rate_dps * (i == 1 ? box_.hinge1_axis : box_.hinge2_axis).normalized();
+    const Eigen::Vector3d& fb = i == 1 ? fixed_bias_.segment<3>(kBias1.start) : fixed_bias_.segment<3>(kBias2.start);
+    sum += M * yc - hinge;
+    raw += M * y - hinge;
+    fixed += M * (y - fb) - hinge;
+    ++n;
+  };
+  if (n == 0) {
+    moving(1, st.plat1_deg, st.plat1_rate_dps, out_.y1c_dps, s.gyro1_dps);
+    moving(2, st.plat2_deg, st.plat2_rate_dps, out_.y2c_dps, s.gyro2_dps);
   }
   out_.sensors_fused = n;
   if (n > 0) {
@@ -843,16 +903,17 @@ void DriftlessFilter::use_box_dwell(const StandstillSegment& seg) {
   // a dwell's noise, and a rate taken from a bias not yet known would pass its error into E
   last_w_dps_ = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
   if (seg.n_temp > 0) predict_temperature(seg.sum_temp1_c / double(seg.n_temp), seg.sum_temp2_c / double(seg.n_temp));
-  const double t_mid = 0.5 * (seg.t_first_s + seg.t_last_s);
-  predict_to(std::max(t_mid, finite(t_filter_s_) ? t_filter_s_ : t_mid));
+  // updated at the dwell's end with its window's wander, as the standstills (section 1h)
+  predict_to(std::max(seg.t_last_s, finite(t_filter_s_) ? t_filter_s_ : seg.t_last_s));
+  const WindowWander wander = window_wander(seg.t_first_s, seg.t_last_s, t_filter_s_);
   // one axis of eq. (2)'s R for this segment (rotations: M1 M1^T + M2 M2^T = 2 I), as rest_row expects
   const double rate_hz = double(seg.n - 1) / seg.span_s();
-  const double var_r = 2.0 * (cfg_.sample_variance_dps2(rate_hz) / double(seg.n) + q_rate_dps2_per_s_ * seg.span_s() / 12.0);
+  const double var_r = 2.0 * cfg_.sample_variance_dps2(rate_hz) / double(seg.n);
   Eigen::Matrix<double, 1, kFullStateDim> h;
   Eigen::Matrix<double, 1, 1> z, var_z;
   if (!rest_row(seg, M1, M2, var_r, h, z(0), var_z(0))) return;
   UpdateRecord rec;  // not emitted: the platform updates' record and counts stay theirs
-  const bool ok = update<1>(z, h, var_z, rec, false);
+  const bool ok = update<1>(z, h, var_z, rec, false, wander);
   ++counters_.box_dwell_updates;
   if (!ok) ++counters_.box_dwell_rejected;
   predict_to(std::max(seg.t_last_s, t_filter_s_));
@@ -928,12 +989,12 @@ void DriftlessFilter::use_flip() {
 }
 
 template bool DriftlessFilter::update<1>(const Eigen::Matrix<double, 1, 1>&, const Eigen::Matrix<double, 1, kFullStateDim>&,
-                                         const Eigen::Matrix<double, 1, 1>&, UpdateRecord&, bool);
+                                         const Eigen::Matrix<double, 1, 1>&, UpdateRecord&, bool, WindowWander);
 template bool DriftlessFilter::update<3>(const Eigen::Matrix<double, 3, 1>&, const Eigen::Matrix<double, 3, kFullStateDim>&,
-                                         const Eigen::Matrix<double, 3, 3>&, UpdateRecord&, bool);
+                                         const Eigen::Matrix<double, 3, 3>&, UpdateRecord&, bool, WindowWander);
 template bool DriftlessFilter::update<4>(const Eigen::Matrix<double, 4, 1>&, const Eigen::Matrix<double, 4, kFullStateDim>&,
-                                         const Eigen::Matrix<double, 4, 4>&, UpdateRecord&, bool);
+                                         const Eigen::Matrix<double, 4, 4>&, UpdateRecord&, bool, WindowWander);
 template bool DriftlessFilter::update<6>(const Eigen::Matrix<double, 6, 1>&, const Eigen::Matrix<double, 6, kFullStateDim>&,
-                                         const Eigen::Matrix<double, 6, 6>&, UpdateRecord&, bool);
+                                         const Eigen::Matrix<double, 6, 6>&, UpdateRecord&, bool, WindowWander);
 
 }  // namespace driftless::est

@@ -248,6 +248,8 @@ class DriftlessFilter {
   /// Corrected outputs and fused body rate of the sample last pushed.
   const SampleOutput& output() const { return out_; }
   const FilterCounters& counters() const { return counters_; }
+  /// The standstill detector (its gyro flip tracker, the angle columns' jitter).
+  const StandstillDetector& standstill() const { return standstill_; }
   const EstimatorConfig& config() const { return cfg_; }
   const BoxGeometry& geometry() const { return box_; }
 
@@ -274,9 +276,18 @@ class DriftlessFilter {
   void predict_to(double t_s);
   void predict_temperature(double temp1_c, double temp2_c);
   Vector6d bias_at(const Sample& s, const StateVector& x, const std::array<double, 2>& temp_ref) const;
+  // the random walk over an averaging window, the update made at or after its end (docs/estimator.md
+  // section 1h): the window mean is b(t) - u; Cov(u, J) = q c_s and Var(u) = q v_s, J the walk the
+  // prior's error holds; zero for a point measurement (flips, paper mode)
+  struct WindowWander {
+    double c_s = 0.0;
+    double v_s = 0.0;
+  };
+  static WindowWander window_wander(double t_first_s, double t_last_s, double t_update_s);
   template <int D>
   bool update(const Eigen::Matrix<double, D, 1>& r, const Eigen::Matrix<double, D, kFullStateDim>& H,
-              const Eigen::Matrix<double, D, D>& R, UpdateRecord& rec, bool may_relock = true);
+              const Eigen::Matrix<double, D, D>& R, UpdateRecord& rec, bool may_relock = true,
+              WindowWander wander = {});
   void emit_update(const UpdateRecord& rec, bool accepted);
   void check_paper_position(double plat1_deg, double plat2_deg, int pattern);
   void fuse_rate(const Sample& s, const StandstillStep& st);
@@ -300,7 +311,7 @@ class DriftlessFilter {
   BoxGeometry box_;
   double q_rate_dps2_per_s_ = 0.0;
   // --calib terms without states of their own: fixed corrections (use_calibration_prior)
-  bool fixed_g_ = false, fixed_e_ = false;
+  bool fixed_g_ = false, fixed_e_ = false, fixed_stops_ = false;
   UpdateObserver* observer_ = nullptr;
   const StateVector* output_x_ = nullptr;
   const std::array<double, 2>* output_temp_ref_ = nullptr;

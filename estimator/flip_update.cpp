@@ -134,7 +134,7 @@ FlipRows flip_rows(const FlipWindow& w, const FlipModel& m) {
   // the middle of each sample's interval)
   double delta_deg = 0.0, span_s = 0.0, sum_dt2 = 0.0, prev_step_deg = 0.0, jump_deg = 0.0;
   Eigen::Matrix3d S_b = Eigen::Matrix3d::Zero();
-  Eigen::Vector3d F_m = Eigen::Vector3d::Zero(), W_c = Eigen::Vector3d::Zero();
+  Eigen::Vector3d F_m = Eigen::Vector3d::Zero(), W_c = Eigen::Vector3d::Zero(), W_s = Eigen::Vector3d::Zero();
   for (const FlipSample& k : buf) {
     const Eigen::Vector3d um = corrected(m.moving, ym(k), fm(k), use_g), us = corrected(m.rest, ys(k), fs(k), use_g);
     const double step_deg = (a.dot(um) - a.dot(C0 * us)) * k.dt_s;
@@ -149,14 +149,17 @@ FlipRows flip_rows(const FlipWindow& w, const FlipModel& m) {
       out.H_G_rest -= matrix_error_jacobian(C, fs(k)) * k.dt_s;
     }
     W_c += C * us * k.dt_s;
+    // the part of the stops' difference d_end - d_start the platform has turned through so far
+    // (the profile's progress): it turns the moving frame as d_start does, but grows over the flip
+    W_s += (delta_deg - 0.5 * step_deg) / turn_deg * (C * us) * k.dt_s;
     out.H_stop_rest += kRadPerDeg * (C * a_s.cross(us)) * k.dt_s;
     out.H_E_rest -= matrix_error_jacobian(C, us) * k.dt_s;
     span_s += k.dt_s;
     sum_dt2 += k.dt_s * k.dt_s;
   }
   out.z_deg -= dtheta_deg * a;
-  out.H_stop_end = a;
-  out.H_stop_start = -a - kRadPerDeg * a.cross(W_c);
+  out.H_stop_end = a - kRadPerDeg * a.cross(W_s);
+  out.H_stop_start = -a - kRadPerDeg * a.cross(W_c - W_s);
   out.H_b_moving = span_s * Eigen::Matrix3d::Identity();
   out.H_b_rest = -S_b;
   if (use_g) out.H_G_moving = matrix_error_jacobian(Eigen::Matrix3d::Identity(), F_m);

@@ -76,6 +76,101 @@ void add_saturation_findings(HealthReport& h, const std::vector<ClippedChannel>&
   put_first(h, std::move(first));
 }
 
+namespace {
+
+HealthCause flip_cause(FlipTurn k) {
+  switch (k) {
+    case FlipTurn::kGyroRadPerS: return HealthCause::kFlipGyroUnit;
+    case FlipTurn::kAngleRadians: return HealthCause::kFlipAngleUnit;
+    case FlipTurn::kTimeMs:
+    case FlipTurn::kTimeUs: return HealthCause::kFlipTimeUnit;
+    case FlipTurn::kStuck: return HealthCause::kFlipNotSeen;
+    case FlipTurn::kSign: return HealthCause::kFlipAngleSign;
+    case FlipTurn::kWrapped: return HealthCause::kFlipWrapped;
+    case FlipTurn::kSwapped: return HealthCause::kFlipSensorsSwapped;
+    case FlipTurn::kAxis: return HealthCause::kFlipAxis;
+    case FlipTurn::kAgrees:
+    case FlipTurn::kOther: break;
+  }
+  return HealthCause::kFlipTurnRatio;
+}
+
+// one finding for the flips of `kind` on the platforms that had any (a unit error shows on both)
+void add_flip_kind(HealthReport& first, const FlipCheckResult& r, FlipTurn kind, const std::vector<int>& platforms,
+                   HealthVerdict severity) {
+  HealthFinding f;
+  f.cause = flip_cause(kind);
+  f.severity = severity;
+  f.sigma = kNaN;
+  const int k = static_cast<int>(kind);
+  std::uint64_t most = 0;
+  for (int p : platforms) {
+    const PlatformFlipSummary& s = r.platform[static_cast<std::size_t>(p - 1)];
+    if (s.count[k] == 0) continue;
+    f.components.push_back(p);
+    f.count += s.count[k];
+    f.suggested = (std::isnan(f.suggested) ? 0.0 : f.suggested) + double(s.flips);
+    if (!(f.sigma <= s.first_t_s[k])) f.sigma = s.first_t_s[k];
+    if (s.count[k] > most) {  // the ratio of the platform with most such flips
+      most = s.count[k];
+      f.value = s.median_ratio[k];
+      for (int i = 0; i < 3; ++i) {
+        f.measured_axis[static_cast<std::size_t>(i)] = s.axis_sensor[i];
+        f.header_axis[static_cast<std::size_t>(i)] = s.hinge_sensor[i];
+      }
+    }
+  }
+  if (f.count > 0) add(first, std::move(f));
+}
+
+}  // namespace
+
+void add_flip_check_findings(HealthReport& h, const FlipCheckResult& r, const EstimatorConfig& cfg) {
+  if (r.flips == 0) return;
+  HealthReport first;
+  // a wrong unit or convention makes every number wrong: failed when most flips disagree
+  const HealthVerdict bad = 2 * r.disagree > r.flips ? HealthVerdict::kFailed : HealthVerdict::kDegraded;
+  const bool flip_updates = cfg.self_calibration && cfg.flip_updates;
+  const HealthVerdict selfcal = flip_updates ? HealthVerdict::kDegraded : HealthVerdict::kOk;
+  for (FlipTurn k : {FlipTurn::kGyroRadPerS, FlipTurn::kAngleRadians, FlipTurn::kTimeMs, FlipTurn::kTimeUs}) {
+    add_flip_kind(first, r, k, {1, 2}, bad);
+  }
+  const bool unit_error = !first.findings.empty();
+  // by kind, then platform: a stuck platform's wrong angle also spoils the resting frame in the
+  // other platform's flips (the box's rate leaks into their turn: kOther), so the causes go first
+  for (FlipTurn k : {FlipTurn::kSwapped, FlipTurn::kStuck, FlipTurn::kSign, FlipTurn::kAxis, FlipTurn::kOther}) {
+    for (int p = 1; p <= 2; ++p) add_flip_kind(first, r, k, {p}, bad);
+  }
+  for (int p = 1; p <= 2; ++p) {
+    add_flip_kind(first, r, FlipTurn::kWrapped, {p}, selfcal);
+    // a scale error along the hinge beyond 3 sigma of its prior: the flip gate rejects its flips
+    const PlatformFlipSummary& s = r.platform[static_cast<std::size_t>(p - 1)];
+    const double ratio = s.median_ratio[static_cast<int>(FlipTurn::kAgrees)];
+    if (!unit_error && s.of(FlipTurn::kAgrees) >= 2 && std::fabs(ratio - 1.0) > 3.0 * cfg.scale_misalign_sigma_frac) {
+      HealthFinding f;
+      f.cause = HealthCause::kFlipScale;
+      f.severity = selfcal;
+      f.value = ratio;
+      f.components = {p};
+      f.count = s.of(FlipTurn::kAgrees);
+      f.suggested = double(s.flips);
+      add(first, std::move(f));
+    }
+  }
+  // flips longer than flip_max_s never become flip updates
+  const std::uint64_t slow = r.platform[0].slower_than_max + r.platform[1].slower_than_max;
+  if (flip_updates && !unit_error && slow > 0) {
+    HealthFinding f;
+    f.cause = HealthCause::kFlipsTooSlow;
+    f.severity = 2 * slow >= r.flips ? HealthVerdict::kDegraded : HealthVerdict::kOk;
+    f.value = std::max(r.platform[0].longest_s, r.platform[1].longest_s);
+    f.count = slow;
+    f.suggested = double(r.flips);
+    add(first, std::move(f));
+  }
+  put_first(h, std::move(first));
+}
+
 void add_dead_axis_findings(HealthReport& h, const std::vector<DeadChannel>& dead) {
   if (dead.empty()) return;
   HealthReport first;
@@ -93,13 +188,108 @@ void add_dead_axis_findings(HealthReport& h, const std::vector<DeadChannel>& dea
   h.verdict = HealthVerdict::kFailed;
 }
 
-void add_attitude_withheld_finding(HealthReport& h, double t_s, std::uint64_t flips) {
-  if (!std::isfinite(t_s)) return;
+void add_attitude_withheld_finding(HealthReport& h, AttitudeWithheld why, double t_s, double detail) {
+  if (why == AttitudeWithheld::kNo || !std::isfinite(t_s)) return;
   HealthFinding f;
-  f.cause = HealthCause::kAttitudeWithheld;
+  f.cause = why == AttitudeWithheld::kBothFlipping ? HealthCause::kAttitudeWithheld
+            : why == AttitudeWithheld::kTimeGap    ? HealthCause::kAttitudeWithheldGap
+                                                   : HealthCause::kAttitudeWithheldNoRate;
   f.value = t_s;
-  f.suggested = double(flips);
+  if (why == AttitudeWithheld::kBothFlipping) f.suggested = detail;
+  if (why == AttitudeWithheld::kTimeGap) f.sigma = detail;
   add(h, std::move(f));
+}
+
+void add_flip_setup_findings(HealthReport& h, const BoxGeometry& box,
+                             const std::vector<std::array<double, 2>>& positions_deg, std::uint64_t updates) {
+  HealthReport first;
+  const double sin_apart = box.hinge1_axis.normalized().cross(box.hinge2_axis.normalized()).norm();
+  if (sin_apart < std::sin(kParallelHingesDeg * kRadPerDeg)) {
+    HealthFinding f;
+    f.cause = HealthCause::kParallelHinges;
+    f.severity = HealthVerdict::kFailed;
+    f.value = std::asin(std::min(1.0, sin_apart)) * kDegPerRad;
+    add(first, std::move(f));
+  }
+  if (updates > 0 && positions_deg.size() == 1) {
+    HealthFinding f;
+    f.cause = HealthCause::kNeverFlipped;
+    f.severity = HealthVerdict::kFailed;
+    f.positions_deg = positions_deg;
+    f.count = updates;
+    add(first, std::move(f));
+  }
+  put_first(h, std::move(first));
+}
+
+void add_angle_jitter_finding(HealthReport& h, const StandstillDetector::AngleJitter& j, double tolerance_deg) {
+  if (j.samples == 0 || 2 * j.jittery <= j.samples) return;
+  HealthFinding f;
+  f.cause = HealthCause::kAngleJitter;
+  f.severity = HealthVerdict::kFailed;
+  f.value = j.max_change_deg;
+  f.sigma = tolerance_deg;
+  f.suggested = double(j.jittery) / double(j.samples);
+  HealthReport first;
+  add(first, std::move(f));
+  put_first(h, std::move(first));
+}
+
+void name_prior_rejection(HealthReport& h, const UpdateRecord& first) {
+  if (first.accepted || first.index != 0) return;
+  for (HealthFinding& f : h.findings) {
+    if (f.cause != HealthCause::kLoneRejection || f.suggested != first.t_s) continue;
+    f.cause = HealthCause::kPriorRejected;
+    f.sigma = first.innovation_dps.head(first.dim).cwiseAbs().maxCoeff();
+  }
+}
+
+bool stamp_rate_off(double stated_hz, double median_hz, double mean_hz) {
+  const auto off = [stated_hz](double hz) { return std::fabs(hz / stated_hz - 1.0) > kStampRateTolerance; };
+  return std::isfinite(stated_hz) && std::isfinite(median_hz) && std::isfinite(mean_hz) && off(median_hz) &&
+         off(mean_hz);
+}
+
+void add_stamp_rate_finding(HealthReport& h, double stated_hz, double median_hz, double mean_hz) {
+  if (!stamp_rate_off(stated_hz, median_hz, mean_hz)) return;
+  HealthFinding f;
+  f.cause = HealthCause::kStampRate;
+  const double ratio = median_hz / stated_hz;
+  f.severity = ratio < 0.5 || ratio > 2.0 ? HealthVerdict::kFailed : HealthVerdict::kDegraded;
+  f.value = median_hz;
+  f.sigma = mean_hz;
+  f.suggested = stated_hz;
+  HealthReport first;
+  add(first, std::move(f));
+  put_first(h, std::move(first));
+}
+
+void add_gyro_standstill_findings(HealthReport& h, const GyroFlipTracker& tracker, double flip_angle_deg) {
+  HealthReport first;
+  const GyroFlipTracker::FlipAngleRecord& a = tracker.flip_angles();
+  if (a.unlike > 0) {
+    HealthFinding f;
+    f.cause = HealthCause::kGyroFlipAngle;
+    f.severity = 2 * a.unlike >= a.flips ? HealthVerdict::kFailed : HealthVerdict::kDegraded;
+    f.value = a.measured_flip_angle_deg;
+    f.sigma = flip_angle_deg;
+    f.count = a.unlike;
+    f.suggested = double(a.flips);
+    add(first, std::move(f));
+  }
+  const GyroFlipTracker::GapRecord& g = tracker.gaps();
+  if (g.count > 0) {
+    HealthFinding f;
+    f.cause = HealthCause::kGyroGapPositions;
+    const bool lost = tracker.motion() == GyroFlipTracker::Motion::kUnknown;
+    f.severity = lost ? HealthVerdict::kDegraded : HealthVerdict::kOk;
+    f.value = g.t_s;
+    f.sigma = g.length_s;
+    f.suggested = lost ? kNaN : g.recovered_t_s;
+    f.count = g.changed;
+    add(first, std::move(f));
+  }
+  put_first(h, std::move(first));
 }
 
 void add_box_motion_finding(HealthReport& h, const BoxMotion& m, bool box_at_rest, std::uint64_t dwell_updates) {

@@ -14,8 +14,10 @@
 #include "estimator/box_motion_check.hpp"
 #include "estimator/clip_detector.hpp"
 #include "estimator/filter.hpp"
+#include "estimator/flip_check.hpp"
 #include "estimator/lag_check.hpp"
 #include "estimator/reference_check.hpp"
+#include "estimator/standstill_gyro.hpp"
 
 namespace driftless::est {
 
@@ -44,9 +46,45 @@ enum class HealthCause {
                          // the channel; value: its value if stuck, NaN if empty; suggested: rows)
   kAttitudeWithheld,     // standstill: gyro: both platforms flipped at once, no sensor read the box
                          // rate (value: from when, s; suggested: how many such flips)
+  kAttitudeWithheldNoRate,  // no platform rested with a known angle and none moved with its angle
+                            // read (value: from when, s)
+  kAttitudeWithheldGap,  // a time gap inside the comparison: the box's turn in it is unknown
+                         // (value: the sample before it, s; sigma: its length, s)
+  kGyroFlipAngle,        // standstill: gyro: the flips turned unlike 2 flip_angle_deg (value: the
+                         // measured flip angle, deg; sigma: flip_angle_deg; count: such flips;
+                         // suggested: all flips)
+  kStampRate,            // the stamps step at another rate than sample_rate_hz states (value: the
+                         // stamps' rate from the median interval, Hz; sigma: from the mean one, Hz;
+                         // suggested: the stated rate, Hz)
+  kParallelHinges,       // the hinge axes are within kParallelHingesDeg of parallel: the bias along
+                         // the common hinge can never be observed (value: the angle between them, deg)
+  kNeverFlipped,         // every update at one position pair: the platforms never moved
+                         // (positions_deg: that pair; count: the updates)
+  kAngleJitter,          // no standstill, and the angle columns move by small steps above
+                         // angle_tolerance_deg most of the time (value: the largest step, deg; sigma:
+                         // angle_tolerance_deg; suggested: the fraction of samples)
+  kPriorRejected,        // the first update was rejected: its residual lies beyond the prior
+                         // (value: its NIS; suggested: its time, s; sigma: the largest residual
+                         // component, deg/s) - a note, the biases are larger than initial_sigma_dps
+  kGyroGapPositions,     // standstill: gyro: a time gap, after which the positions were recovered
+                         // (a note; count: 1 if a flip was lost in it) or not (degraded); value: the
+                         // sample before the gap, s; sigma: its length, s; suggested: when recovered, s
   kPaperRestAngles,      // paper mode: the platforms rest away from +-flip_angle_deg (eq. (5)'s H)
   kPaperSchedule,        // paper mode: the positions did not follow eq. (5)'s sequence
   kLockLost,             // locked once, then a re-lock widened P and it did not lock again
+  // the flip-turn check (flip_check.hpp; components: the platforms, value: the median turn/Δθ,
+  // count: such flips, suggested: the platforms' flips, sigma: the first one's time, s)
+  kFlipGyroUnit,         // turn/Δθ ≈ 1/57.3: gyro columns in rad/s
+  kFlipAngleUnit,        // turn/Δθ ≈ 57.3: angle columns in radians
+  kFlipTimeUnit,         // turn/Δθ ≈ 1e3 or 1e6: stamps in ms or µs
+  kFlipNotSeen,          // the gyro saw no turn where the angle column flipped: stuck platform
+  kFlipAngleSign,        // turn/Δθ ≈ −1: the angle counts against the right-hand rule
+  kFlipWrapped,          // one-way platform, angle wrapped at ±180: the flip updates drop those
+  kFlipSensorsSwapped,   // the resting sensor's column turned about the moving hinge
+  kFlipAxis,             // the turn is about another axis than the header's hinge (measured_axis)
+  kFlipTurnRatio,        // about the hinge by a ratio none of the above
+  kFlipScale,            // 1 ± a few % beyond 3 sigma of the scale prior (value: the median ratio)
+  kFlipsTooSlow,         // flips longer than flip_max_s (value: the longest, s): no flip update
   kBoxNotAtRest,         // --box-at-rest or box dwells, yet the box turned while both platforms
                          // rested (box_motion_check.hpp): value = ref_q's largest turn rate over a
                          // standstill (deg/s; NaN: no ref_q), sigma = the largest change of the fused
@@ -83,6 +121,8 @@ struct HealthFinding {
   // kPaperRestAngles: value = the standstills off, suggested = a rest angle read (deg), sigma =
   // flip_angle_deg; kPaperSchedule: value = the standstills off; both: count = paper standstills
   std::uint64_t count = 0;
+  // kFlipAxis: the turn axis measured, and the header's hinge, both in that sensor's axes
+  std::array<double, 3> measured_axis{}, header_axis{};
 };
 
 /// Limits of the verdict (docs/estimator.md section 6.1).
@@ -140,9 +180,46 @@ void add_saturation_findings(HealthReport& h, const std::vector<ClippedChannel>&
 /// dead channel makes every row invalid, or every standstill wrong on that axis: it is their cause).
 void add_dead_axis_findings(HealthReport& h, const std::vector<DeadChannel>& dead);
 
-/// 'standstill: gyro' and `flips` flips of both platforms at once, the first inside the attitude
-/// comparison at `t_s`: the attitude from there on is withheld (degraded; the biases stand).
-void add_attitude_withheld_finding(HealthReport& h, double t_s, std::uint64_t flips);
+/// The stamps disagree with the stated sample_rate_hz: both their median and their mean interval
+/// (log::LogReader::stamp_rate_*_hz) more than kStampRateTolerance off 1 / sample_rate_hz.
+inline constexpr double kStampRateTolerance = 0.1;
+bool stamp_rate_off(double stated_hz, double median_hz, double mean_hz);
+/// Puts a `stamp_rate` finding first when stamp_rate_off(): durations, the noise per sample and the
+/// gap threshold all use the stated rate. Failed beyond a factor 2 (a unit: ms or us stamps, or a
+/// wrong key), degraded otherwise.
+void add_stamp_rate_finding(HealthReport& h, double stated_hz, double median_hz, double mean_hz);
+
+/// Hinges closer than this to parallel (deg) cannot observe the bias along their common line.
+inline constexpr double kParallelHingesDeg = 10.0;
+/// Two causes of `never_locked` that more flips cannot cure, put first (failed): parallel hinge
+/// axes, and platforms that never moved (`positions_deg`: the position pairs of the `updates`).
+void add_flip_setup_findings(HealthReport& h, const BoxGeometry& box,
+                             const std::vector<std::array<double, 2>>& positions_deg, std::uint64_t updates);
+
+/// Platform columns and no update: the angles moved by small steps (above angle_tolerance_deg,
+/// at most StandstillDetector::kAngleJitterDeg) in more than half of the samples: their noise
+/// hid every standstill. Put first (failed).
+void add_angle_jitter_finding(HealthReport& h, const StandstillDetector::AngleJitter& j, double tolerance_deg);
+/// The lone rejection was the filter's first update: not an outlier but biases beyond the prior.
+/// `first` is that update; the lone_rejection note becomes a prior_rejected note.
+void name_prior_rejection(HealthReport& h, const UpdateRecord& first);
+
+/// Why the attitude comparison stopped (EstimateSummary::attitude_withheld_from_s).
+enum class AttitudeWithheld : std::uint8_t {
+  kNo,
+  kBothFlipping,  // standstill: gyro: both platforms flipped at once
+  kNoBoxRate,     // no sensor gave the box rate (no platform at rest with a known angle)
+  kTimeGap,       // a time gap: the box's turn in it is unknown
+};
+
+/// The attitude from `t_s` on is withheld for `why` (degraded; the biases stand). `detail`: the
+/// flips of both platforms at once (kBothFlipping) or the gap's length, s (kTimeGap).
+void add_attitude_withheld_finding(HealthReport& h, AttitudeWithheld why, double t_s, double detail);
+
+/// 'standstill: gyro': flips whose measured turn was unlike 2 flip_angle_deg (ahead of the others:
+/// their positions were snapped to the wrong stops; failed when at least half of the flips), and a
+/// time gap after which the positions were recovered (a note) or not (degraded).
+void add_gyro_standstill_findings(HealthReport& h, const GyroFlipTracker& tracker, double flip_angle_deg);
 
 /// --box-at-rest, or box dwells used (`dwell_updates` > 0), on a box that turned while the
 /// platforms rested (box_turned): `box_not_at_rest` ahead of the other findings (their cause).
@@ -157,6 +234,13 @@ void add_reference_finding(HealthReport& h, const ReferenceFit& fit);
 /// `failed` when at least half of the standstills are off (most updates used an H that is not the
 /// box's), else `degraded`. `counters` are the filter's at the end of the pass.
 void add_paper_mode_findings(HealthReport& h, const FilterCounters& counters, double flip_angle_deg);
+
+/// The flip-turn check's findings (flip_check.hpp), ahead of the others (a wrong unit, a stuck
+/// platform or a wrong hinge makes the updates wrong): `failed` when most flips disagree with
+/// their angle columns, else `degraded`; a one-way platform's wrapped flips, a scale error along
+/// a hinge beyond 3 sigma of the prior and flips slower than flip_max_s are `degraded` with
+/// --selfcal (whose flip updates they defeat), notes without it.
+void add_flip_check_findings(HealthReport& h, const FlipCheckResult& r, const EstimatorConfig& cfg);
 
 /// Watches the updates of one pass and gives the verdict at the end.
 class HealthMonitor {

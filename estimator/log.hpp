@@ -31,10 +31,9 @@ inline constexpr std::string_view kFormatId = "driftless-log 1";
 inline constexpr double kDefaultGyroFullScaleDps = 4000.0;
 inline constexpr double kFullScaleMargin = 1.1;
 
-/// A time gap is an interval longer than max(kGapMinS, kGapIntervals x the sample interval), the
-/// sample interval being 1 / sample_rate_hz, or the shortest interval so far without a stated rate.
-inline constexpr double kGapMinS = 1.0;
-inline constexpr double kGapIntervals = 10.0;
+/// Time gaps: driftless::gap_threshold_s (estimator/sample.hpp), with the shortest interval so far
+/// standing for the sample interval when the log states no rate.
+using driftless::kGapMinS;
 
 /// A malformed or unreadable log: the one input-error type, naming the file, line and key.
 using LogError = InputError;
@@ -198,6 +197,13 @@ class LogReader {
   /// The gap threshold in force, s.
   double gap_threshold_s() const { return gap_threshold_s_; }
   static constexpr std::size_t kMaxGapsKept = 100;
+  /// The rate the stamps step at, Hz: from the mean interval between gaps (bursty stamps average
+  /// out) and from the median of the first kIntervalsKept intervals (dropped rows do not move it).
+  /// NaN with fewer than two rows. Without gap-free intervals (every step a gap: ms stamps under
+  /// a rate key) the mean is over all intervals.
+  double stamp_rate_mean_hz() const;
+  double stamp_rate_median_hz() const;
+  static constexpr std::size_t kIntervalsKept = 4096;
   /// True if the file ended in a partial row that was dropped (only for incomplete logs).
   bool dropped_truncated_row() const { return dropped_truncated_; }
   /// Number of rows holding a NaN or empty gyro value (they are returned; callers skip them).
@@ -248,6 +254,10 @@ class LogReader {
   double gap_threshold_s_ = kGapMinS;
   bool rate_stated_ = false;
   double min_dt_s_ = std::numeric_limits<double>::infinity();  // s, shortest interval so far
+  double first_t_s_ = kNaN;               // s, the first row's stamp
+  double sum_dt_s_ = 0.0;                 // s, the gap-free intervals' sum ...
+  std::uint64_t n_dt_ = 0;                // ... and count
+  std::vector<double> first_dt_s_;        // s, the first kIntervalsKept intervals
   // per sensor: the plausibility bound and the stated full scale (NaN: none stated, no saturation count)
   std::array<double, 2> gyro_limit_dps_{kFullScaleMargin * kDefaultGyroFullScaleDps,
                                         kFullScaleMargin * kDefaultGyroFullScaleDps};

@@ -73,7 +73,7 @@ LogReader::LogReader(const std::filesystem::path& path, ReaderOptions opts) : pa
   }
   const double rate = meta_.sample_rate_hz();
   rate_stated_ = std::isfinite(rate);
-  gap_threshold_s_ = rate_stated_ ? std::max(kGapMinS, kGapIntervals / rate) : kGapMinS;
+  gap_threshold_s_ = rate_stated_ ? driftless::gap_threshold_s(1.0 / rate) : kGapMinS;
   for (int sensor = 1; sensor <= 2; ++sensor) {
     const std::size_t i = static_cast<std::size_t>(sensor - 1);
     gyro_limit_dps_[i] = kFullScaleMargin * meta_.gyro_full_scale_dps(sensor);
@@ -303,12 +303,18 @@ void LogReader::check_row(const Sample& s) {
     if (!rate_stated_ && dt < min_dt_s_) {
       // no stated rate: the shortest interval so far stands for the sample interval
       min_dt_s_ = dt;
-      gap_threshold_s_ = std::max(kGapMinS, kGapIntervals * min_dt_s_);
+      gap_threshold_s_ = driftless::gap_threshold_s(min_dt_s_);
     }
     if (dt > gap_threshold_s_) {
       ++gap_count_;
       if (gaps_.size() < kMaxGapsKept) gaps_.push_back(Gap{last_t_, dt, line_no_});
+    } else {
+      sum_dt_s_ += dt;
+      ++n_dt_;
     }
+    if (first_dt_s_.size() < kIntervalsKept) first_dt_s_.push_back(dt);
+  } else {
+    first_t_s_ = s.t_s;
   }
   const int n = sensors() == 1 ? 3 : 6;
   const bool resting = platforms_resting(s);
@@ -384,6 +390,19 @@ std::vector<Sample> read_all(const std::filesystem::path& path, Metadata* meta, 
   if (meta != nullptr) *meta = reader.metadata();
   if (fields != nullptr) *fields = reader.fields();
   return out;
+}
+
+double LogReader::stamp_rate_mean_hz() const {
+  if (n_dt_ > 0) return double(n_dt_) / sum_dt_s_;
+  return rows_ >= 2 ? double(rows_ - 1) / (last_t_ - first_t_s_) : kNaN;
+}
+
+double LogReader::stamp_rate_median_hz() const {
+  if (first_dt_s_.empty()) return kNaN;
+  std::vector<double> dt = first_dt_s_;
+  const auto mid = dt.begin() + static_cast<std::ptrdiff_t>(dt.size() / 2);
+  std::nth_element(dt.begin(), mid, dt.end());
+  return 1.0 / *mid;
 }
 
 }  // namespace driftless::log

@@ -8,6 +8,7 @@
 
 #include <Eigen/Cholesky>
 
+#include "estimator/flip_check.hpp"
 #include "estimator/stats.hpp"
 
 namespace driftless::est {
@@ -122,6 +123,17 @@ void add_reader_warnings(const log::LogReader& reader, EstimateSummary& sum) {
                            " rows had a missing or NaN gyro value and were skipped");
   }
   if (reader.dropped_truncated_row()) sum.warnings.push_back("the last row was cut off and dropped");
+  if (reader.gap_count() > 0) {
+    const auto& g = reader.gaps();
+    const auto longest = std::max_element(g.begin(), g.end(), [](const log::Gap& a, const log::Gap& b) {
+      return a.length_s < b.length_s;
+    });
+    sum.warnings.push_back(std::to_string(reader.gap_count()) + " time gap(s) longer than " +
+                           std::to_string(reader.gap_threshold_s()) + " s in the log, the longest " +
+                           std::to_string(longest->length_s) + " s after t = " + std::to_string(longest->t_before_s) +
+                           " s (line " + std::to_string(longest->line) +
+                           "): an attitude comparison stops at the first one after its start");
+  }
   if (reader.rows_saturated() > 0) {
     sum.warnings.push_back(std::to_string(reader.rows_saturated()) +
                            " rows have a gyro value at the stated gyro_full_scale_dps (saturated)");
@@ -201,20 +213,56 @@ void add_attitude_results(const AttitudeComparison& att, const DriftlessFilter& 
   }
 }
 
-// 'standstill: gyro' and a flip of both platforms at once after the comparison began: during it
-// neither sensor read the box rate, so the attitude from there on is not known; the figures that
-// span it are withheld (the points before it, in attitude.csv, stand)
+// the comparison stopped (no box rate, or a time gap) after it began: the attitude from there on
+// is not known; the figures that span it are withheld (the points before it, in attitude.csv, stand)
 void withhold_attitude(const DriftlessFilter& filter, EstimateSummary& sum) {
   if (std::isnan(sum.attitude_withheld_from_s)) return;
   sum.drift_corrected_deg_per_h = sum.drift_raw_deg_per_h = sum.drift_fixed_deg_per_h = kNaN;
   sum.drift_net_corrected_deg_per_h = sum.drift_net_raw_deg_per_h = sum.drift_net_fixed_deg_per_h = kNaN;
   sum.final_corrected = sum.final_raw = sum.final_fixed = kAttitudeErrorUnknown;
-  sum.warnings.push_back(
-      "attitude withheld from t = " + std::to_string(sum.attitude_withheld_from_s) + " s: with 'standstill: gyro' " +
-      std::to_string(filter.counters().simultaneous_flips) +
-      " flip(s) moved both platforms at once, and while both turn neither sensor reads the box rate; "
-      "attitude.csv stops there and the drift figures are not given. Flip one platform at a time, or log the "
-      "platform angles (plat1_deg, plat2_deg)");
+  const std::string from = "attitude withheld from t = " + std::to_string(sum.attitude_withheld_from_s) + " s: ";
+  const std::string tail = "; attitude.csv stops there and the drift figures are not given. ";
+  switch (sum.attitude_withheld_why) {
+    case AttitudeWithheld::kBothFlipping:
+      sum.warnings.push_back(from + "with 'standstill: gyro' " + std::to_string(filter.counters().simultaneous_flips) +
+                             " flip(s) moved both platforms at once, and while both turn neither sensor reads the box "
+                             "rate" + tail + "Flip one platform at a time, or log the platform angles (plat1_deg, plat2_deg)");
+      break;
+    case AttitudeWithheld::kTimeGap:
+      sum.warnings.push_back(from + "the log has no rows for " + std::to_string(sum.attitude_withheld_gap_s) +
+                             " s there, and how far the box turned in that gap is unknown" + tail +
+                             "Log without gaps, or compare the pieces between gaps as separate logs");
+      break;
+    case AttitudeWithheld::kNoBoxRate:
+    case AttitudeWithheld::kNo:
+      sum.warnings.push_back(from + "no platform rested with a known angle, and no moving one had its angle read, so no "
+                             "sensor gave the box rate" + tail + "Log plat1_deg and plat2_deg while the platforms move");
+      break;
+  }
+}
+
+// the attitude comparison stops at the first sample after its start that follows a time gap, or
+// where no sensor gave the box rate (a row the filter could not use at all is not one)
+void check_attitude_input(const Sample& s, double prev_t_s, double gap_s, const DriftlessFilter& filter,
+                          const AttitudeComparison& att, EstimateSummary& sum) {
+  if (!att.started() || !std::isnan(sum.attitude_withheld_from_s)) return;
+  if (s.t_s - prev_t_s > gap_s) {
+    sum.attitude_withheld_from_s = prev_t_s;
+    sum.attitude_withheld_why = AttitudeWithheld::kTimeGap;
+    sum.attitude_withheld_gap_s = s.t_s - prev_t_s;
+  } else if (!filter.output().rate_body_dps.allFinite() && filter.output().status != PushStatus::kInvalid) {
+    // (a row without a gyro value is bridged as before: the integrator holds the last rate)
+    sum.attitude_withheld_from_s = s.t_s;
+    sum.attitude_withheld_why =
+        filter.output().both_moving ? AttitudeWithheld::kBothFlipping : AttitudeWithheld::kNoBoxRate;
+  }
+}
+
+// adds the pair to `seen` unless a pair within 0.1 deg is there (a handful of pairs per log)
+void note_position(std::vector<std::array<double, 2>>& seen, double p1_deg, double p2_deg) {
+  for (const auto& p : seen)
+    if (std::fabs(p[0] - p1_deg) < 0.1 && std::fabs(p[1] - p2_deg) < 0.1) return;
+  if (seen.size() < 16) seen.push_back({p1_deg, p2_deg});
 }
 
 // ref_q in another convention than the log's (or of another body): the errors against it say
@@ -232,6 +280,16 @@ void withhold_attitude_reference(EstimateSummary& sum) {
 // after an update: is the correction locked (filter_locked at the lock level)? Records the first
 // lock, each gate re-lock and when the lock came back after it.
 // `t_s` is the time of the sample whose push made the update: the first row it corrects.
+// the flip-turn check (flip_check.hpp): one sample of the filter's output; a flip that ended is
+// measured in the frames of its start angles
+void check_flip(FlipCheck& check, const DriftlessFilter& filter) {
+  const SampleOutput& o = filter.output();
+  if (!check.push(o.t_s, o.y1c_dps, o.y2c_dps, o.plat1_deg, o.plat2_deg, o.at_rest)) return;
+  const BoxGeometry& box = filter.geometry();
+  check.close({filter.body_from_sensor(1, check.start_deg(1)), filter.body_from_sensor(2, check.start_deg(2)),
+               box.hinge1_axis.normalized(), box.hinge2_axis.normalized()});
+}
+
 bool lock_step(const DriftlessFilter& filter, double lock_sigma_dps, const UpdateRecord& u, double t_s,
                EstimateSummary& sum) {
   if (u.relocked) sum.relocks.push_back({u.t_s, u.relock_nis, kNaN});
@@ -242,6 +300,34 @@ bool lock_step(const DriftlessFilter& filter, double lock_sigma_dps, const Updat
     sum.relocks.back().locked_again_t_s = t_s;
   }
   return true;
+}
+
+// the findings about the input, each ahead of those it causes (the last put first leads): the
+// paper schedule, the flip set-up, the gyro tracker's, then the reader's (a dead axis leads), and
+// the attitude withheld last
+void add_input_findings(const log::Metadata& meta, const log::LogReader* reader, const EstimatorConfig& cfg,
+                        const DriftlessFilter& filter, const std::vector<std::array<double, 2>>& positions,
+                        EstimateSummary& sum) {
+  if (cfg.mode == FilterMode::kPaper) add_paper_mode_findings(sum.health, filter.counters(), filter.geometry().flip_angle_deg);
+  if (sum.health.verdict != HealthVerdict::kOk) {
+    add_flip_setup_findings(sum.health, filter.geometry(), positions, sum.counters.updates);
+  }
+  if (cfg.standstill == StandstillSource::kPlatformColumns && sum.counters.updates == 0) {
+    add_angle_jitter_finding(sum.health, filter.standstill().angle_jitter(), cfg.angle_tolerance_deg);
+  }
+  if (cfg.standstill == StandstillSource::kGyroSignal) {
+    add_gyro_standstill_findings(sum.health, filter.standstill().gyro_tracker(), filter.geometry().flip_angle_deg);
+  }
+  if (reader != nullptr) {
+    add_stamp_rate_finding(sum.health, meta.sample_rate_hz(), reader->stamp_rate_median_hz(),
+                           reader->stamp_rate_mean_hz());
+    add_saturation_findings(sum.health, reader->suspected_clipping(), reader->rows_read());
+    add_dead_axis_findings(sum.health, reader->dead_channels());
+  }
+  add_attitude_withheld_finding(sum.health, sum.attitude_withheld_why, sum.attitude_withheld_from_s,
+                                sum.attitude_withheld_why == AttitudeWithheld::kTimeGap
+                                    ? sum.attitude_withheld_gap_s
+                                    : double(sum.counters.simultaneous_flips));
 }
 
 // the pass itself; `reader` (optional) adds the log reader's findings to the warnings
@@ -261,14 +347,19 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
   const bool use_window = have_truth && std::isfinite(opt.eval_start_s);
   HealthMonitor health(opt.health);
   LagCheck lag(filter.geometry().sample_rate_hz);
+  FlipCheck flips(cfg.flip_max_s, cfg.settle_s);
   ReferenceCheck ref_check;
   BoxMotionCheck box_motion;
 
   // the lock state changes only at updates (P shrinks there; a gate re-lock widens it)
   bool locked = false;
+  std::vector<std::array<double, 2>> positions;  // the position pairs of the updates (to 0.1 deg)
+  UpdateRecord first_update;
   auto on_update = [&](PushStatus st, const Sample& s) {
     if (st != PushStatus::kUpdated && st != PushStatus::kRejected) return;
     const UpdateRecord& u = filter.last_update();
+    note_position(positions, u.plat1_deg, u.plat2_deg);
+    if (u.index == 0) first_update = u;
     locked = lock_step(filter, opt.attitude_start_sigma_dps, u, s.t_s, sum);
     if (sink != nullptr) sink->on_update(u, filter.covariance_dps2(), s, locked);
     health.on_update(u, filter);
@@ -276,6 +367,8 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
     if (use_window) window.on_update(u);
   };
 
+  const double gap_s = gap_threshold_s(1.0 / filter.geometry().sample_rate_hz);
+  double prev_t_s = kNaN;
   Sample s;
   while (next(s)) {
     if (should_stop != nullptr && (sum.rows & 4095u) == 0 && should_stop()) {
@@ -288,6 +381,7 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
     const PushStatus st = filter.push(s);
     on_update(st, s);  // first: the row that made an update carries the state after it
     lag.push(s, filter);
+    check_flip(flips, filter);
     if (sum.attitude_available) ref_check.push(s, filter);
     box_motion.push(s, filter.output());
     sum.samples_locked += locked ? 1 : 0;
@@ -296,10 +390,9 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
 
     // attitude: the comparison starts at the first finite ref_q once the filter has locked on
     // (every bias sigma below attitude_start_sigma_dps); it stops where no sensor reads the box
-    // rate (standstill: gyro, both platforms flipping at once)
-    if (filter.output().both_moving && att.started() && std::isnan(sum.attitude_withheld_from_s)) {
-      sum.attitude_withheld_from_s = s.t_s;
-    }
+    // rate or after a time gap
+    check_attitude_input(s, prev_t_s, gap_s, filter, att, sum);
+    prev_t_s = s.t_s;
     AttitudePoint ap;
     if (std::isnan(sum.attitude_withheld_from_s) && att.push(s, filter, ap)) {
       sum.final_corrected = ap.corrected;
@@ -346,12 +439,11 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
   score.finish();
   if (use_window) window.finish(filter);
   sum.health = health.finish(filter, sum.rows > 0 ? sum.t_last_s - sum.t_first_s : 0.0, lag.finish());
-  if (cfg.mode == FilterMode::kPaper) add_paper_mode_findings(sum.health, filter.counters(), filter.geometry().flip_angle_deg);
-  if (reader != nullptr) {
-    add_saturation_findings(sum.health, reader->suspected_clipping(), reader->rows_read());
-    add_dead_axis_findings(sum.health, reader->dead_channels());
-  }
-  add_attitude_withheld_finding(sum.health, sum.attitude_withheld_from_s, sum.counters.simultaneous_flips);
+  name_prior_rejection(sum.health, first_update);
+  // the flip check's findings first: the input findings put first lead them (a clipping gyro or
+  // rests away from the stops make the flip turns disagree with the angles)
+  add_flip_check_findings(sum.health, flips.finish(), cfg);
+  add_input_findings(meta, reader, cfg, filter, positions, sum);
   add_reference_finding(sum.health, sum.reference);
   sum.box_motion = box_motion.finish();
   add_box_motion_finding(sum.health, sum.box_motion, cfg.box_at_rest, sum.counters.box_dwell_updates);

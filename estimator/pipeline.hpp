@@ -139,9 +139,12 @@ struct EstimateSummary {
   double drift_net_fixed_deg_per_h = kNaN;
   double attitude_start_s = kNaN;                  // s, where the comparison started
   double attitude_realign_s = kNaN;                // s, where it was re-aligned (NaN: not)
-  // s, 'standstill: gyro': the comparison stopped at the first flip of both platforms at once (no
-  // sensor read the box rate); the drifts and final errors are withheld (NaN). NaN: not withheld
+  // s, the comparison stopped here: no sensor read the box rate ('standstill: gyro' and a flip of
+  // both platforms at once; no platform angle known), or a time gap hid the box's turn; the drifts
+  // and final errors are withheld (NaN). NaN: not withheld
   double attitude_withheld_from_s = kNaN;
+  AttitudeWithheld attitude_withheld_why = AttitudeWithheld::kNo;
+  double attitude_withheld_gap_s = kNaN;  // s, the gap's length (kTimeGap)
   // does ref_q turn with the gyros (reference_check.hpp)? When another convention fits, or none,
   // the drifts and final errors are withheld (NaN) and health names reference_mismatch
   ReferenceFit reference;

@@ -19,6 +19,16 @@ inline constexpr double kDegPerRad = 180.0 / kPi;
 inline constexpr double kRadPerDeg = kPi / 180.0;
 inline constexpr double kStandardGravityMps2 = 9.80665;
 
+/// A time gap is an interval longer than max(kGapMinS, kGapIntervals x the sample interval), the
+/// sample interval being 1 / sample_rate_hz (or, without a stated rate, the shortest interval seen).
+/// The log reader reports gaps by it; the estimator withholds what a gap leaves unknown.
+inline constexpr double kGapMinS = 1.0;
+inline constexpr double kGapIntervals = 10.0;
+/// The gap threshold, s, for a sample interval `interval_s` (NaN: unknown, kGapMinS).
+inline double gap_threshold_s(double interval_s) {
+  return interval_s * kGapIntervals > kGapMinS ? interval_s * kGapIntervals : kGapMinS;
+}
+
 /// Optional column groups a log (or a stream) carries. Required columns are always present.
 enum SampleField : std::uint32_t {
   kFieldAccel = 1u << 0,      // accel1_x..accel2_z, m/s^2

@@ -22,6 +22,8 @@ void StandstillDetector::restart(const BoxGeometry& box) {
   active_ = false;
   seg_ = StandstillSegment{};
   prev_p1_ = prev_p2_ = kNaN;
+  prev_rate1_dps_ = prev_rate2_dps_ = kNaN;
+  prev_both_moving_ = false;
   sched_start_s_ = kNaN;
   gyro_.restart(box);  // positions kept, motion and rest level re-learned
   n_closed_ = 0;
@@ -53,16 +55,50 @@ StandstillDetector::Pending StandstillDetector::pending_of(const Sample& s) {
   return p;
 }
 
+// the hinge rate whose mean with the previous one is the angle change over the interval (the
+// attitude integrator's trapezoid then turns the box by what the columns say): at rest 0; while
+// moving (1 + l) change / dt - l previous. l = 1 is that exactly, but lets an encoder's noise build
+// up from sample to sample; l = kHingeRateMemory keeps it bounded and misses the trapezoid by
+// (1 - l) / 2 of the rate's change over the interval, which sums to nothing over a flip that
+// starts and ends at rest (lag on a ramp: (1 - l) / (2 (1 + l)) of a sample)
+double StandstillDetector::hinge_rate_dps(double angle_deg, double prev_deg, double prev_rate_dps, bool rest,
+                                          double dt_s) {
+  constexpr double kHingeRateMemory = 0.9;
+  if (rest) return 0.0;
+  if (!finite(angle_deg) || !finite(prev_deg) || !(dt_s > 0.0)) return kNaN;
+  return (1.0 + kHingeRateMemory) * (angle_deg - prev_deg) / dt_s -
+         kHingeRateMemory * (finite(prev_rate_dps) ? prev_rate_dps : 0.0);
+}
+
+// an angle change above the tolerance but too small for a flip: the read-back's own noise
+void StandstillDetector::note_jitter(double d1_deg, double d2_deg) {
+  if (!finite(d1_deg) || !finite(d2_deg)) return;
+  ++jitter_.samples;
+  const double d = std::max(std::fabs(d1_deg), std::fabs(d2_deg));
+  if (d <= cfg_.angle_tolerance_deg || d > kAngleJitterDeg) return;
+  ++jitter_.jittery;
+  jitter_.max_change_deg = std::max(jitter_.max_change_deg, d);
+}
+
 // at-rest test for the platform columns: a platform rests when its angle is finite and unchanged
-bool StandstillDetector::classify(const Sample& s, StandstillStep& st) {
+bool StandstillDetector::classify(const Sample& s, double dt_s, StandstillStep& st) {
   st.plat1_deg = s.plat1_deg;
   st.plat2_deg = s.plat2_deg;
   const double tol = cfg_.angle_tolerance_deg;
   st.plat1_rest = finite(s.plat1_deg) && finite(prev_p1_) && std::fabs(s.plat1_deg - prev_p1_) <= tol;
   st.plat2_rest = finite(s.plat2_deg) && finite(prev_p2_) && std::fabs(s.plat2_deg - prev_p2_) <= tol;
+  note_jitter(s.plat1_deg - prev_p1_, s.plat2_deg - prev_p2_);
+  st.plat1_rate_dps = hinge_rate_dps(s.plat1_deg, prev_p1_, prev_rate1_dps_, st.plat1_rest, dt_s);
+  st.plat2_rate_dps = hinge_rate_dps(s.plat2_deg, prev_p2_, prev_rate2_dps_, st.plat2_rest, dt_s);
+  // both moving with their angles read (not the first sample, whose angles count from the next)
+  st.both_moving = !st.plat1_rest && !st.plat2_rest && finite(prev_p1_) && finite(prev_p2_);
+  if (st.both_moving && !prev_both_moving_) ++both_moving_;
+  prev_both_moving_ = st.both_moving;
   // the very first sample with both angles known counts as at rest only from the next one on
   prev_p1_ = s.plat1_deg;
   prev_p2_ = s.plat2_deg;
+  prev_rate1_dps_ = st.plat1_rate_dps;
+  prev_rate2_dps_ = st.plat2_rate_dps;
   return st.plat1_rest && st.plat2_rest;
 }
 
@@ -85,13 +121,14 @@ StandstillStep StandstillDetector::push(const Sample& s, double dt_s, const Eige
   seg_tag_ = 0;
   switch (cfg_.standstill) {
     case StandstillSource::kPlatformColumns:
-      at_rest = classify(s, st);
+      at_rest = classify(s, dt_s, st);
       break;
     case StandstillSource::kGyroSignal:
-      gyro_.push(s.gyro1_dps, s.gyro2_dps, bias1_dps, bias2_dps, dt_s);
+      gyro_.push(s.gyro1_dps, s.gyro2_dps, bias1_dps, bias2_dps, dt_s, s.t_s);
       at_rest = gyro_.motion() == GyroFlipTracker::Motion::kRest;
-      st.plat1_deg = gyro_.position_deg(1);
-      st.plat2_deg = gyro_.position_deg(2);
+      // after a time gap the positions are unknown until the tracker finds them again
+      st.plat1_deg = gyro_.motion() == GyroFlipTracker::Motion::kUnknown ? kNaN : gyro_.position_deg(1);
+      st.plat2_deg = gyro_.motion() == GyroFlipTracker::Motion::kUnknown ? kNaN : gyro_.position_deg(2);
       // each platform on its own: the one that rests still gives the box rate during the other's flip
       st.plat1_rest = gyro_.rest(1);
       st.plat2_rest = gyro_.rest(2);

@@ -65,8 +65,13 @@ struct StandstillStep {
   // 'standstill: gyro': a platform at rest whose hinge rate has begun to rise (the start of a flip,
   // below the motion threshold): its sensor is left out of the fused box rate
   bool plat1_starting = false, plat2_starting = false;
-  // 'standstill: gyro': both platforms move at once, so no sensor reads the box rate alone
+  // both platforms move at once, so no sensor reads the box rate alone ('standstill: gyro': the
+  // attitude is then unknown; platform columns: the moving sensors give it, see plat*_rate_dps)
   bool both_moving = false;
+  // platform columns: each hinge rate, deg/s, such that the mean of two samples' rates is (nearly)
+  // the angle change between them over their interval (the trapezoid the attitude integrator
+  // applies), so a moving sensor gives the box rate M(theta) y - rate a; NaN where an angle is missing
+  double plat1_rate_dps = kNaN, plat2_rate_dps = kNaN;
 };
 
 /// Streaming standstill detector. push() never throws.
@@ -95,7 +100,18 @@ class StandstillDetector {
   /// A standstill was discarded by the last push()/finish() (paper mode counts it as a step).
   bool discarded_last() const { return discarded_last_; }
   /// 'standstill: gyro': flips in which both platforms moved at once, since construction.
-  std::uint64_t simultaneous_flips() const { return gyro_.simultaneous_flips(); }
+  std::uint64_t simultaneous_flips() const { return gyro_.simultaneous_flips() + both_moving_; }
+  /// 'standstill: gyro': the time gaps and each flip's measured turn (standstill_gyro.hpp).
+  const GyroFlipTracker& gyro_tracker() const { return gyro_; }
+  /// Platform columns: samples with both angles read after a row with both, and those in which an
+  /// angle moved by more than angle_tolerance_deg but at most kAngleJitterDeg (an encoder's noise,
+  /// not a flip), with the largest such change, deg.
+  struct AngleJitter {
+    std::uint64_t samples = 0, jittery = 0;
+    double max_change_deg = 0.0;
+  };
+  static constexpr double kAngleJitterDeg = 0.1;
+  const AngleJitter& angle_jitter() const { return jitter_; }
   /// Sample rate used for durations, Hz (the geometry's, else measured from the segment).
   double rate_hz(const StandstillSegment& seg) const;
 
@@ -104,7 +120,9 @@ class StandstillDetector {
     Eigen::Vector3d y1, y2, f1, f2, up;
     double temp1, temp2, t_s;
   };
-  bool classify(const Sample& s, StandstillStep& st);
+  bool classify(const Sample& s, double dt_s, StandstillStep& st);
+  void note_jitter(double d1_deg, double d2_deg);
+  static double hinge_rate_dps(double angle_deg, double prev_deg, double prev_rate_dps, bool rest, double dt_s);
   void schedule_positions(const Sample& s, StandstillStep& st);
   void start_segment(double t_s, double p1, double p2, std::int64_t tag);
   void end_standstill();
@@ -121,6 +139,10 @@ class StandstillDetector {
   std::vector<Pending> ring_;  // the end margin, sized once
   std::size_t ring_head_ = 0, ring_count_ = 0, ring_capacity_ = 0;
   double prev_p1_ = kNaN, prev_p2_ = kNaN;
+  double prev_rate1_dps_ = kNaN, prev_rate2_dps_ = kNaN;  // platform columns: the last hinge rates
+  bool prev_both_moving_ = false;
+  std::uint64_t both_moving_ = 0;  // platform columns: flips of both platforms at once
+  AngleJitter jitter_;
   double sched_start_s_ = kNaN;
   GyroFlipTracker gyro_;  // positions from the gyros alone (standstill: gyro)
   std::array<StandstillSegment, 2> closed_{};

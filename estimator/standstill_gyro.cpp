@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "estimator/geometry.hpp"
 
@@ -18,6 +19,14 @@ constexpr double kStartingFraction = 0.2;
 constexpr double kQuietS = 0.25;
 // s: time constant of the rest level (it follows the biases' slow wander and the rest noise)
 constexpr double kLevelTauS = 1.0;
+// a measured turn further than this from 2 flip_angle_deg (fraction of it, and at least kTurnOffDeg)
+// is unlike the configured flip
+constexpr double kTurnOffFraction = 0.1;
+constexpr double kTurnOffDeg = 5.0;
+// after a gap: the best position pair's mean difference below kSeekFitFraction of the threshold,
+// every other pair's above kSeekRejectFactor times it (the box turned enough to tell them apart)
+constexpr double kSeekFitFraction = 0.5;
+constexpr double kSeekRejectFactor = 2.0;
 
 double snap_deg(double p_deg, double turn_deg, double flip_deg) {
   if (std::fabs(turn_deg) < 0.5 * flip_deg) return p_deg;  // an aborted or false start: no change
@@ -54,6 +63,7 @@ bool GyroFlipTracker::rest(int i) const {
     case Motion::kPlatform1: return i == 2;
     case Motion::kPlatform2: return i == 1;
     case Motion::kBoth: return false;
+    case Motion::kUnknown: return false;
   }
   return false;
 }
@@ -70,7 +80,13 @@ Eigen::Vector3d GyroFlipTracker::rest_difference(const Eigen::Vector3d& y1, cons
 }
 
 void GyroFlipTracker::push(const Eigen::Vector3d& y1, const Eigen::Vector3d& y2, const Eigen::Vector3d& b1,
-                           const Eigen::Vector3d& b2, double dt_s) {
+                           const Eigen::Vector3d& b2, double dt_s, double t_s) {
+  const double interval_s = std::isfinite(box_.sample_rate_hz) ? 1.0 / box_.sample_rate_hz : kNaN;
+  if (std::isfinite(dt_s) && dt_s > gap_threshold_s(interval_s)) start_gap(dt_s, t_s);
+  if (motion_ == Motion::kUnknown) {
+    seek_positions(y1, y2, b1, b2, t_s);
+    return;
+  }
   if (!have_level_) {  // the first sample sets the rest level (the box starts at rest)
     level_ = rest_difference(y1, y2);
     have_level_ = true;
@@ -157,6 +173,8 @@ void GyroFlipTracker::track_both(const Eigen::Vector3d& y1, const Eigen::Vector3
 }
 
 void GyroFlipTracker::end_motion(const Eigen::Vector3d& y1, const Eigen::Vector3d& y2) {
+  note_turn(turn1_deg_);
+  note_turn(turn2_deg_);
   p1_ = snap_deg(p1_, turn1_deg_, box_.flip_angle_deg);
   p2_ = snap_deg(p2_, turn2_deg_, box_.flip_angle_deg);
   motion_ = Motion::kRest;
@@ -164,6 +182,64 @@ void GyroFlipTracker::end_motion(const Eigen::Vector3d& y1, const Eigen::Vector3
   quiet_ = 0;
   level_.setZero();
   level_ = rest_difference(y1, y2);  // the new rest level from this sample (refined as it rests)
+}
+
+// a flip (a turn of at least half the configured one) between +-f turns 2f: a turn unlike
+// 2 flip_angle_deg says the platforms rest elsewhere than the configuration assumes
+void GyroFlipTracker::note_turn(double turn_deg) {
+  const double expected = 2.0 * box_.flip_angle_deg, turn = std::fabs(turn_deg);
+  if (turn < 0.5 * box_.flip_angle_deg) return;  // an aborted or false start
+  ++angles_.flips;
+  if (std::fabs(turn - expected) <= std::max(kTurnOffDeg, kTurnOffFraction * expected)) return;
+  // the first such flip is the one measured: it starts from the configured positions, the later
+  // ones from positions snapped to the wrong stops (on a turning box their turns are then off too)
+  if (angles_.unlike++ == 0) angles_.measured_flip_angle_deg = 0.5 * turn;
+}
+
+// a time gap: whatever turned in it was not seen, so the positions are unknown from here
+void GyroFlipTracker::start_gap(double dt_s, double t_s) {
+  if (gap_.count++ == 0) {
+    gap_.t_s = std::isfinite(t_s) ? t_s - dt_s : kNaN;
+    gap_.length_s = dt_s;
+  }
+  if (motion_ != Motion::kUnknown) {
+    p1_before_gap_ = p1_;
+    p2_before_gap_ = p2_;
+  }
+  motion_ = Motion::kUnknown;
+  turn1_deg_ = turn2_deg_ = 0.0;
+  quiet_ = starting_ = 0;
+  seek_n_ = 0;
+  for (auto& v : seek_sum_) v.setZero();
+}
+
+// eq. (2) at rest with the bias estimate removed: M1 (y1 - b1) - M2 (y2 - b2) = 0 at the right
+// positions; a wrong pair leaves (M M'^T - I) w of the box rate w. Decided over blocks of
+// quiet_samples(): one pair must fit and every other one must not
+void GyroFlipTracker::seek_positions(const Eigen::Vector3d& y1, const Eigen::Vector3d& y2, const Eigen::Vector3d& b1,
+                                     const Eigen::Vector3d& b2, double t_s) {
+  const double f = box_.flip_angle_deg;
+  const std::array<std::array<double, 2>, 4> pairs{{{f, f}, {f, -f}, {-f, f}, {-f, -f}}};
+  for (std::size_t c = 0; c < pairs.size(); ++c) {
+    seek_sum_[c] += geo::rot_about_axis_deg(box_.hinge1_axis, pairs[c][0]) * (y1 - b1) -
+                    geo::rot_about_axis_deg(box_.hinge2_axis, pairs[c][1]) * (y2 - b2);
+  }
+  if (++seek_n_ < quiet_samples()) return;
+  std::array<double, 4> m{};
+  for (std::size_t c = 0; c < pairs.size(); ++c) m[c] = seek_sum_[c].norm() / double(seek_n_);
+  const std::size_t best = static_cast<std::size_t>(std::min_element(m.begin(), m.end()) - m.begin());
+  double second = std::numeric_limits<double>::infinity();
+  for (std::size_t c = 0; c < pairs.size(); ++c) second = c == best ? second : std::min(second, m[c]);
+  seek_n_ = 0;
+  for (auto& v : seek_sum_) v.setZero();
+  if (!(m[best] < kSeekFitFraction * thr_dps_ && second > kSeekRejectFactor * thr_dps_)) return;
+  p1_ = pairs[best][0];
+  p2_ = pairs[best][1];
+  ++gap_.recovered;
+  if (p1_ != p1_before_gap_ || p2_ != p2_before_gap_) ++gap_.changed;
+  if (std::isnan(gap_.recovered_t_s)) gap_.recovered_t_s = t_s;
+  motion_ = Motion::kRest;
+  have_level_ = false;  // the next sample sets the rest level at the recovered positions
 }
 
 }  // namespace driftless::est

@@ -9,21 +9,45 @@
 // threshold, and the platform's new position is its integrated turn snapped to the nearer stop.
 // When both platforms move at once no sensor reads the box rate: the tracker says so (the
 // attitude cannot be made then) and follows both turns from a least-squares fit of the box rate
-// and both hinge rates to the six readings. Eigen + std only; push() never throws nor allocates.
+// and both hinge rates to the six readings.
+// Two things the gyros can tell about the configuration and the log: each flip's measured turn
+// (a flip between +-f turns 2f; a turn unlike 2 flip_angle_deg is counted, its size kept), and a
+// time gap (sample.hpp), in which a flip may have been lost: the positions are then unknown until
+// a rest where exactly one of the four position pairs makes M1 (y1 - b1) - M2 (y2 - b2) vanish
+// (on a turning box the wrong pairs leave (M M'^T - I) w; on a still one all fit: not recovered).
+// Eigen + std only; push() never throws nor allocates.
 #pragma once
 
+#include <array>
 #include <cstdint>
 
 #include <Eigen/Core>
 
 #include "estimator/box_geometry.hpp"
+#include "estimator/sample.hpp"
 
 namespace driftless::est {
 
 /// Where the platforms are and which of them rest, from the two gyros' readings.
 class GyroFlipTracker {
  public:
-  enum class Motion : std::uint8_t { kRest, kPlatform1, kPlatform2, kBoth };
+    // kUnknown: after a time gap, until the positions are recovered (no platform counts as resting)
+  enum class Motion : std::uint8_t { kRest, kPlatform1, kPlatform2, kBoth, kUnknown };
+
+  /// The first time gap and what became of the positions after it.
+  struct GapRecord {
+    std::uint64_t count = 0;       // gaps seen
+    double t_s = kNaN;             // s, the sample before the first gap
+    double length_s = kNaN;        // s, its length
+    std::uint64_t recovered = 0;   // gaps after which the positions were found again
+    std::uint64_t changed = 0;     // ... and differed from those before the gap (a flip was lost)
+    double recovered_t_s = kNaN;   // s, when the positions after the first gap were found
+  };
+  /// Flips whose measured turn is unlike 2 flip_angle_deg (count) and the mean half-turn, deg.
+  struct FlipAngleRecord {
+    std::uint64_t flips = 0, unlike = 0;
+    double measured_flip_angle_deg = kNaN;  // |turn| / 2 of the first unlike flip
+  };
 
   /// `threshold_dps`: a hinge rate above this is a platform moving (gyro_motion_threshold_dps);
   /// `p1_deg`/`p2_deg`: the positions at the start (initial_plat*_deg).
@@ -33,8 +57,9 @@ class GyroFlipTracker {
 
   /// One sample: raw readings y1/y2 (deg/s, sensor axes), the filter's bias estimate b1/b2 and
   /// the time since the previous sample (NaN for the first).
+  /// `t_s` (optional) dates the gaps.
   void push(const Eigen::Vector3d& y1, const Eigen::Vector3d& y2, const Eigen::Vector3d& b1,
-            const Eigen::Vector3d& b2, double dt_s);
+            const Eigen::Vector3d& b2, double dt_s, double t_s = kNaN);
 
   Motion motion() const { return motion_; }
   /// Platform `i` (1 or 2) at rest at position_deg(i).
@@ -47,6 +72,8 @@ class GyroFlipTracker {
   double position_deg(int i) const { return i == 1 ? p1_ : p2_; }
   /// Flips in which both platforms moved at once (counted when they began).
   std::uint64_t simultaneous_flips() const { return simultaneous_; }
+  const GapRecord& gaps() const { return gap_; }
+  const FlipAngleRecord& flip_angles() const { return angles_; }
 
  private:
   Eigen::Vector3d rest_difference(const Eigen::Vector3d& y1, const Eigen::Vector3d& y2) const;
@@ -56,6 +83,10 @@ class GyroFlipTracker {
   void track_both(const Eigen::Vector3d& y1, const Eigen::Vector3d& y2, const Eigen::Vector3d& b1,
                   const Eigen::Vector3d& b2, double dt_s);
   void end_motion(const Eigen::Vector3d& y1, const Eigen::Vector3d& y2);
+  void note_turn(double turn_deg);
+  void start_gap(double dt_s, double t_s);
+  void seek_positions(const Eigen::Vector3d& y1, const Eigen::Vector3d& y2, const Eigen::Vector3d& b1,
+                      const Eigen::Vector3d& b2, double t_s);
   int quiet_samples() const;
 
   BoxGeometry box_;
@@ -70,6 +101,12 @@ class GyroFlipTracker {
   int quiet_ = 0;
   int starting_ = 0;               // 1 or 2: that platform's hinge rate is above a fifth of the threshold
   std::uint64_t simultaneous_ = 0;
+  GapRecord gap_;
+  FlipAngleRecord angles_;
+  // kUnknown: the four position pairs' differences summed over a block of quiet_samples()
+  std::array<Eigen::Vector3d, 4> seek_sum_{};
+  int seek_n_ = 0;
+  double p1_before_gap_ = kNaN, p2_before_gap_ = kNaN;
 };
 
 }  // namespace driftless::est

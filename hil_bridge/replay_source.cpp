@@ -17,8 +17,11 @@ ReplaySource::~ReplaySource() = default;
 void ReplaySource::describe(log::Metadata& meta) const {
   // the box and sensors are the recording's: keep its geometry, place, rest angles and gyro range
   // (the session's filter takes its geometry from these keys, the log's readers the range)
+  // (a sensor's own range, gyro1_/gyro2_full_scale_dps, overrides the shared one: without it the
+  // session's log would refuse the wider gyro's good readings or hide the narrower one's clipping)
   for (const char* key : {"latitude_deg", "hinge1_axis", "hinge2_axis", "flip_angle_deg", "end_stop_deg",
-                          "gyro_full_scale_dps", "platform_readback", "sensor1_preset", "sensor2_preset"}) {
+                          "gyro_full_scale_dps", "gyro1_full_scale_dps", "gyro2_full_scale_dps",
+                          "platform_readback", "sensor1_preset", "sensor2_preset"}) {
     if (auto v = meta_.get(key)) meta.set(key, *v);
   }
   meta.set("source", name());

@@ -1,6 +1,13 @@
 // calib.yaml from a self-calibration (docs/calibration.md): written, read back to the last bit,
 // turned into the filter's calibration (G subtracted, temperature states starting at k with its
 // sigma) and into a twin prior that plants G and k and nothing M would say.
+#include <algorithm>
+#include <cstdio>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
@@ -221,6 +228,123 @@ TEST(CalibSelfcal, ANegativeOrLargeESigmaIsRefusedWithItsKey) {
   }
 }
 
+// the planted self-calibration with the four end-stop angle errors (deg) and their sigma
+SelfCalibration planted_with_stops() {
+  SelfCalibration sc = planted_with_e();
+  sc.stop_states = true;
+  sc.end_stop_deg << 0.0412, -0.0387, 1.0 / 3.0 * 0.1, 0.0525;
+  sc.end_stop_sigma_deg << 0.0123, 0.0119, 0.05, 0.0;  // 0: exactly known, a frozen state
+  return sc;
+}
+
+TEST(CalibSelfcal, EndStopsReadBackExactlyAndStartTheFiltersStates) {
+  // GIVEN a self-calibration with end-stop states written as calib.yaml
+  const auto path = test::temp_path("selfcal_calib_stops.yaml");
+  const SelfCalibration sc = planted_with_stops();
+  save_selfcal_calib(path, sc);
+  // WHEN it is read back
+  const CalibFile c = load_calib(path);
+  // THEN the four angles and their sigma are the written doubles, named per platform and stop
+  ASSERT_TRUE(c.has_end_stops);
+  EXPECT_EQ(c.end_stop_deg, sc.end_stop_deg);
+  EXPECT_EQ(c.end_stop_sigma_deg, sc.end_stop_sigma_deg);
+  const YAML::Node y = YAML::LoadFile(path.string());
+  EXPECT_EQ(y["end_stops"]["platform2"]["minus90_deg"].as<double>(), sc.end_stop_deg[2]);
+  EXPECT_EQ(y["end_stops"]["platform1"]["plus90_sigma_deg"].as<double>(), sc.end_stop_sigma_deg[1]);
+  // AND a filter built with it starts its end-stop states there, P0 = sigma^2 (0: frozen)
+  est::EstimatorConfig cfg;
+  cfg.self_calibration = true;
+  cfg.calibration = c.to_filter_calibration();
+  const est::DriftlessFilter f(cfg, est::BoxGeometry{});
+  ASSERT_TRUE(f.has_stop_states());
+  EXPECT_EQ(f.stop_angle_deg(), sc.end_stop_deg);
+  EXPECT_LT((f.stop_angle_sigma_deg() - sc.end_stop_sigma_deg).norm(), 1e-15);
+  // AND without end-stop states (flip_angle_sigma_deg 0) M turns to the stop: Rot(a, plat + d)
+  cfg.flip_angle_sigma_deg = 0.0;
+  const est::DriftlessFilter fixed(cfg, est::BoxGeometry{});
+  ASSERT_FALSE(fixed.has_stop_states());
+  EXPECT_EQ(fixed.stop_angle_deg(), Eigen::Vector4d::Zero());
+  const Eigen::Matrix3d want = geo::rot_about_axis_deg(Eigen::Vector3d::UnitX(), -90.0 + sc.end_stop_deg[2]);
+  EXPECT_LT((fixed.body_from_sensor(2, -90.0) - want).norm(), 1e-14);  // E is a state here, not in M
+  // AND a file without them (the end-stop states off) has none
+  SelfCalibration off = sc;
+  off.stop_states = false;
+  save_selfcal_calib(path, off);
+  EXPECT_FALSE(load_calib(path).has_end_stops);
+  EXPECT_FALSE(YAML::LoadFile(path.string())["end_stops"]);
+}
+
+TEST(CalibSelfcal, ThePriorPlantsTheEndStops) {
+  // GIVEN a file with end stops WHEN it becomes a twin prior
+  const auto path = test::temp_path("selfcal_calib_stops_prior.yaml");
+  const SelfCalibration sc = planted_with_stops();
+  save_selfcal_calib(path, sc);
+  const YAML::Node box = YAML::Load(model_prior_yaml(load_calib(path)))["model"]["box"];
+  // THEN the box's stop errors are the file's, [-90 stop, +90 stop] per platform
+  ASSERT_TRUE(box["stop1_error_deg"]) << box;
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_DOUBLE_EQ(box["stop1_error_deg"][k].as<double>(), sc.end_stop_deg[k]) << k;
+    EXPECT_DOUBLE_EQ(box["stop2_error_deg"][k].as<double>(), sc.end_stop_deg[2 + k]) << k;
+  }
+}
+
+// where `key:` first stands after `block` in `text`: its offset and line (1-based)
+std::pair<std::size_t, long> find_key(const std::string& text, const std::string& block, const std::string& key) {
+  const std::size_t at = text.find(key + ":", text.find(block));
+  EXPECT_NE(at, std::string::npos) << key << " not after " << block;
+  return {at, 1 + std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(std::min(at, text.size())), '\n')};
+}
+
+// `text` with that line's `key: value` replaced by `new_key: value`
+std::string with_value(std::string text, const std::string& block, const std::string& key, const std::string& new_key,
+                       const std::string& value) {
+  const std::size_t at = find_key(text, block, key).first;
+  if (at != std::string::npos) text.replace(at, text.find('\n', at) - at, new_key + ": " + value);
+  return text;
+}
+
+TEST(CalibSelfcal, AMalformedEndStopBlockIsRefusedWithFileLineAndKey) {
+  const auto path = test::temp_path("selfcal_calib_stops_bad.yaml");
+  save_selfcal_calib(path, planted_with_stops());
+  std::string good;
+  {
+    std::ifstream in(path);
+    good.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  struct Case {
+    std::string text;
+    long line;
+    std::string key, expected;
+  };
+  // GIVEN a negative sigma, an angle of 20 deg, a platform missing a key (written as another one),
+  // end stops beside calibrated matrices
+  const long sigma_line = find_key(good, "platform2:", "plus90_sigma_deg").second;
+  const long angle_line = find_key(good, "platform2:", "minus90_deg").second;
+  const std::vector<Case> cases = {
+      {with_value(good, "platform2:", "plus90_sigma_deg", "plus90_sigma_deg", "-0.01"), sigma_line,
+       "end_stops.platform2.plus90_sigma_deg", "a sigma must be >= 0 deg"},
+      {with_value(good, "platform2:", "minus90_deg", "minus90_deg", "20"), angle_line, "end_stops.platform2.minus90_deg",
+       "within +-10 deg"},
+      {with_value(good, "platform2:", "minus90_deg", "minus90_offset_deg", "0.001"), angle_line,
+       "end_stops.platform2.minus90_offset_deg", "minus90"},
+      // (the error points at the block: its first line)
+      {with_value(good, "format:", "matrices", "matrices", "calibrated"), find_key(good, "end_stops:", "platform1").second,
+       "end_stops", "matrices: nominal"},
+  };
+  for (const Case& c : cases) {
+    // WHEN it is read THEN the error names the file, the line, the key and what was expected
+    try {
+      parse_calib(c.text, "calib.yaml");
+      ADD_FAILURE() << "accepted: " << c.key;
+    } catch (const InputError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("calib.yaml:" + std::to_string(c.line) + ":"), std::string::npos) << what;
+      EXPECT_NE(what.find(c.key), std::string::npos) << what;
+      EXPECT_NE(what.find(c.expected), std::string::npos) << what;
+    }
+  }
+}
+
 // a box turning about every axis at about 30 deg/s with 20 s standstills: the flips and the turning
 // observe most of E (docs/estimator.md section 1c); the same two sensors on two logs (other noise)
 test::SynthParams turning_pair(std::uint64_t seed) {
@@ -303,6 +427,64 @@ TEST(CalibSelfcal, ASelfCalibrationCarriedIntoTheNextLogRecoversEWithinSigma) {
   for (int r = 0; r < 3; ++r) {
     EXPECT_NEAR(b.g_sensitivity_dps_per_g(2)(r, 1), first.G_dps_per_g[1](r, 1), 3.0 * b.g_sensitivity_sigma_dps_per_g(2)(r, 1)) << r;
     EXPECT_LE(b.g_sensitivity_sigma_dps_per_g(2)(r, 1), sc.G_sigma[1](r, 1) * (1.0 + 1e-9)) << r;
+  }
+}
+
+// the self-calibration a filter ends with, as `estimate --calib-out` writes it
+SelfCalibration written_by(const est::DriftlessFilter& f) {
+  SelfCalibration sc;
+  sc.scale_states = f.has_scale_states();
+  for (int i = 1; i <= 2; ++i) {
+    const auto iu = static_cast<std::size_t>(i - 1);
+    sc.G_dps_per_g[iu] = f.g_sensitivity_dps_per_g(i);
+    sc.G_sigma[iu] = f.g_sensitivity_sigma_dps_per_g(i);
+    sc.E_frac[iu] = f.scale_misalign(i);
+    sc.E_sigma_frac[iu] = f.scale_misalign_sigma(i);
+  }
+  sc.stop_states = f.has_stop_states();
+  sc.end_stop_deg = f.stop_angle_deg();
+  sc.end_stop_sigma_deg = f.stop_angle_sigma_deg();
+  return sc;
+}
+
+// GIVEN the turning pair whose platforms rest 0.12 / -0.08 deg and -0.10 / 0.06 deg off their
+// stops (actual - read, [-90, +90])
+// WHEN a first log is self-calibrated, its end stops (with sigma) written as calib.yaml, read back
+// and given to the self-calibrating filter on a second log of the same box
+// THEN no end-stop sigma grew, each difference of a platform's two stops (what the turning box
+// observes, docs/estimator.md section 1g) is known better than after the first log alone, and every
+// stop lies within 3 of its sigma of the planted one after either run
+TEST(CalibSelfcal, EndStopsCarriedIntoTheNextLogNarrowAndStayWithinSigma) {
+  test::SynthParams first = turning_pair(1), second = turning_pair(2);
+  for (test::SynthParams* p : {&first, &second}) p->stop_error_deg = {Eigen::Vector2d(0.12, -0.08), Eigen::Vector2d(-0.10, 0.06)};
+  const Eigen::Vector4d truth(0.12, -0.08, -0.10, 0.06);
+  const est::DriftlessFilter a = selfcal_run(first, est::Calibration{});
+  ASSERT_TRUE(a.has_stop_states());
+  const auto path = test::temp_path("selfcal_calib_stops_roundtrip.yaml");
+  save_selfcal_calib(path, written_by(a));
+  const est::DriftlessFilter b = selfcal_run(second, load_calib(path).to_filter_calibration());
+  EXPECT_EQ(a.counters().rejected, 0u);
+  EXPECT_EQ(b.counters().rejected, 0u);
+  const Eigen::Vector4d sa = a.stop_angle_sigma_deg(), sb = b.stop_angle_sigma_deg();
+  for (int k = 0; k < 4; ++k) {
+    std::printf("[ info ] stop %d: planted %+.4f, first %+.4f +- %.4f, second %+.4f +- %.4f deg\n", k, truth[k],
+                a.stop_angle_deg()[k], sa[k], b.stop_angle_deg()[k], sb[k]);
+    EXPECT_LE(sb[k], sa[k] * (1.0 + 1e-9)) << k;
+    EXPECT_NEAR(a.stop_angle_deg()[k], truth[k], 3.0 * sa[k]) << k;
+    EXPECT_NEAR(b.stop_angle_deg()[k], truth[k], 3.0 * sb[k]) << k;
+  }
+  // the difference of each platform's two stops: its sigma from the stop block of P
+  for (int p = 0; p < 2; ++p) {
+    Eigen::Matrix<double, 1, est::kFullStateDim> d = Eigen::Matrix<double, 1, est::kFullStateDim>::Zero();
+    d[est::kStopAngle.start + 2 * p] = -1.0;
+    d[est::kStopAngle.start + 2 * p + 1] = 1.0;
+    const double sd_a = std::sqrt((d * a.full_covariance() * d.transpose())(0, 0));
+    const double sd_b = std::sqrt((d * b.full_covariance() * d.transpose())(0, 0));
+    const double diff_b = b.stop_angle_deg()[2 * p + 1] - b.stop_angle_deg()[2 * p];
+    std::printf("[ info ] platform %d: + minus - stop %+.4f +- %.4f (first run's sigma %.4f), planted %+.4f deg\n",
+                p + 1, diff_b, sd_b, sd_a, truth[2 * p + 1] - truth[2 * p]);
+    EXPECT_LT(sd_b, sd_a) << p;
+    EXPECT_NEAR(diff_b, truth[2 * p + 1] - truth[2 * p], 3.0 * sd_b) << p;
   }
 }
 

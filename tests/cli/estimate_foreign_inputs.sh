@@ -5,7 +5,11 @@
 #   P13 --selfcal without accel columns makes flip updates and says G cannot be observed;
 #   P6  both platforms flipping together: "never locked" names the positions that occurred;
 #   P3  two unlike gyros described by gyro1_/gyro2_full_scale_dps;
-#   P8  a repeated time stamp is refused with the way out.
+#   P8  a repeated time stamp is refused with the way out;
+# and (stop-27 findings):
+#   F5  a time gap during a turn: the attitude is withheld from the gap, the gap is a warning;
+#   F16 sample_rate_hz unlike the stamps (or ms stamps) is named first, with the fix;
+#   F3  parallel hinge axes and F24 platforms that never moved are named as such, not "record more flips".
 # usage: estimate_foreign_inputs.sh <path-to-driftless> <source-dir>
 set -uo pipefail
 bin=$1; src=$2
@@ -67,4 +71,44 @@ grep -q "stated full scale of 250 / 2000 deg/s" "$t/own.out" || fail "own full s
 [[ $? -eq 1 ]] || fail "repeated stamp accepted"
 grep -q "dup.csv:[0-9]*: t = .*time must increase strictly.*drop the repeated row, or re-stamp it" "$t/dup.out" ||
   fail "repeated stamp: $(cat "$t/dup.out")"
+
+# F5 GIVEN a 10 s gap while the box turns THEN the attitude is withheld from the gap (it was 89 deg off
+# with 'ok'), the gap is a warning, and --strict exits 1
+"$py" "$gen" --out "$t/gapturn.csv" --gap 118:10 --motion turn --sensor bmi088 --seed 8 --duration 300 > /dev/null ||
+  fail "generator"
+"$bin" estimate --strict --log "$t/gapturn.csv" --out "$t/gapturn" > "$t/gapturn.out" 2>&1
+[[ $? -eq 1 ]] || fail "gap in a turn: expected exit 1 under --strict: $(cat "$t/gapturn.out")"
+grep -q "attitude withheld from t = 117.99 s: the log has no rows for 10[.0-9]* s there" "$t/gapturn.out" ||
+  fail "gap in a turn: not withheld: $(cat "$t/gapturn.out")"
+grep -q "1 time gap(s) longer than 1.0* s in the log, the longest 10.0[0-9]* s after t = 117.99" "$t/gapturn.out" ||
+  fail "gap in a turn: no warning: $(cat "$t/gapturn.out")"
+[[ $(json "$t/gapturn" "d['attitude_drift_deg_per_h']['with_driftless']") == None ]] || fail "gap in a turn: a drift was given"
+
+# F16 GIVEN a 100 Hz log stated as 400 Hz, and the same log stamped in milliseconds THEN each is named
+# first (failed: a factor 4 and 1000), with the fix; check warns too
+sed 's/^# sample_rate_hz: 100$/# sample_rate_hz: 400/' "$t/base.csv" > "$t/rate400.csv"
+"$bin" estimate --log "$t/rate400.csv" --out "$t/rate400" > "$t/rate400.out" 2>&1
+[[ $? -eq 1 ]] || fail "rate 4x off: expected exit 1: $(cat "$t/rate400.out")"
+[[ $(json "$t/rate400" "d['health']['findings'][0]['cause']") == stamp_rate ]] || fail "rate 4x off: $(cat "$t/rate400.out")"
+grep -q "sample_rate_hz says 400 Hz, but the stamps step 0.01 s (100 Hz" "$t/rate400.out" || fail "rate 4x off: $(cat "$t/rate400.out")"
+"$bin" check --log "$t/rate400.csv" | grep -q "warning: sample_rate_hz says 400 Hz" || fail "check: rate 4x off"
+awk -F, 'BEGIN{OFS=","} /^#/ || $1=="t" {print; next} {$1=sprintf("%.3f", $1*1000); print}' "$t/base.csv" > "$t/ms.csv"
+"$bin" estimate --log "$t/ms.csv" --out "$t/ms" > "$t/ms.out" 2>&1
+[[ $? -eq 1 ]] || fail "ms stamps: expected exit 1"
+grep -q "stamps in milliseconds?" "$t/ms.out" || fail "ms stamps: $(cat "$t/ms.out")"
+! grep -q "stamp_rate" "$t/base/summary.json" || fail "base log: a stamp-rate finding"
+
+# F3 GIVEN both hinges about box z THEN the parallel hinges are named first, not "record more flips"
+"$py" "$gen" --out "$t/parallel.csv" --hinge1 0,0,1 --hinge2 0,0,1 --sensor bmi088 --seed 33 --duration 200 > /dev/null ||
+  fail "generator"
+"$bin" estimate --log "$t/parallel.csv" --out "$t/parallel" > "$t/parallel.out" 2>&1
+[[ $? -eq 1 ]] || fail "parallel hinges: expected exit 1"
+[[ $(json "$t/parallel" "d['health']['findings'][0]['cause']") == parallel_hinges ]] || fail "parallel hinges: $(cat "$t/parallel.out")"
+grep -q "hinge1_axis and hinge2_axis are 0.0 deg from parallel" "$t/parallel.out" || fail "parallel: $(cat "$t/parallel.out")"
+
+# F24 GIVEN platforms that never flip THEN that is named, with the one position pair
+"$py" "$gen" --out "$t/still.csv" --period 1000 --sensor bmi088 --seed 201 --duration 200 > /dev/null || fail "generator"
+"$bin" estimate --log "$t/still.csv" --out "$t/still" > "$t/still.out" 2>&1
+[[ $? -eq 1 ]] || fail "never flipped: expected exit 1"
+grep -q "the platforms never moved: all 1 standstill(s) were at (90, 90) deg" "$t/still.out" || fail "never flipped: $(cat "$t/still.out")"
 echo "ok"

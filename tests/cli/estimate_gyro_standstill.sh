@@ -57,4 +57,23 @@ blank "$t/both.csv" "$t/both_blind.csv"
 [[ $? -eq 1 ]] || fail "both together: expected exit 1: $(cat "$t/both.out")"
 "$py" -c "import json,sys; d=json.load(open('$t/both/summary.json')); sys.exit(0 if d['attitude_drift_deg_per_h']['with_driftless'] is None else 1)" ||
   fail "both together: an attitude drift was given"
+
+# GIVEN platforms that rest at +-45 deg and a log without flip_angle_deg THEN the measured flip is
+# named first, with the fix, and the run fails (it named "never locked" alone)
+"$py" "$gen" --out "$t/amp45.csv" --amp 45 --motion turn --sensor bmi088 --seed 5 --duration 200 > /dev/null || fail "generator"
+"$bin" estimate --config "$t/gyro.cfg" --log "$t/amp45.csv" --out "$t/amp45" > "$t/amp45.out" 2>&1
+[[ $? -eq 1 ]] || fail "+-45 deg: expected exit 1: $(cat "$t/amp45.out")"
+grep -q "failed: with 'standstill: gyro' the first flip turned 9[0-9].[0-9] deg.*set flip_angle_deg to the rest angle (about 4[5-7].[0-9]) in the log header" \
+  "$t/amp45.out" || fail "+-45 deg: the flip angle is not named: $(cat "$t/amp45.out")"
+
+# GIVEN a turning box and a time gap that swallows a flip THEN the positions are recovered after it,
+# the lost flip is said, and the attitude is withheld from the gap with the gap as the cause
+"$py" "$gen" --out "$t/gap.csv" --drop 0.02 --gap 100:5 --gap 161:2 --motion turn --sensor bmi088 --seed 13 --duration 300 \
+  > /dev/null || fail "generator"
+"$bin" estimate --config "$t/gyro.cfg" --log "$t/gap.csv" --out "$t/gap" > "$t/gap.out" 2>&1
+grep -q "a time gap of 5[.0-9]* s from t = 99.9[0-9] s hid the platforms; their positions were recovered at .*a flip was lost in the gap" \
+  "$t/gap.out" || fail "gap: the recovery is not said: $(cat "$t/gap.out")"
+grep -q "attitude withheld from t = 99.9[0-9] s: the log has no rows for 5[.0-9]* s there" "$t/gap.out" ||
+  fail "gap: the attitude is not withheld for the gap: $(cat "$t/gap.out")"
+! grep -q "both platforms at once" "$t/gap.out" || fail "gap: blamed on a flip of both platforms: $(cat "$t/gap.out")"
 echo "ok"

@@ -51,7 +51,8 @@ EOF
   --prior-out "$t/prior.yaml" > "$t/sc.out" 2> "$t/sc.err" || fail "selfcal: exit $?: $(cat "$t/sc.out" "$t/sc.err")"
 # THEN calib.yaml holds G with its sigma, the temperature coefficients, nominal matrices
 for key in "format: driftless-calib 1" "method: selfcal" "matrices: nominal" G_dps_per_g G_sigma \
-           scale_misalignment E_frac E_sigma_frac bias_tc_dps_per_degc bias_tc_sigma_dps_per_degc; do
+           scale_misalignment E_frac E_sigma_frac bias_tc_dps_per_degc bias_tc_sigma_dps_per_degc \
+           end_stops platform1 platform2 minus90_deg minus90_sigma_deg plus90_deg plus90_sigma_deg; do
   grep -q "$key" "$t/calib.yaml" || fail "calib.yaml lacks '$key'"
 done
 # AND the G it holds is the planted one where the flips observe it: sensor 2's y column (platform 2
@@ -99,6 +100,12 @@ for key in ("g_sensitivity_sigma_dps_per_g", "scale_misalign_sigma_frac"):
             for c in range(3):
                 if b[key][i][r][c] > a[key][i][r][c] * (1 + 1e-9) + 1e-15:
                     print(f"{key} sensor {i+1} [{r}][{c}]: {b[key][i][r][c]} > {a[key][i][r][c]}"); ok = False
+# the end stops start at the file too: no sigma grew, none moved by more than 3 sigma
+for k in range(4):
+    if b["end_stop_sigma_deg"][k] > a["end_stop_sigma_deg"][k] * (1 + 1e-9) + 1e-15:
+        print(f"end stop {k}: sigma {b['end_stop_sigma_deg'][k]} > {a['end_stop_sigma_deg'][k]}"); ok = False
+    if abs(b["end_stop_deg"][k] - a["end_stop_deg"][k]) > 3 * a["end_stop_sigma_deg"][k]:
+        print(f"end stop {k}: {b['end_stop_deg'][k]} moved from {a['end_stop_deg'][k]}"); ok = False
 G, S = b["g_sensitivity_dps_per_g"][1], b["g_sensitivity_sigma_dps_per_g"][1]
 for r, want in enumerate([0.03, -0.03, -0.06]):
     print(f"second run: sensor 2 G[{r}][y] {G[r][1]:.4f} sigma {S[r][1]:.4f} (first {a['g_sensitivity_sigma_dps_per_g'][1][r][1]:.4f}, planted {want})")
@@ -114,6 +121,29 @@ g=$(grep -o 'matrix_dps_per_g: \[\[[^]]*\], \[[^]]*\]' "$t/twin/scenario.resolve
 # the self-calibrated sensor 2 G[0][y] (summary.json), cut after 4 decimals
 want=$(jq -r '.self_calibration.g_sensitivity_dps_per_g[1][0][1]' "$t/sc/summary.json" | awk '{printf "%.4f", int($1 * 10000) / 10000}')
 [[ $g == *"$want"* ]] || fail "the prior's sensor 2 G (G[0][y] $want) is not in the resolved scenario: $g"
+# AND the box's stop errors are the file's end stops, [-90, +90] per platform (the file's own
+# values, not the planted 0.12 / -0.08 and -0.05 / 0.15: a static box does not observe them)
+python3 - "$t/calib.yaml" "$t/twin/scenario.resolved.yaml" <<'EOF' || fail "the prior's stop errors are not the file's end stops"
+import re, sys
+calib, resolved = open(sys.argv[1]).read(), open(sys.argv[2]).read()
+stops = calib[calib.index("\nend_stops:"):]
+for p in (1, 2):
+    block = stops[stops.index(f"platform{p}:"):]
+    want = [float(re.search(rf"\b{k}_deg: (\S+)", block).group(1)) for k in ("minus90", "plus90")]
+    got = [float(v) for v in re.search(rf"stop{p}_error_deg: \[([^]]*)\]", resolved).group(1).split(",")]
+    print(f"platform {p}: stop errors {got}, calib.yaml {want}")
+    assert all(abs(g - w) < 1e-9 for g, w in zip(got, want)), (got, want)
+EOF
+# a calib.yaml whose end stop has a negative sigma is refused: file, line, key, what was expected, exit 1
+awk '/^  platform2:/ { p = 1 } p && /plus90_sigma_deg:/ && !done { sub(/: .*/, ": -0.01"); done = 1 } { print }' \
+  "$t/calib.yaml" > "$t/bad.yaml"
+line=$(grep -n 'plus90_sigma_deg: -0.01' "$t/bad.yaml" | cut -d: -f1)
+[[ -n $line ]] || fail "could not plant the negative sigma"
+"$bin" estimate --log "$t/b/log.csv" --out "$t/bad" --calib "$t/bad.yaml" > /dev/null 2> "$t/bad.err"
+rc=$?
+[[ $rc -ne 0 ]] || fail "a negative end-stop sigma accepted (exit 0)"
+grep -q "bad.yaml:$line: end_stops.platform2.plus90_sigma_deg: .*a sigma must be >= 0 deg" "$t/bad.err" \
+  || fail "the error does not name file:line:key and what was expected (exit $rc): $(cat "$t/bad.err")"
 # --calib-out without --selfcal is refused
 "$bin" estimate --log "$t/b/log.csv" --out "$t/x" --calib-out "$t/x.yaml" > /dev/null 2> "$t/x.err"
 [[ $? -ne 0 ]] && grep -q -- "--calib-out needs --selfcal" "$t/x.err" || fail "--calib-out without --selfcal accepted"

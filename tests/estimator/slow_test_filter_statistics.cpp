@@ -121,11 +121,14 @@ TEST(FilterTest, LongRunWithBiasWanderTracksTruthAndKeepsPSymmetricPositiveDefin
     const Matrix6d& P = f.covariance_dps2();
     if ((P - P.transpose()).cwiseAbs().maxCoeff() > 0.0 || P.llt().info() != Eigen::Success) ++spd_fail;
   });
-  // THEN >= 95 % of updates hold every component within 3 sigma, and P stays SPD throughout
+  // THEN >= 95 % of updates hold every component within 3 sigma, P stays SPD throughout, and the
+  // gate rejects no more than a consistent filter's chance does: 1e-4 of about 4600 updates is
+  // 0.46 expected, more than 3 has probability 0.1 % (the windowed update's S is no longer
+  // inflated; this seed has 1)
   EXPECT_GT(updates, 4000u);
   EXPECT_GE(double(within) / double(updates), 0.95);
   EXPECT_EQ(spd_fail, 0u);
-  EXPECT_EQ(f.counters().rejected, 0u);
+  EXPECT_LE(f.counters().rejected, 3u);
 }
 
 }  // namespace

@@ -58,6 +58,10 @@ struct SynthParams {
   // scale-factor and misalignment error per sensor (fraction): y_i += E_i (R_i^T w + thetadot_i a_i),
   // w the box's inertial rate: the sensor scales whatever turns it, the flips included
   std::array<Eigen::Matrix3d, 2> E_frac{Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero()};
+  // end-stop angle errors per platform [at the negative stop, at the positive one] (deg, actual -
+  // read about the hinge, as the twin's model.box.stopN_error_deg): the angle columns read the
+  // nominal angles, the sensors turn through the actual ones (the flips too)
+  std::array<Eigen::Vector2d, 2> stop_error_deg{Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};
   double temp0_c = 25.0, temp_rise_c = 0.0, temp_tau_s = 600.0;  // T = T0 + rise (1 - e^-t/tau), degC
   bool write_accel_temp = false;  // log accel (m/s^2, sensor axes) and temperature columns
 };
@@ -113,19 +117,25 @@ inline void synth_samples(const SynthParams& p, const std::function<void(const S
       t1 = a * kS1[pj];
       t2 = p.hold_platform2 ? a : a * kS2[pj];
     };
+    // t1, t2: the angles read; e1, e2: how far the actual ones are off (the stop's error)
+    const auto off = [&](std::size_t i, double read_deg) { return p.stop_error_deg[i][read_deg < 0.0 ? 0 : 1]; };
     double t1, t2, w1 = 0.0, w2 = 0.0;
     angles(c, t1, t2);
+    double e1 = off(0, t1), e2 = off(1, t2);
     bool moving = false;
     if (in >= p.standstill_s) {
       double n1, n2;
       angles(c + 1, n1, n2);
+      const double f1 = off(0, n1), f2 = off(1, n2);
       const double u = (in - p.standstill_s) / p.flip_s;
       const double s = 0.5 * (1.0 - std::cos(kPi * u));
       const double sd = 0.5 * kPi * std::sin(kPi * u) / p.flip_s;
-      w1 = (n1 - t1) * sd;
-      w2 = (n2 - t2) * sd;
+      w1 = (n1 + f1 - t1 - e1) * sd;
+      w2 = (n2 + f2 - t2 - e2) * sd;
       t1 = t1 + (n1 - t1) * s;
       t2 = t2 + (n2 - t2) * s;
+      e1 = e1 + (f1 - e1) * s;
+      e2 = e2 + (f2 - e2) * s;
       moving = true;
     }
     const Eigen::Vector3d w_nb = p.body_rate_dps ? p.body_rate_dps(t) : Eigen::Vector3d::Zero();
@@ -134,8 +144,8 @@ inline void synth_samples(const SynthParams& p, const std::function<void(const S
         p.earth_rate ? Eigen::Vector3d(Eigen::Vector3d(0.0, std::cos(phi), std::sin(phi)) * kEarthRateRadps * kDegPerRad)
                      : Eigen::Vector3d(Eigen::Vector3d::Zero());
     const Eigen::Vector3d w = w_nb + q.conjugate() * w_ie_enu_dps;  // inertial, box axes
-    const Eigen::Matrix3d R1 = Eigen::AngleAxisd(t1 * kRadPerDeg, p.hinge1.normalized()).toRotationMatrix();
-    const Eigen::Matrix3d R2 = Eigen::AngleAxisd(t2 * kRadPerDeg, p.hinge2.normalized()).toRotationMatrix();
+    const Eigen::Matrix3d R1 = Eigen::AngleAxisd((t1 + e1) * kRadPerDeg, p.hinge1.normalized()).toRotationMatrix();
+    const Eigen::Matrix3d R2 = Eigen::AngleAxisd((t2 + e2) * kRadPerDeg, p.hinge2.normalized()).toRotationMatrix();
     const double temp_c = p.temp0_c + p.temp_rise_c * (1.0 - std::exp(-t / p.temp_tau_s));
     const Eigen::Vector3d b1 = p.b1_dps + gm1 + walk1 + p.temp_coef_dps_per_degc[0] * (temp_c - p.temp0_c);
     const Eigen::Vector3d b2 = p.b2_dps + gm2 + walk2 + p.temp_coef_dps_per_degc[1] * (temp_c - p.temp0_c) +
@@ -168,8 +178,8 @@ inline void synth_samples(const SynthParams& p, const std::function<void(const S
     const bool hide = p.nan_while_moving && moving;
     s.plat1_deg = hide && w1 != 0.0 ? kNaN : t1;
     s.plat2_deg = hide && w2 != 0.0 ? kNaN : t2;
-    s.true_plat1_deg = t1;
-    s.true_plat2_deg = t2;
+    s.true_plat1_deg = t1 + e1;
+    s.true_plat2_deg = t2 + e2;
     s.true_bias1_dps = b1;
     s.true_bias2_dps = b2;
     s.true_rate_body_dps = w;

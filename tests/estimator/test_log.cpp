@@ -332,6 +332,33 @@ TEST(LogValidation, TimeGapsAreReportedWithTheirLines) {
   EXPECT_NEAR(r.gaps()[0].length_s, 1e9 - 0.04, 1e-3);
 }
 
+TEST(LogValidation, StampRateFromTheMedianAndTheMeanIntervalAgainstTheStatedRate) {
+  // GIVEN stamps at 400 Hz under a 'sample_rate_hz: 100' line, every 7th row dropped and one 3 s gap
+  const auto path = temp_file("stamp_rate.csv");
+  std::string text = "# format: driftless-log 1\n# sample_rate_hz: 100\n"
+                     "t,gyro1_x,gyro1_y,gyro1_z,gyro2_x,gyro2_y,gyro2_z,plat1_deg,plat2_deg\n";
+  int kept = 0, steps = 0, doubled = 0;  // gap-free intervals: 2.5 ms, or 5 ms over a dropped row
+  for (int i = 0; i < 1000; ++i) {
+    if (i % 7 == 3) continue;
+    const double t = 0.0025 * i + (i >= 500 ? 3.0 : 0.0);
+    text += std::to_string(t) + ",0,0,0,0,0,0,90,90\n";
+    steps += kept > 0 && i != 500 && i != 501 ? 1 : 0;   // row 500 follows the gap (row 499 is kept)
+    doubled += kept > 0 && i % 7 == 4 && i != 501 ? 1 : 0;
+    ++kept;
+  }
+  write_text(path, text);
+  LogReader r(path);
+  Sample s;
+  while (r.next(s)) {
+  }
+  ASSERT_EQ(r.rows_read(), static_cast<std::uint64_t>(kept));
+  // THEN the median interval is the stamps' 2.5 ms (the drops do not move it), the mean one is
+  // over the gap-free intervals (the gap left out), each 2.5 or 5 ms
+  EXPECT_NEAR(r.stamp_rate_median_hz(), 400.0, 1e-3);
+  EXPECT_NEAR(r.stamp_rate_mean_hz(), double(steps) / (0.0025 * (steps + doubled)), 1e-3);
+  EXPECT_EQ(r.gap_count(), 1u);
+}
+
 TEST(LogValidation, ByteOrderMarkAndTextInUnknownColumnsAreAccepted) {
   const auto path = temp_file("bom.csv");
   write_text(path, "\xEF\xBB\xBFt,gyro1_x,gyro1_y,gyro1_z,gyro2_x,gyro2_y,gyro2_z,plat1_deg,plat2_deg,note\n"

@@ -1,0 +1,188 @@
+#include "estimator/flip_check.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace driftless::est {
+namespace {
+
+bool near(double x, double target) { return std::fabs(x / target - 1.0) <= kFlipTurnTolerance; }
+
+double median(std::vector<double> v) {
+  if (v.empty()) return kNaN;
+  const std::size_t h = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(h), v.end());
+  const double hi = v[h];
+  if (v.size() % 2 == 1) return hi;
+  return 0.5 * (hi + *std::max_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(h)));
+}
+
+// a platform whose every flip turned the same way has its "−1" flips wrapped, not signed wrong
+void mark_wrapped(std::vector<FlipTurnRecord>& recs, int platform) {
+  int pos = 0, neg = 0;
+  for (const FlipTurnRecord& r : recs) {
+    if (r.platform != platform || r.kind == FlipTurn::kStuck) continue;
+    (r.turn_deg > 0.0 ? pos : neg) += 1;
+  }
+  if (pos + neg < 2 || (pos > 0 && neg > 0)) return;
+  for (FlipTurnRecord& r : recs) {
+    if (r.platform == platform && r.kind == FlipTurn::kSign) r.kind = FlipTurn::kWrapped;
+  }
+}
+
+// the six channels (bias-corrected: a constant offset keeps the clip's runs of one value)
+void push_clip(ClipDetector& d, const Eigen::Vector3d& y1, const Eigen::Vector3d& y2) {
+  for (int i = 0; i < 3; ++i) {
+    d.push(i, y1[i], false);
+    d.push(3 + i, y2[i], false);
+  }
+}
+
+}  // namespace
+
+FlipTurn classify_flip(const Eigen::Vector3d& v, const Eigen::Vector3d& w, const Eigen::Vector3d& a, double dtheta_deg,
+                       double moving_raw_deg, double resting_raw_deg) {
+  const double d = std::fabs(dtheta_deg);
+  if (!(d > 0.0) || !v.allFinite() || !w.allFinite()) return FlipTurn::kOther;
+  const double vn = v.norm();
+  const double along = vn > 0.0 ? std::fabs(a.dot(v)) / vn : 0.0;  // |cos| of the turn axis to the hinge
+  const double r = a.dot(v) / dtheta_deg;
+  if (along >= kFlipAxisCos) {
+    if (near(r, 1.0)) return FlipTurn::kAgrees;
+    if (near(r, -1.0)) return FlipTurn::kSign;
+    const double ar = std::fabs(r);
+    if (near(ar, kRadPerDeg)) return FlipTurn::kGyroRadPerS;
+    if (near(ar, 1.0 / kRadPerDeg)) return FlipTurn::kAngleRadians;
+    if (near(ar, 1e3)) return FlipTurn::kTimeMs;
+    if (near(ar, 1e6)) return FlipTurn::kTimeUs;
+  }
+  if (vn < kFlipTurnTolerance * d) return FlipTurn::kStuck;
+  // the resting sensor's column turned by about Δθ about the moving hinge while the moving one's
+  // barely turned (the box's own turn in a second is well under half a flip): columns swapped
+  const double wn = w.norm();
+  if (std::fabs(wn / d - 1.0) <= kFlipTurnTolerance && std::fabs(a.dot(w)) >= kFlipAxisCos * wn &&
+      std::fabs(resting_raw_deg / d - 1.0) <= kFlipTurnTolerance && moving_raw_deg < 0.5 * d) {
+    return FlipTurn::kSwapped;
+  }
+  if (along < kFlipAxisCos) return FlipTurn::kAxis;
+  return FlipTurn::kOther;
+}
+
+bool FlipCheck::push(double t_s, const Eigen::Vector3d& y1c_dps, const Eigen::Vector3d& y2c_dps, double plat1_deg,
+                     double plat2_deg, bool both_rest) {
+  const bool valid = std::isfinite(t_s) && y1c_dps.allFinite() && y2c_dps.allFinite();
+  const double dt_s = valid && std::isfinite(t_last_s_) ? t_s - t_last_s_ : kNaN;
+  t_last_s_ = valid ? t_s : kNaN;
+  if (!valid) {  // a flip with a hole in it is not measured
+    open_ = was_rest_ = false;
+    t_back_s_ = kNaN;
+    return false;
+  }
+  if (open_) {
+    if (!std::isfinite(dt_s)) {
+      open_ = false;
+    } else {
+      s1_ += y1c_dps * dt_s;
+      s2_ += y2c_dps * dt_s;
+      push_clip(clip_, y1c_dps, y2c_dps);
+    }
+  }
+  if (both_rest && open_) {
+    if (!std::isfinite(t_back_s_)) {  // back at rest: the end of the turn, then settle_s more
+      t_back_s_ = t_s;
+      p1_end_ = plat1_deg;
+      p2_end_ = plat2_deg;
+    }
+    if (t_s - t_back_s_ < settle_s_) return false;
+  }
+  if (!both_rest) t_back_s_ = kNaN;
+  if (both_rest) {
+    const bool closing = open_;
+    open_ = false;
+    was_rest_ = std::isfinite(plat1_deg) && std::isfinite(plat2_deg);
+    t_rest_s_ = t_s;
+    if (closing) {
+      t_end_s_ = t_back_s_;  // the flip's length leaves the settle time out
+      t_back_s_ = kNaN;
+    }
+    p1_rest_ = plat1_deg;
+    p2_rest_ = plat2_deg;
+    if (!closing || !was_rest_) return false;
+    if (!clip_.suspected().empty()) {  // a gyro clipped in the flip: its turn reads short (saturation finding)
+      ++clipped_;
+      return false;
+    }
+    // one platform turned, the other stayed (within a twentieth of the turn: encoder noise)
+    const double d1 = std::fabs(p1_end_ - p1_start_), d2 = std::fabs(p2_end_ - p2_start_);
+    return std::isfinite(d1 + d2) && std::max(d1, d2) > 0.0 && std::min(d1, d2) < 0.05 * std::max(d1, d2);
+  }
+  if (!open_ && was_rest_ && std::isfinite(dt_s)) {
+    open_ = true;
+    p1_start_ = p1_rest_;
+    p2_start_ = p2_rest_;
+    t_start_s_ = t_rest_s_;
+    s1_ = y1c_dps * dt_s;
+    s2_ = y2c_dps * dt_s;
+    clip_ = ClipDetector{};
+    push_clip(clip_, y1c_dps, y2c_dps);
+  }
+  was_rest_ = false;
+  return false;
+}
+
+void FlipCheck::close(const Frames& f) {
+  FlipTurnRecord r;
+  r.platform = std::fabs(p1_end_ - p1_start_) > std::fabs(p2_end_ - p2_start_) ? 1 : 2;
+  const bool m1 = r.platform == 1;
+  const Eigen::Matrix3d& Mm = m1 ? f.M1_start : f.M2_start;
+  const Eigen::Matrix3d& Ms = m1 ? f.M2_start : f.M1_start;
+  const Eigen::Matrix3d C0 = Mm.transpose() * Ms;  // resting sensor -> moving sensor at its start
+  const Eigen::Vector3d& Sm = m1 ? s1_ : s2_;
+  const Eigen::Vector3d& Ss = m1 ? s2_ : s1_;
+  const Eigen::Vector3d a = (Mm.transpose() * (m1 ? f.hinge1_box : f.hinge2_box)).normalized();
+  const Eigen::Vector3d v = Sm - C0 * Ss, w = Ss - C0.transpose() * Sm;
+  r.t_start_s = t_start_s_;
+  r.duration_s = t_end_s_ - t_start_s_;
+  r.dtheta_deg = m1 ? p1_end_ - p1_start_ : p2_end_ - p2_start_;
+  r.turn_deg = a.dot(v);
+  r.ratio = r.turn_deg / r.dtheta_deg;
+  const double vn = v.norm();
+  r.axis_sensor = vn > 0.0 ? Eigen::Vector3d(v / vn * (r.dtheta_deg < 0.0 ? -1.0 : 1.0)) : Eigen::Vector3d::Zero();
+  r.hinge_sensor = a;
+  r.kind = classify_flip(v, w, a, r.dtheta_deg, Sm.norm(), Ss.norm());
+  records_.push_back(r);
+}
+
+FlipCheckResult FlipCheck::finish() const {
+  std::vector<FlipTurnRecord> recs = records_;
+  mark_wrapped(recs, 1);
+  mark_wrapped(recs, 2);
+  FlipCheckResult out;
+  out.flip_max_s = flip_max_s_;
+  out.clipped = clipped_;
+  for (int p = 1; p <= 2; ++p) {
+    PlatformFlipSummary& s = out.platform[static_cast<std::size_t>(p - 1)];
+    s.first_t_s.fill(kNaN);
+    s.median_ratio.fill(kNaN);
+    std::array<std::vector<double>, kFlipTurnKinds> ratios;
+    for (const FlipTurnRecord& r : recs) {
+      if (r.platform != p) continue;
+      const int k = static_cast<int>(r.kind);
+      ++s.flips;
+      ++s.count[k];
+      if (std::isnan(s.first_t_s[k])) s.first_t_s[k] = r.t_start_s;
+      ratios[k].push_back(r.ratio);
+      if (r.kind == FlipTurn::kAxis) s.axis_sensor += r.axis_sensor;
+      s.hinge_sensor = r.hinge_sensor;
+      if (r.duration_s > flip_max_s_) ++s.slower_than_max;
+      s.longest_s = std::max(s.longest_s, r.duration_s);
+      if (r.kind != FlipTurn::kAgrees && r.kind != FlipTurn::kWrapped) ++out.disagree;
+    }
+    for (int k = 0; k < kFlipTurnKinds; ++k) s.median_ratio[k] = median(ratios[k]);
+    if (s.axis_sensor.norm() > 0.0) s.axis_sensor.normalize();
+    out.flips += s.flips;
+  }
+  return out;
+}
+
+}  // namespace driftless::est
