@@ -287,10 +287,12 @@ class DriftlessFilter {
     double v_s = 0.0;
   };
   static WindowWander window_wander(double t_first_s, double t_last_s, double t_update_s);
+  // the default spelled out, not '= {}': clang refuses a default argument that needs the nested
+  // struct's member initializers while DriftlessFilter is still incomplete (GCC accepts it)
   template <int D>
   bool update(const Eigen::Matrix<double, D, 1>& r, const Eigen::Matrix<double, D, kFullStateDim>& H,
               const Eigen::Matrix<double, D, D>& R, UpdateRecord& rec, bool may_relock = true,
-              WindowWander wander = {});
+              WindowWander wander = WindowWander{0.0, 0.0});
   void emit_update(const UpdateRecord& rec, bool accepted);
   void check_paper_position(double plat1_deg, double plat2_deg, int pattern);
   void fuse_rate(const Sample& s, const StandstillStep& st);
