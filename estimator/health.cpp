@@ -142,7 +142,8 @@ void add_flip_check_findings(HealthReport& h, const FlipCheckResult& r, const Es
     for (int p = 1; p <= 2; ++p) add_flip_kind(first, r, k, {p}, bad);
   }
   for (int p = 1; p <= 2; ++p) {
-    add_flip_kind(first, r, FlipTurn::kWrapped, {p}, selfcal);
+    // the flip updates take Δθ modulo 360 with the turn the gyros saw: wrapped flips are used, a note
+    add_flip_kind(first, r, FlipTurn::kWrapped, {p}, HealthVerdict::kOk);
     // a scale error along the hinge beyond 3 sigma of its prior: the flip gate rejects its flips
     const PlatformFlipSummary& s = r.platform[static_cast<std::size_t>(p - 1)];
     const double ratio = s.median_ratio[static_cast<int>(FlipTurn::kAgrees)];

@@ -79,7 +79,7 @@ enum class HealthCause {
   kFlipTimeUnit,         // turn/Δθ ≈ 1e3 or 1e6: stamps in ms or µs
   kFlipNotSeen,          // the gyro saw no turn where the angle column flipped: stuck platform
   kFlipAngleSign,        // turn/Δθ ≈ −1: the angle counts against the right-hand rule
-  kFlipWrapped,          // one-way platform, angle wrapped at ±180: the flip updates drop those
+  kFlipWrapped,          // one-way platform, angle wrapped at ±180: handled (Δθ modulo 360), a note
   kFlipSensorsSwapped,   // the resting sensor's column turned about the moving hinge
   kFlipAxis,             // the turn is about another axis than the header's hinge (measured_axis)
   kFlipTurnRatio,        // about the hinge by a ratio none of the above
@@ -237,9 +237,10 @@ void add_paper_mode_findings(HealthReport& h, const FilterCounters& counters, do
 
 /// The flip-turn check's findings (flip_check.hpp), ahead of the others (a wrong unit, a stuck
 /// platform or a wrong hinge makes the updates wrong): `failed` when most flips disagree with
-/// their angle columns, else `degraded`; a one-way platform's wrapped flips, a scale error along
-/// a hinge beyond 3 sigma of the prior and flips slower than flip_max_s are `degraded` with
-/// --selfcal (whose flip updates they defeat), notes without it.
+/// their angle columns, else `degraded`; a one-way platform's wrapped flips are a note (the flip
+/// updates take Δθ modulo 360, flip_update.hpp); a scale error along a hinge beyond 3 sigma of the
+/// prior and flips slower than flip_max_s are `degraded` with --selfcal (whose flip updates they
+/// defeat), notes without it.
 void add_flip_check_findings(HealthReport& h, const FlipCheckResult& r, const EstimatorConfig& cfg);
 
 /// Watches the updates of one pass and gives the verdict at the end.
