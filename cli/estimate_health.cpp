@@ -37,6 +37,7 @@ const char* cause_key(est::HealthCause c) {
     case est::HealthCause::kAttitudeWithheldGap: return "attitude_withheld_gap";
     case est::HealthCause::kGyroFlipAngle: return "gyro_flip_angle";
     case est::HealthCause::kGyroGapPositions: return "gyro_gap_positions";
+    case est::HealthCause::kGyroStartMidFlip: return "gyro_start_mid_flip";
     case est::HealthCause::kStampRate: return "stamp_rate";
     case est::HealthCause::kParallelHinges: return "parallel_hinges";
     case est::HealthCause::kNeverFlipped: return "never_flipped";
@@ -381,6 +382,15 @@ std::string describe_input_checks(const est::HealthFinding& f, const est::Estima
                          "on the turning box{}",
                          f.sigma, f.value, f.suggested,
                          f.count > 0 ? ": a flip was lost in the gap" : " (no flip was lost in it)");
+    case est::HealthCause::kGyroStartMidFlip: {
+      const int p = f.components.empty() ? 0 : f.components[0];
+      const double pos = f.positions_deg.empty() ? est::kNaN : f.positions_deg[0][p == 1 ? 0 : 1];
+      return fmt::format("the log starts during a flip of platform {0} (hinge rate {1:.0f} deg/s at t = {2:.2f} s): "
+                         "its first position is unknown until the flip ended at t = {3:.2f} s, so no standstill was "
+                         "taken before; from there platform {0} is at {4:+.0f} deg, the stop its turn went towards "
+                         "(the platforms at {5}); if that is wrong, cut the log after the flip or log plat{0}_deg",
+                         p, f.value, f.sigma, f.suggested, pos, position_text(f.positions_deg));
+    }
     default: break;
   }
   return "?";
@@ -421,6 +431,7 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
     case est::HealthCause::kParallelHinges:
     case est::HealthCause::kNeverFlipped:
     case est::HealthCause::kGyroGapPositions:
+    case est::HealthCause::kGyroStartMidFlip:
       return describe_input_checks(f, cfg);
     case est::HealthCause::kReferenceMismatch:
       return describe_reference(f);

@@ -290,6 +290,18 @@ void add_gyro_standstill_findings(HealthReport& h, const GyroFlipTracker& tracke
     f.count = g.changed;
     add(first, std::move(f));
   }
+  const GyroFlipTracker::StartRecord& st = tracker.start();
+  if (st.mid_flip) {  // handled: no standstill before the flip ended, then the stop it turned towards
+    HealthFinding f;
+    f.cause = HealthCause::kGyroStartMidFlip;
+    f.severity = HealthVerdict::kOk;
+    f.components = {st.platform};
+    f.value = st.rate_dps;
+    f.sigma = st.t_first_s;
+    f.suggested = st.t_known_s;
+    f.positions_deg = {st.positions_deg};
+    add(first, std::move(f));
+  }
   put_first(h, std::move(first));
 }
 

@@ -69,6 +69,10 @@ enum class HealthCause {
   kGyroGapPositions,     // standstill: gyro: a time gap, after which the positions were recovered
                          // (a note; count: 1 if a flip was lost in it) or not (degraded); value: the
                          // sample before the gap, s; sigma: its length, s; suggested: when recovered, s
+  kGyroStartMidFlip,     // standstill: gyro: the log starts during a flip (a note; components: the
+                         // platform; value: its hinge rate at the first sample, deg/s; sigma: the
+                         // first sample, s; suggested: when the positions became known, s;
+                         // positions_deg: the (plat1, plat2) pair from then on)
   kPaperRestAngles,      // paper mode: the platforms rest away from +-flip_angle_deg (eq. (5)'s H)
   kPaperSchedule,        // paper mode: the positions did not follow eq. (5)'s sequence
   kLockLost,             // locked once, then a re-lock widened P and it did not lock again
