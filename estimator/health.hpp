@@ -69,6 +69,10 @@ enum class HealthCause {
   kGyroGapPositions,     // standstill: gyro: a time gap, after which the positions were recovered
                          // (a note; count: 1 if a flip was lost in it) or not (degraded); value: the
                          // sample before the gap, s; sigma: its length, s; suggested: when recovered, s
+  kSteadyStateAtLock,    // locked late (as kLateLock) because the correction sigma had settled at the
+                         // lock level: a longer log gives the same sigma (value: the settled sigma,
+                         // deg/s; sigma: the lock level, deg/s; suggested: the mean update
+                         // interval, s; count: the updates it settled over)
   kGyroStartMidFlip,     // standstill: gyro: the log starts during a flip (a note; components: the
                          // platform; value: its hinge rate at the first sample, deg/s; sigma: the
                          // first sample, s; suggested: when the positions became known, s;
@@ -266,6 +270,7 @@ class HealthMonitor {
   void add_lock_findings(HealthReport& h, const DriftlessFilter& filter, double duration_s) const;
   void add_lock_lost_finding(HealthReport& h, const DriftlessFilter& filter) const;
   std::vector<std::array<double, 2>> positions_if_never_apart() const;
+  bool settled_sigma(double& sigma_dps, double& interval_s) const;
 
   HealthLimits limits_;
   bool locked_ = false, locked_now_ = false;
@@ -278,6 +283,10 @@ class HealthMonitor {
   NisSums nis_before_, nis_locked_;  // accepted updates before lock / from the lock on
   std::map<std::pair<long, long>, PositionCount> by_position_;  // key: positions in 0.1 deg
   double last_rejected_t_s_ = kNaN, last_rejected_nis_ = kNaN;
+  // the last kSettleHistory updates before the lock: time (s) and the largest correction sigma
+  // after each (deg/s), oldest first; whether it had settled (settled_sigma)
+  static constexpr std::size_t kSettleHistory = 8;
+  std::vector<std::array<double, 2>> before_lock_;
 };
 
 }  // namespace driftless::est
