@@ -30,6 +30,7 @@ const char* cause_key(est::HealthCause c) {
     case est::HealthCause::kUnobservable: return "unobservable";
     case est::HealthCause::kRelocks: return "relocks";
     case est::HealthCause::kLateLock: return "late_lock";
+    case est::HealthCause::kSteadyStateAtLock: return "steady_state_at_lock";
     case est::HealthCause::kSignalChainLag: return "signal_chain_lag";
     case est::HealthCause::kSaturation: return "saturation";
     case est::HealthCause::kAttitudeWithheld: return "attitude_withheld";
@@ -37,6 +38,7 @@ const char* cause_key(est::HealthCause c) {
     case est::HealthCause::kAttitudeWithheldGap: return "attitude_withheld_gap";
     case est::HealthCause::kGyroFlipAngle: return "gyro_flip_angle";
     case est::HealthCause::kGyroGapPositions: return "gyro_gap_positions";
+    case est::HealthCause::kGyroStartMidFlip: return "gyro_start_mid_flip";
     case est::HealthCause::kStampRate: return "stamp_rate";
     case est::HealthCause::kParallelHinges: return "parallel_hinges";
     case est::HealthCause::kNeverFlipped: return "never_flipped";
@@ -213,6 +215,18 @@ std::string describe_lock(const est::HealthFinding& f, const est::EstimatorConfi
                          "the NIS against its band or to compare the attitude; record a longer log or more "
                          "flips after the lock",
                          f.value, f.suggested);
+    case est::HealthCause::kSteadyStateAtLock: {
+      // the wander between two updates, and a start level above the settled sigma
+      const double q = cfg.q_dps2_per_s(), wander_dps = std::sqrt(q * f.suggested);
+      const double start_dps = std::ceil(1.5 * f.value * 100.0) / 100.0;
+      return fmt::format("the correction sigma settled at {:.3f} deg/s over the last {} updates before the lock "
+                         "(within 2 % of itself one position cycle earlier), at the lock level {:.3g} deg/s: the "
+                         "bias wanders (q {:.2g} (deg/s)^2/s) by sqrt(q T) = {:.3f} deg/s between updates T = "
+                         "{:.1f} s apart, as much as the updates pin down, so a longer log gives the same sigma and "
+                         "the lock came by chance; flip more often (shorter rests between flips), or compare the "
+                         "attitude anyway with --attitude-start-sigma {:.2f}",
+                         f.value, f.count, f.sigma, q, wander_dps, f.suggested, start_dps);
+    }
     default: break;
   }
   return "?";
@@ -395,6 +409,15 @@ std::string describe_input_checks(const est::HealthFinding& f, const est::Estima
                          "on the turning box{}",
                          f.sigma, f.value, f.suggested,
                          f.count > 0 ? ": a flip was lost in the gap" : " (no flip was lost in it)");
+    case est::HealthCause::kGyroStartMidFlip: {
+      const int p = f.components.empty() ? 0 : f.components[0];
+      const double pos = f.positions_deg.empty() ? driftless::kNaN : f.positions_deg[0][p == 1 ? 0 : 1];
+      return fmt::format("the log starts during a flip of platform {0} (hinge rate {1:.0f} deg/s at t = {2:.2f} s): "
+                         "its first position is unknown until the flip ended at t = {3:.2f} s, so no standstill was "
+                         "taken before; from there platform {0} is at {4:+.0f} deg, the stop its turn went towards "
+                         "(the platforms at {5}); if that is wrong, cut the log after the flip or log plat{0}_deg",
+                         p, f.value, f.sigma, f.suggested, pos, position_text(f.positions_deg));
+    }
     default: break;
   }
   return "?";
@@ -412,6 +435,7 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
     case est::HealthCause::kLockLost:
     case est::HealthCause::kRelocks:
     case est::HealthCause::kLateLock:
+    case est::HealthCause::kSteadyStateAtLock:
       return describe_lock(f, cfg);
     case est::HealthCause::kNoiseUnderstated:
     case est::HealthCause::kNoiseOverstated:
@@ -435,6 +459,7 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
     case est::HealthCause::kParallelHinges:
     case est::HealthCause::kNeverFlipped:
     case est::HealthCause::kGyroGapPositions:
+    case est::HealthCause::kGyroStartMidFlip:
       return describe_input_checks(f, cfg);
     case est::HealthCause::kReferenceMismatch:
       return describe_reference(f);

@@ -60,12 +60,11 @@ std::string platform_text(const est::HealthFinding& f, const est::EstimatorConfi
                          p, how_many(f), f.value);
     case HealthCause::kFlipWrapped:
       return fmt::format("platform {0} turned the same way in every flip, and {1} read the opposite way from "
-                         "plat{0}_deg: the angle wraps at +-180 (a platform that turns one way){2}; log the angle "
-                         "unwrapped (90, 270, 450, ...) or flip back and forth",
+                         "plat{0}_deg: the angle wraps at +-180 (a platform that turns one way){2}; nothing to do",
                          p, how_many(f),
-                         cfg.self_calibration ? ": the self-calibration's flip updates dropped those flips (they take "
-                                                "the turn from the angle columns)"
-                                              : " (the standstills are not affected)");
+                         cfg.self_calibration ? ": handled, the self-calibration's flip updates take the angle change "
+                                                "modulo 360 with the sign and size the gyros saw"
+                                              : " (handled: the standstills use the angle modulo 360)");
     case HealthCause::kFlipSensorsSwapped:
       return fmt::format("in {0} the other sensor's gyro columns turned about hinge{1}_axis, gyro{1}_* did not: "
                          "the gyro1_* and gyro2_* columns are swapped (or plat1_deg and plat2_deg); swap them back",

@@ -6,8 +6,8 @@
 // in rad/s (ratio 1/57.3), angle columns in radians (57.3), stamps in ms or µs (1e3, 1e6), a
 // platform that stuck while its angle column says it flipped (≈ 0), the angle sign (−1), a wrong
 // hinge line or swapped sensor columns (another axis), a scale error along the hinge (1 ± a few
-// %), flips slower than flip_max_s and platforms that always turn the same way with the angle
-// wrapped at ±180° (the self-calibration's flip updates drop both). Eigen + std only; push()
+// %), flips slower than flip_max_s (the self-calibration's flip updates drop them) and platforms
+// that always turn the same way with the angle wrapped at ±180° (handled: a note). Eigen + std only; push()
 // allocates only when a flip ends (one record).
 //
 // The sums are linear in the readings: with C0 = M_m0^T M_s (resting sensor to moving sensor at

@@ -105,13 +105,20 @@ bool accel_ok(const FlipSample& k) { return k.accel1_mps2.allFinite() && k.accel
 
 }  // namespace
 
+double nearest_turn_mod_360_deg(double dtheta_deg, double turn_deg) {
+  if (!std::isfinite(dtheta_deg) || !std::isfinite(turn_deg)) return dtheta_deg;
+  return dtheta_deg + 360.0 * std::round((turn_deg - dtheta_deg) / 360.0);
+}
+
 FlipRows flip_rows(const FlipWindow& w, const FlipModel& m) {
   FlipRows out;
   const std::vector<FlipSample>& buf = w.samples();
   if (buf.empty()) return out;
   const bool m1 = w.moving() == 1;
   const Eigen::Vector3d a = (m.M_moving_start.transpose() * m.hinge_box).normalized();  // moving sensor axes
-  const double dtheta_deg = w.end_deg() - w.start_deg();
+  // the angle columns' change, taken modulo 360 below with the sign and size the gyros saw (a
+  // platform that always turns one way reads +90 -> -90 where it turned +180 through +-180)
+  double dtheta_deg = w.end_deg() - w.start_deg();
   const Eigen::Matrix3d C0 = m.M_moving_start.transpose() * m.M_rest;  // rest sensor -> moving sensor at start
   const Eigen::Vector3d a_s = (m.M_rest.transpose() * m.hinge_rest_box).normalized();  // rest hinge, rest sensor axes
   const auto ym = [m1](const FlipSample& k) -> const Eigen::Vector3d& { return m1 ? k.gyro1_dps : k.gyro2_dps; };
@@ -127,6 +134,7 @@ FlipRows flip_rows(const FlipWindow& w, const FlipModel& m) {
     const Eigen::Vector3d um = corrected(m.moving, ym(k), fm(k), use_g), us = corrected(m.rest, ys(k), fs(k), use_g);
     turn_deg += (a.dot(um) - a.dot(C0 * us)) * k.dt_s;
   }
+  dtheta_deg = nearest_turn_mod_360_deg(dtheta_deg, turn_deg);
   if (!(turn_deg * dtheta_deg > 0.0) || std::fabs(dtheta_deg / turn_deg - 1.0) > 0.2) return out;
   // the profile delta(t) scaled to the angle change the rest readings give (its scale error is E_aa)
   const double lambda = dtheta_deg / turn_deg;

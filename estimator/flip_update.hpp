@@ -119,8 +119,14 @@ struct FlipRows {
 /// integrated turn then falls short of the flip, so the flip is no measurement of E.
 bool flip_clipped(const FlipWindow& w);
 
-/// Builds the flip measurement; invalid when the window is not a clean flip (the gyro-integrated
-/// turn more than 20 % off the angle change or of the other sign). With `use_g` and a sample
+/// The angle change dtheta_deg + k 360 nearest the gyros' turn turn_deg (deg): the angle columns
+/// give the platform's position modulo 360, the gyros how far and which way it turned. A platform
+/// that always turns +180 with its angle wrapped at +-180 reads -180 where it turned +180.
+double nearest_turn_mod_360_deg(double dtheta_deg, double turn_deg);
+
+/// Builds the flip measurement (Δθ: the angle columns' change modulo 360 nearest the gyros' turn);
+/// invalid when the window is not a clean flip (the gyro-integrated turn more than 20 % off that
+/// Δθ or of the other sign). With `use_g` and a sample
 /// without accel the G columns are left out and G f's variance goes into R (g_columns false).
 FlipRows flip_rows(const FlipWindow& w, const FlipModel& m);
 

@@ -142,7 +142,8 @@ void add_flip_check_findings(HealthReport& h, const FlipCheckResult& r, const Es
     for (int p = 1; p <= 2; ++p) add_flip_kind(first, r, k, {p}, bad);
   }
   for (int p = 1; p <= 2; ++p) {
-    add_flip_kind(first, r, FlipTurn::kWrapped, {p}, selfcal);
+    // the flip updates take Δθ modulo 360 with the turn the gyros saw: wrapped flips are used, a note
+    add_flip_kind(first, r, FlipTurn::kWrapped, {p}, HealthVerdict::kOk);
     // a scale error along the hinge beyond 3 sigma of its prior: the flip gate rejects its flips
     const PlatformFlipSummary& s = r.platform[static_cast<std::size_t>(p - 1)];
     const double ratio = s.median_ratio[static_cast<int>(FlipTurn::kAgrees)];
@@ -289,6 +290,18 @@ void add_gyro_standstill_findings(HealthReport& h, const GyroFlipTracker& tracke
     f.count = g.changed;
     add(first, std::move(f));
   }
+  const GyroFlipTracker::StartRecord& st = tracker.start();
+  if (st.mid_flip) {  // handled: no standstill before the flip ended, then the stop it turned towards
+    HealthFinding f;
+    f.cause = HealthCause::kGyroStartMidFlip;
+    f.severity = HealthVerdict::kOk;
+    f.components = {st.platform};
+    f.value = st.rate_dps;
+    f.sigma = st.t_first_s;
+    f.suggested = st.t_known_s;
+    f.positions_deg = {st.positions_deg};
+    add(first, std::move(f));
+  }
   put_first(h, std::move(first));
 }
 
@@ -336,7 +349,12 @@ const char* to_string(HealthVerdict v) {
 void HealthMonitor::on_update(const UpdateRecord& rec, const DriftlessFilter& filter) {
   ++updates_;
   // the lock now (a gate re-lock widens P inside a rejected or an accepted update alike)
-  const bool now = filter.correction_sigma_dps().maxCoeff() < limits_.lock_sigma_dps;
+  const double sigma_dps = filter.correction_sigma_dps().maxCoeff();
+  const bool now = sigma_dps < limits_.lock_sigma_dps;
+  if (!locked_ && !now) {
+    if (before_lock_.size() == kSettleHistory) before_lock_.erase(before_lock_.begin());
+    before_lock_.push_back({rec.t_s, sigma_dps});
+  }
   if (locked_ && locked_now_ && !now) lost_t_s_ = rec.t_s;
   locked_now_ = now;
   PositionCount& pc = by_position_[{tenth_deg(rec.plat1_deg), tenth_deg(rec.plat2_deg)}];
@@ -432,6 +450,25 @@ std::vector<std::array<double, 2>> HealthMonitor::positions_if_never_apart() con
   return pairs;
 }
 
+// the correction sigma before the lock had settled: after each of the last four updates it was
+// within 2 % of its value one position cycle (eq. (5): four updates) earlier. Then the filter sits
+// at its steady state, where the bias's wander between updates balances what each update pins
+// down; sigma_dps: its largest value over the last cycle, interval_s: the mean update interval
+bool HealthMonitor::settled_sigma(double& sigma_dps, double& interval_s) const {
+  constexpr std::size_t kCycle = 4;
+  constexpr double kSettledFraction = 0.02;
+  if (before_lock_.size() < 2 * kCycle) return false;
+  const std::size_t n = before_lock_.size();
+  sigma_dps = 0.0;
+  for (std::size_t k = n - kCycle; k < n; ++k) {
+    const double s = before_lock_[k][1], s_cycle_ago = before_lock_[k - kCycle][1];
+    if (!(std::fabs(s - s_cycle_ago) <= kSettledFraction * s)) return false;
+    sigma_dps = std::max(sigma_dps, s);
+  }
+  interval_s = (before_lock_[n - 1][0] - before_lock_[0][0]) / double(n - 1);
+  return std::isfinite(interval_s) && interval_s > 0.0;
+}
+
 // locked once, then lost it and did not lock again before the end: the estimates at the end carry
 // the widened sigma of the re-lock, not a bias a script may use (failed, as never locked)
 void HealthMonitor::add_lock_lost_finding(HealthReport& h, const DriftlessFilter& filter) const {
@@ -478,6 +515,16 @@ void HealthMonitor::add_lock_findings(HealthReport& h, const DriftlessFilter& fi
     f.cause = HealthCause::kLateLock;
     f.value = h.lock_t_s;
     f.suggested = double(h.nis_updates);
+    // settled at (or within a tenth of) the lock level: the lock came by chance, a longer log
+    // gives the same sigma; say that, not "record a longer log"
+    double settled_dps = kNaN, interval_s = kNaN;
+    if (settled_sigma(settled_dps, interval_s) && settled_dps >= 0.9 * limits_.lock_sigma_dps) {
+      f.cause = HealthCause::kSteadyStateAtLock;
+      f.value = settled_dps;
+      f.sigma = limits_.lock_sigma_dps;
+      f.suggested = interval_s;
+      f.count = before_lock_.size();
+    }
     add(h, f);
   }
   if (!h.unobservable.empty()) {

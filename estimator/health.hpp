@@ -69,6 +69,14 @@ enum class HealthCause {
   kGyroGapPositions,     // standstill: gyro: a time gap, after which the positions were recovered
                          // (a note; count: 1 if a flip was lost in it) or not (degraded); value: the
                          // sample before the gap, s; sigma: its length, s; suggested: when recovered, s
+  kSteadyStateAtLock,    // locked late (as kLateLock) because the correction sigma had settled at the
+                         // lock level: a longer log gives the same sigma (value: the settled sigma,
+                         // deg/s; sigma: the lock level, deg/s; suggested: the mean update
+                         // interval, s; count: the updates it settled over)
+  kGyroStartMidFlip,     // standstill: gyro: the log starts during a flip (a note; components: the
+                         // platform; value: its hinge rate at the first sample, deg/s; sigma: the
+                         // first sample, s; suggested: when the positions became known, s;
+                         // positions_deg: the (plat1, plat2) pair from then on)
   kPaperRestAngles,      // paper mode: the platforms rest away from +-flip_angle_deg (eq. (5)'s H)
   kPaperSchedule,        // paper mode: the positions did not follow eq. (5)'s sequence
   kLockLost,             // locked once, then a re-lock widened P and it did not lock again
@@ -79,7 +87,7 @@ enum class HealthCause {
   kFlipTimeUnit,         // turn/Δθ ≈ 1e3 or 1e6: stamps in ms or µs
   kFlipNotSeen,          // the gyro saw no turn where the angle column flipped: stuck platform
   kFlipAngleSign,        // turn/Δθ ≈ −1: the angle counts against the right-hand rule
-  kFlipWrapped,          // one-way platform, angle wrapped at ±180: the flip updates drop those
+  kFlipWrapped,          // one-way platform, angle wrapped at ±180: handled (Δθ modulo 360), a note
   kFlipSensorsSwapped,   // the resting sensor's column turned about the moving hinge
   kFlipAxis,             // the turn is about another axis than the header's hinge (measured_axis)
   kFlipTurnRatio,        // about the hinge by a ratio none of the above
@@ -240,9 +248,10 @@ void add_paper_mode_findings(HealthReport& h, const FilterCounters& counters, do
 
 /// The flip-turn check's findings (flip_check.hpp), ahead of the others (a wrong unit, a stuck
 /// platform or a wrong hinge makes the updates wrong): `failed` when most flips disagree with
-/// their angle columns, else `degraded`; a one-way platform's wrapped flips, a scale error along
-/// a hinge beyond 3 sigma of the prior and flips slower than flip_max_s are `degraded` with
-/// --selfcal (whose flip updates they defeat), notes without it.
+/// their angle columns, else `degraded`; a one-way platform's wrapped flips are a note (the flip
+/// updates take Δθ modulo 360, flip_update.hpp); a scale error along a hinge beyond 3 sigma of the
+/// prior and flips slower than flip_max_s are `degraded` with --selfcal (whose flip updates they
+/// defeat), notes without it.
 void add_flip_check_findings(HealthReport& h, const FlipCheckResult& r, const EstimatorConfig& cfg);
 
 /// Watches the updates of one pass and gives the verdict at the end.
@@ -264,6 +273,7 @@ class HealthMonitor {
   void add_lock_findings(HealthReport& h, const DriftlessFilter& filter, double duration_s) const;
   void add_lock_lost_finding(HealthReport& h, const DriftlessFilter& filter) const;
   std::vector<std::array<double, 2>> positions_if_never_apart() const;
+  bool settled_sigma(double& sigma_dps, double& interval_s) const;
 
   HealthLimits limits_;
   bool locked_ = false, locked_now_ = false;
@@ -276,6 +286,10 @@ class HealthMonitor {
   NisSums nis_before_, nis_locked_;  // accepted updates before lock / from the lock on
   std::map<std::pair<long, long>, PositionCount> by_position_;  // key: positions in 0.1 deg
   double last_rejected_t_s_ = kNaN, last_rejected_nis_ = kNaN;
+  // the last kSettleHistory updates before the lock: time (s) and the largest correction sigma
+  // after each (deg/s), oldest first; whether it had settled (settled_sigma)
+  static constexpr std::size_t kSettleHistory = 8;
+  std::vector<std::array<double, 2>> before_lock_;
 };
 
 }  // namespace driftless::est

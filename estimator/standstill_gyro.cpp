@@ -48,6 +48,8 @@ void GyroFlipTracker::restart(const BoxGeometry& box) {
   turn1_deg_ = turn2_deg_ = 0.0;
   quiet_ = 0;
   starting_ = 0;
+  fresh_ = true;
+  starting_up_ = false;
   // r1 - r2 = u1 a1 - u2 a2 (+ what lies off both hinges): least squares on [a1, -a2]
   Eigen::Matrix<double, 3, 2> A;
   A.col(0) = box_.hinge1_axis.normalized();
@@ -83,11 +85,17 @@ void GyroFlipTracker::push(const Eigen::Vector3d& y1, const Eigen::Vector3d& y2,
                            const Eigen::Vector3d& b2, double dt_s, double t_s) {
   const double interval_s = std::isfinite(box_.sample_rate_hz) ? 1.0 / box_.sample_rate_hz : kNaN;
   if (std::isfinite(dt_s) && dt_s > gap_threshold_s(interval_s)) start_gap(dt_s, t_s);
+  if (starting_up_) {
+    step_start(y1, y2, b1, b2, dt_s, t_s);
+    return;
+  }
   if (motion_ == Motion::kUnknown) {
     seek_positions(y1, y2, b1, b2, t_s);
     return;
   }
   if (!have_level_) {  // the first sample sets the rest level (the box starts at rest)
+    if (fresh_ && begin_start(y1, y2, b1, b2, t_s)) return;  // it does not: a flip is under way
+    fresh_ = false;
     level_ = rest_difference(y1, y2);
     have_level_ = true;
     return;
@@ -196,17 +204,70 @@ void GyroFlipTracker::note_turn(double turn_deg) {
   if (angles_.unlike++ == 0) angles_.measured_flip_angle_deg = 0.5 * turn;
 }
 
+// the first sample of a source: at rest both sensors read the box rate (plus their biases), so
+// their rate norms agree, wherever the platforms stand; a platform turning at it (the log starts
+// during a flip) makes its norm the larger by about its hinge rate. Then no level is taken: the
+// positions are unknown (kUnknown) until the flip has ended (step_start)
+bool GyroFlipTracker::begin_start(const Eigen::Vector3d& y1, const Eigen::Vector3d& y2, const Eigen::Vector3d& b1,
+                                  const Eigen::Vector3d& b2, double t_s) {
+  norm_diff0_dps_ = (y1 - b1).norm() - (y2 - b2).norm();
+  if (!(std::fabs(norm_diff0_dps_) > thr_dps_)) return false;
+  starting_up_ = true;
+  motion_ = Motion::kUnknown;
+  rate0_dps_ = {box_.hinge1_axis.normalized().dot(y1 - b1), box_.hinge2_axis.normalized().dot(y2 - b2)};
+  start_turn_deg_.setZero();
+  norm_diff_sum_dps_ = 0.0;
+  norm_diff_n_ = 0;
+  start_.t_first_s = t_s;
+  return true;
+}
+
+// the norms' difference stays within the threshold of its running mean for quiet_samples(): the
+// flip has ended. The platform that turned at the first sample (the larger hinge component of its
+// own reading: a turn about a_i keeps a_i, so a_i . y_i is the hinge rate plus the box's rate about
+// a_i) rests where its turn took it: +flip_angle_deg for a positive turn (rests at +-f)
+void GyroFlipTracker::step_start(const Eigen::Vector3d& y1, const Eigen::Vector3d& y2, const Eigen::Vector3d& b1,
+                                 const Eigen::Vector3d& b2, double dt_s, double t_s) {
+  if (std::isfinite(dt_s)) {
+    start_turn_deg_ += Eigen::Vector2d(box_.hinge1_axis.normalized().dot(y1 - b1),
+                                       box_.hinge2_axis.normalized().dot(y2 - b2)) * dt_s;
+  }
+  const double nd = (y1 - b1).norm() - (y2 - b2).norm();
+  if (norm_diff_n_ > 0 && std::fabs(nd - norm_diff_sum_dps_ / double(norm_diff_n_)) > thr_dps_) norm_diff_n_ = 0;
+  if (norm_diff_n_ == 0) norm_diff_sum_dps_ = 0.0;
+  norm_diff_sum_dps_ += nd;
+  if (++norm_diff_n_ < quiet_samples()) return;
+  starting_up_ = false;
+  fresh_ = false;
+  if (std::fabs(norm_diff0_dps_ - norm_diff_sum_dps_ / double(norm_diff_n_)) > thr_dps_) {
+    const int i = std::fabs(rate0_dps_[0]) >= std::fabs(rate0_dps_[1]) ? 1 : 2;
+    const double turn = start_turn_deg_[i - 1];
+    start_.mid_flip = true;
+    start_.platform = i;
+    start_.rate_dps = rate0_dps_[i - 1];
+    start_.t_known_s = t_s;
+    start_.position_deg = turn >= 0.0 ? box_.flip_angle_deg : -box_.flip_angle_deg;
+    (i == 1 ? p1_ : p2_) = start_.position_deg;
+    start_.positions_deg = {p1_, p2_};
+  }
+  // at rest from here: the level from this sample (refined as it rests), as after a flip
+  motion_ = Motion::kRest;
+  level_ = rest_difference(y1, y2);
+  have_level_ = true;
+}
+
 // a time gap: whatever turned in it was not seen, so the positions are unknown from here
 void GyroFlipTracker::start_gap(double dt_s, double t_s) {
   if (gap_.count++ == 0) {
     gap_.t_s = std::isfinite(t_s) ? t_s - dt_s : kNaN;
     gap_.length_s = dt_s;
   }
-  if (motion_ != Motion::kUnknown) {
+  if (motion_ != Motion::kUnknown || starting_up_) {
     p1_before_gap_ = p1_;
     p2_before_gap_ = p2_;
   }
   motion_ = Motion::kUnknown;
+  starting_up_ = fresh_ = false;  // a start still waiting for its flip's end: the gap's search takes over
   turn1_deg_ = turn2_deg_ = 0.0;
   quiet_ = starting_ = 0;
   seek_n_ = 0;

@@ -15,6 +15,9 @@
 // time gap (sample.hpp), in which a flip may have been lost: the positions are then unknown until
 // a rest where exactly one of the four position pairs makes M1 (y1 - b1) - M2 (y2 - b2) vanish
 // (on a turning box the wrong pairs leave (M M'^T - I) w; on a still one all fit: not recovered).
+// A log that starts during a flip (the two sensors' rate norms differ by more than the threshold
+// at the first sample) takes no rest level until the flip has ended; the platform then rests at
+// the stop its turn went towards (start()).
 // Eigen + std only; push() never throws nor allocates.
 #pragma once
 
@@ -43,6 +46,17 @@ class GyroFlipTracker {
     std::uint64_t changed = 0;     // ... and differed from those before the gap (a flip was lost)
     double recovered_t_s = kNaN;   // s, when the positions after the first gap were found
   };
+  /// A log that starts during a flip: the rest level is not taken while a platform turns (it
+  /// would read the turn as the level); the positions are unknown until the first quiet interval.
+  struct StartRecord {
+    bool mid_flip = false;         // the log started while a platform turned
+    int platform = 0;              // 1 or 2: the one that turned at the first sample
+    double rate_dps = kNaN;        // deg/s, its hinge rate (a_i . (y_i - b_i)) at the first sample
+    double t_first_s = kNaN;       // s, the first sample
+    double t_known_s = kNaN;       // s, when the positions became known (the flip had ended)
+    double position_deg = kNaN;    // deg, where its turn took it (the stop it turned towards)
+    std::array<double, 2> positions_deg{kNaN, kNaN};  // deg, both platforms' from t_known_s
+  };
   /// Flips whose measured turn is unlike 2 flip_angle_deg (count) and the mean half-turn, deg.
   struct FlipAngleRecord {
     std::uint64_t flips = 0, unlike = 0;
@@ -52,7 +66,8 @@ class GyroFlipTracker {
   /// `threshold_dps`: a hinge rate above this is a platform moving (gyro_motion_threshold_dps);
   /// `p1_deg`/`p2_deg`: the positions at the start (initial_plat*_deg).
   GyroFlipTracker(const BoxGeometry& box, double threshold_dps, double p1_deg, double p2_deg);
-  /// A new source: the motion and the rest level are forgotten, the positions kept.
+  /// A new source: the motion and the rest level are forgotten, the positions kept. A source
+  /// that starts during a flip waits for the flip to end (start()); its first record is kept.
   void restart(const BoxGeometry& box);
 
   /// One sample: raw readings y1/y2 (deg/s, sensor axes), the filter's bias estimate b1/b2 and
@@ -74,6 +89,7 @@ class GyroFlipTracker {
   std::uint64_t simultaneous_flips() const { return simultaneous_; }
   const GapRecord& gaps() const { return gap_; }
   const FlipAngleRecord& flip_angles() const { return angles_; }
+  const StartRecord& start() const { return start_; }
 
  private:
   Eigen::Vector3d rest_difference(const Eigen::Vector3d& y1, const Eigen::Vector3d& y2) const;
@@ -88,6 +104,10 @@ class GyroFlipTracker {
   void seek_positions(const Eigen::Vector3d& y1, const Eigen::Vector3d& y2, const Eigen::Vector3d& b1,
                       const Eigen::Vector3d& b2, double t_s);
   int quiet_samples() const;
+  bool begin_start(const Eigen::Vector3d& y1, const Eigen::Vector3d& y2, const Eigen::Vector3d& b1,
+                   const Eigen::Vector3d& b2, double t_s);
+  void step_start(const Eigen::Vector3d& y1, const Eigen::Vector3d& y2, const Eigen::Vector3d& b1,
+                  const Eigen::Vector3d& b2, double dt_s, double t_s);
 
   BoxGeometry box_;
   double thr_dps_;
@@ -103,6 +123,14 @@ class GyroFlipTracker {
   std::uint64_t simultaneous_ = 0;
   GapRecord gap_;
   FlipAngleRecord angles_;
+  // the start (kUnknown, starting_up_): the first sample of a source is taken as a rest only when
+  // the two sensors' rate norms agree within the threshold; else the norms' difference must stay
+  // within the threshold of its running mean for quiet_samples() (the flip has ended)
+  bool fresh_ = true, starting_up_ = false;
+  double norm_diff0_dps_ = kNaN, norm_diff_sum_dps_ = 0.0;
+  int norm_diff_n_ = 0;
+  Eigen::Vector2d rate0_dps_ = Eigen::Vector2d::Zero(), start_turn_deg_ = Eigen::Vector2d::Zero();
+  StartRecord start_;
   // kUnknown: the four position pairs' differences summed over a block of quiet_samples()
   std::array<Eigen::Vector3d, 4> seek_sum_{};
   int seek_n_ = 0;

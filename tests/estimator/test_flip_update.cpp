@@ -105,6 +105,20 @@ TEST(FlipUpdateTest, TheFlipMeasurementIsExactOnANoiseFreeFlip) {
   EXPECT_GE(closed[1], 2);
 }
 
+// GIVEN the angle columns' change and the gyros' turn over a flip WHEN Δθ is taken modulo 360
+// THEN it is the representative nearest the turn: a one-way platform's +90 -> -90 (read -180)
+// that turned +180 is +180; a back-and-forth flip keeps its reading; NaN stays NaN
+TEST(FlipUpdateTest, TheAngleChangeIsTakenModulo360WithTheTurnTheGyrosSaw) {
+  EXPECT_DOUBLE_EQ(nearest_turn_mod_360_deg(-180.0, 179.2), 180.0);
+  EXPECT_DOUBLE_EQ(nearest_turn_mod_360_deg(180.0, -181.5), -180.0);
+  EXPECT_DOUBLE_EQ(nearest_turn_mod_360_deg(-180.0, -178.0), -180.0);
+  EXPECT_DOUBLE_EQ(nearest_turn_mod_360_deg(90.0, 91.0), 90.0);
+  EXPECT_DOUBLE_EQ(nearest_turn_mod_360_deg(-270.0, 88.0), 90.0);   // 135 -> -135 read, +90 turned
+  EXPECT_DOUBLE_EQ(nearest_turn_mod_360_deg(170.0, -540.0), -550.0);  // a whole turn and a half
+  EXPECT_TRUE(std::isnan(nearest_turn_mod_360_deg(kNaN, 180.0)));
+  EXPECT_DOUBLE_EQ(nearest_turn_mod_360_deg(-180.0, kNaN), -180.0);
+}
+
 EstimatorConfig selfcal(bool flips) {
   EstimatorConfig cfg;
   cfg.self_calibration = true;

@@ -2,6 +2,7 @@
 // from the sensor equation y_i = Rot(a_i, theta_i)^T w + theta_i' a_i + b_i: a turning box whose
 // platforms flip one at a time and then both at once. The box rate made from the resting sensors
 // is integrated and compared with the truth: the attitude the estimator makes in 'standstill: gyro'.
+#include <array>
 #include <cmath>
 #include <vector>
 
@@ -148,4 +149,60 @@ TEST(GyroFlipTracker, BothPlatformsAtOnceAreSaidAndTrackedToTheirNewPositions) {
 }
 
 }  // namespace
+// GIVEN a log that starts half-way through platform 2's flip (+90 -> -90, -360 deg/s at t = 0) on
+// a box turning at up to 30 deg/s, then a flip of platform 1 at 10 s and of platform 2 at 20 s,
+// the bias estimate 0 (the filter's before any update)
+// WHEN tracked from the first sample, the configuration's start positions (90, 90)
+// THEN no platform is said to rest while it turns faster than 10 deg/s, the start is recorded
+// (platform 2, its hinge rate at t = 0 within the box rate's 20 deg/s and the bias of -360, known
+// 0.25 s after the flip's end at 0.5 s, within 0.1 s, at -90), and the positions
+// follow the later flips: (-90, -90) at 15 s, (-90, +90) at the end. The same log starting at rest
+// records no such start.
+TEST(GyroFlipTracker, ALogStartingMidFlipWaitsForTheFlipToEndAndTakesItsStop) {
+  BoxGeometry box;
+  box.sample_rate_hz = kRateHz;
+  box.validate();
+  const Eigen::Vector3d b1(1.5, -0.7, 0.4), b2(-2.0, 0.3, 1.1), zero = Eigen::Vector3d::Zero();
+  const auto track = [&](const Platform& pl1, const Platform& pl2, std::array<double, 2>& at_15, bool& wrong_rest) {
+    GyroFlipTracker tr(box, 5.0, 90.0, 90.0);
+    wrong_rest = false;
+    for (int k = 0; k <= 3000; ++k) {
+      const double t = k / kRateHz;
+      double th1, th1d, th2, th2d;
+      pl1.at(t, th1, th1d);
+      pl2.at(t, th2, th2d);
+      const Eigen::Vector3d w = box_rate_dps(t);
+      tr.push(geo::rot_about_axis_deg(box.hinge1_axis, th1).transpose() * w + th1d * box.hinge1_axis + b1,
+              geo::rot_about_axis_deg(box.hinge2_axis, th2).transpose() * w + th2d * box.hinge2_axis + b2, zero, zero,
+              k == 0 ? std::nan("") : 1.0 / kRateHz, t);
+      wrong_rest |= (tr.rest(1) && std::fabs(th1d) > 10.0) || (tr.rest(2) && std::fabs(th2d) > 10.0);
+      if (k == 1500) at_15 = {tr.position_deg(1), tr.position_deg(2)};
+    }
+    return tr;
+  };
+  std::array<double, 2> at_15{};
+  bool wrong_rest = true;
+  const GyroFlipTracker tr = track(Platform{{10.0}}, Platform{{-0.5, 20.0}}, at_15, wrong_rest);
+  EXPECT_FALSE(wrong_rest);
+  const GyroFlipTracker::StartRecord& s = tr.start();
+  EXPECT_TRUE(s.mid_flip);
+  EXPECT_EQ(s.platform, 2);
+  EXPECT_NEAR(s.rate_dps, -360.0, 20.0 + 2.0);
+  EXPECT_EQ(s.t_first_s, 0.0);
+  // the raised cosine's rate falls under the 5 deg/s threshold 0.0375 s before the flip's end
+  // (1 - cos(2 pi u) = 5 / 180); the norms then agree within it, give or take the biases' part
+  EXPECT_GE(s.t_known_s, 0.5 - 0.1 + 0.25);
+  EXPECT_LE(s.t_known_s, 0.5 + 0.25 + 0.1);
+  EXPECT_EQ(s.position_deg, -90.0);
+  EXPECT_EQ(at_15[0], -90.0);
+  EXPECT_EQ(at_15[1], -90.0);
+  EXPECT_EQ(tr.position_deg(1), -90.0);
+  EXPECT_EQ(tr.position_deg(2), 90.0);
+  const GyroFlipTracker at_rest = track(Platform{{10.0}}, Platform{{20.0}}, at_15, wrong_rest);
+  EXPECT_FALSE(at_rest.start().mid_flip);
+  EXPECT_FALSE(wrong_rest);
+  EXPECT_EQ(at_15[0], -90.0);
+  EXPECT_EQ(at_15[1], 90.0);
+}
+
 }  // namespace driftless::est
