@@ -56,10 +56,12 @@ void ReferenceCheck::push(const Sample& s, const Eigen::Vector3d& rate_body_dps,
     return;
   }
   // trapezoid in the body frame, as AttitudeIntegrator does (the Earth rate, <= 0.0042 deg/s, is
-  // left in: far below the turns compared)
+  // left in: far below the turns compared), with the step's quaternion to second order in its
+  // half-angle h (angle error |phi|^3 / 48 per step: 3e-9 rad at 30 deg/s and 100 Hz, 3e-7 rad over a
+  // 1 s window, against turns of degrees); no sine or cosine per sample
   const double dt_s = s.t_s - t_last_s_;
-  const Eigen::Vector3d w_rad = 0.5 * (rate_last_dps_ + rate_body_dps) * kRadPerDeg;
-  q_gyro_ = (q_gyro_ * geo::quat_from_rotvec(w_rad * dt_s)).normalized();
+  const Eigen::Vector3d h = (0.25 * dt_s * kRadPerDeg) * (rate_last_dps_ + rate_body_dps);
+  q_gyro_ = (q_gyro_ * Eigen::Quaterniond(1.0 - 0.5 * h.squaredNorm(), h.x(), h.y(), h.z())).normalized();
   t_last_s_ = s.t_s;
   rate_last_dps_ = rate_body_dps;
   if (s.t_s - t0_s_ >= lim_.window_s) {

@@ -107,9 +107,11 @@ void NoiseTuner::close_visit() {
   auto it = last_visit_.find(visit_key_);
   if (it != last_visit_.end()) {
     const Visit& a = it->second;
+    // each visit spans its samples at the log's rate (its blocks are contiguous)
+    const double spans_s = double(visit_.n + a.n) / rate_hz_;
     wander_.push_back({visit_.r_sum / double(visit_.n) - a.r_sum / double(a.n),
                        visit_.x_sum / double(visit_.n) - a.x_sum / double(a.n), visit_key_,
-                       visit_.t_mid_s - a.t_mid_s, 1.0 / double(visit_.n) + 1.0 / double(a.n)});
+                       visit_.t_mid_s - a.t_mid_s, spans_s / 6.0, 1.0 / double(visit_.n) + 1.0 / double(a.n)});
   }
   last_visit_[visit_key_] = visit_;
   visit_ = Visit{};
@@ -161,7 +163,9 @@ TuneResult NoiseTuner::finish() {
   const double sigma2 = ss / (2.0 * dof);  // (deg/s)^2 per sample and axis: E[SS] = 2 sigma^2 dof
   t.noise_estimated = sigma2 > 0.0;
   t.noise_density_dps_rthz = std::sqrt(sigma2 / rate_hz_);
-  // K^2 = sum(|dr - coef^T dx|^2 - 6 sigma^2 w) / sum(6 dt)
+  // K^2 = sum(|dr - coef^T dx|^2 - 6 sigma^2 w) / sum(6 (dt - window)): the difference of two
+  // visits' means of a random walk has variance q (dt - (span_a + span_b) / 6) per component, dt
+  // between their midpoints (dt alone read q 8-16 % low on 20 s standstills revisited every 40-80 s)
   t.wander_pairs = wander_.size();
   if (wander_.size() < limits_.min_wander_pairs) return t;
   double num = 0.0, den = 0.0, num_var = 0.0;
@@ -174,7 +178,7 @@ TuneResult NoiseTuner::finish() {
       coef_error = 6.0 * sigma2 * p.dx.dot(m->second.xx_inv * p.dx);
     }
     num += (p.dr - motion).squaredNorm() - 6.0 * sigma2 * p.inv_n - coef_error;
-    den += 6.0 * p.dt_s;
+    den += 6.0 * (p.dt_s - p.window_s);
     // without wander |dr|^2 is v chi-square(3), v = 2 sigma^2 inv_n per axis: variance 6 v^2
     const double v = 2.0 * sigma2 * p.inv_n;
     num_var += 6.0 * v * v;

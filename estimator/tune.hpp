@@ -105,7 +105,9 @@ class NoiseTuner {
     Eigen::Vector3d dr;
     Regressors dx;
     std::pair<long, long> key;
-    double dt_s, inv_n;
+    // dt_s: between the visits' midpoints; window_s: (span_a + span_b) / 6, what averaging over the
+    // two visits takes off a random walk's variance of their difference: q (dt_s - window_s)
+    double dt_s, window_s, inv_n;
   };
   std::vector<WanderPair> wander_;
   // the standstill being collected, and the last visit per position pair (0.1 deg keys)

@@ -2,6 +2,7 @@
 // and the bias random walk K of seeded synthetic logs, and a filter tuned with them is consistent
 // where the defaults were not.
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <random>
 
@@ -47,6 +48,34 @@ TEST(TuneTest, RecoversNoiseDensityAndRandomWalk) {
   ASSERT_TRUE(t.q_estimated);
   EXPECT_GT(t.wander_pairs, 150u);
   EXPECT_NEAR(t.q_dps2_per_s, Noisy::kK2, 0.35 * Noisy::kK2);
+}
+
+// GIVEN 16 seeds of 30 min of the noisy sensor (its wander a random walk over the revisits), only
+// platform 1 flipping: each position is revisited 22 s after the last visit's middle, and a visit
+// spans 10 s
+// WHEN each is tuned
+// THEN the mean K^2 over the seeds is K^2 within 3 standard errors of that mean (each run's K^2
+// scatters by about 10 %, so 3 SE of 16 is 7.5 %): the revisits' spans are taken off their
+// interval (a random walk averaged over spans a and b differs by q (dt - (a + b) / 6): here
+// 22 - 20/6 = 18.7 s, so dt alone reads 0.85 K^2)
+TEST(TuneTest, TheRandomWalkIsUnbiasedOverSeeds) {
+  constexpr int kSeeds = 16;
+  double sum = 0.0, sum2 = 0.0;
+  for (int i = 0; i < kSeeds; ++i) {
+    Noisy n(100 + static_cast<std::uint64_t>(i), 1800.0);
+    n.p.hold_platform2 = true;
+    NoiseTuner tuner(EstimatorConfig{}, test::synth_geometry(n.p));
+    test::synth_samples(n.p, [&](const Sample& s) { tuner.push(s); });
+    const TuneResult t = tuner.finish();
+    ASSERT_TRUE(t.q_estimated);
+    const double ratio = t.q_dps2_per_s / Noisy::kK2;
+    sum += ratio;
+    sum2 += ratio * ratio;
+  }
+  const double mean = sum / kSeeds, sd = std::sqrt((sum2 - kSeeds * mean * mean) / (kSeeds - 1));
+  std::printf("[ info ] K^2 / truth over %d seeds: mean %.4f, SD %.4f\n", kSeeds, mean, sd);
+  EXPECT_LT(sd, 0.2);  // the 10 % a run scatters by, with room
+  EXPECT_NEAR(mean, 1.0, 0.075);
 }
 
 TEST(TuneTest, TooLittleDataKeepsTheConfiguredValues) {
