@@ -19,6 +19,16 @@ if(DRIFTLESS_SANITIZE)
   target_link_options(driftless_flags INTERFACE -fsanitize=address,undefined -gz)
 endif()
 
+# driftless_pch_for_ccache(target): a target that builds or uses a precompiled header. clang writes
+# the time stamps of the headers into the header it precompiles: every fresh clone's header then
+# differs, and ccache, which hashes it, would compile every file that uses it again (ccache manual,
+# "Precompiled headers"). GCC needs nothing (scripts/build.sh sets ccache's pch sloppiness).
+function(driftless_pch_for_ccache target)
+  if(CMAKE_CXX_COMPILER_ID MATCHES "Clang")
+    target_compile_options(${target} PRIVATE "SHELL:-Xclang -fno-pch-timestamp")
+  endif()
+endfunction()
+
 # the repository root is the include root, so an include names its folder:
 #   #include "estimator/log.hpp"   (and estimator/ never includes twin/, hil_bridge/ or renders/)
 set(DRIFTLESS_SOURCE_ROOT ${PROJECT_SOURCE_DIR})
@@ -44,6 +54,7 @@ function(driftless_add_test name)
   set_target_properties(${name} PROPERTIES CROSSCOMPILING_EMULATOR ${DRIFTLESS_TEST_RUNNER})
   # GoogleTest, Eigen and the standard library parsed once for every test (tests/CMakeLists.txt)
   target_precompile_headers(${name} REUSE_FROM driftless_test_pch)
+  driftless_pch_for_ccache(${name})
   # with the standard library from a precompiled header, GCC 12 at -O2 inlines std::string's
   # operator+ chains further and reports false -Warray-bounds, -Wrestrict and -Wstringop-overflow
   # on them (GCC bugs 105329, 105651); test code only, the product keeps these warnings as errors
@@ -64,14 +75,27 @@ function(driftless_add_test name)
     WORKING_DIRECTORY ${PROJECT_BINARY_DIR})
 endfunction()
 
-# driftless_add_tests_in_folder(LIBS ...): every test_*.cpp / slow_test_*.cpp here or in a subfolder is one binary.
+# driftless_add_tests_in_folder(LIBS ... [ALONE stem ...]): the test_*.cpp files here and in the
+# subfolders make one GoogleTest program, <folder>_tests; the slow_test_*.cpp files another,
+# <folder>_slow_tests (label 'slow'). A file named in ALONE (its stem) is a program of its own,
+# <folder>_<stem>, for flags the others do not share. The tests' names (Suite.Name) and labels are
+# the same as with one program per file; CTest runs each test as before.
+# One program per folder instead of one per file: ~100 links and ~100 test listings (each run at
+# build time) become ~20, and the files of a program compile in unity batches
+# (DRIFTLESS_TEST_UNITY_BATCH files per translation unit): GoogleTest's and Eigen's templates are
+# instantiated once a batch instead of once a file. A file whose names clash with another's in a
+# batch is named in the folder's NOT_UNITY list: it compiles on its own, in the same program.
+set(DRIFTLESS_TEST_UNITY_BATCH 8 CACHE STRING "test files per translation unit (unity build); 1: one per file")
 function(driftless_add_tests_in_folder)
-  cmake_parse_arguments(ARG "" "" "LIBS" ${ARGN})
+  cmake_parse_arguments(ARG "" "" "LIBS;ALONE;NOT_UNITY" ${ARGN})
   # subfolders mirror the source's (tests/twin/sensor/ for twin/sensor/); the label and the
   # target prefix stay the top folder's
   file(GLOB_RECURSE files CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/test_*.cpp
        ${CMAKE_CURRENT_SOURCE_DIR}/slow_test_*.cpp)
+  list(SORT files)
   get_filename_component(folder ${CMAKE_CURRENT_SOURCE_DIR} NAME)
+  set(fast "")
+  set(slow "")
   foreach(f ${files})
     get_filename_component(stem ${f} NAME_WE)
     # one label per test: a list would be split into separate PROPERTIES arguments by
@@ -83,7 +107,29 @@ function(driftless_add_tests_in_folder)
       endif()
       set(labels slow)
     endif()
-    driftless_add_test(${folder}_${stem} SOURCES ${f} LIBS ${ARG_LIBS} LABELS "${labels}")
+    if(stem IN_LIST ARG_ALONE)
+      driftless_add_test(${folder}_${stem} SOURCES ${f} LIBS ${ARG_LIBS} LABELS "${labels}")
+    elseif(stem MATCHES "^slow_")
+      list(APPEND slow ${f})
+    else()
+      list(APPEND fast ${f})
+    endif()
+    if(stem IN_LIST ARG_NOT_UNITY)
+      set_source_files_properties(${f} PROPERTIES SKIP_UNITY_BUILD_INCLUSION ON)
+    endif()
+  endforeach()
+  foreach(kind tests slow_tests)
+    set(sources ${fast})
+    set(labels ${folder})
+    if(kind STREQUAL "slow_tests")
+      set(sources ${slow})
+      set(labels slow)
+    endif()
+    if(sources)
+      driftless_add_test(${folder}_${kind} SOURCES ${sources} LIBS ${ARG_LIBS} LABELS "${labels}")
+      set_target_properties(${folder}_${kind} PROPERTIES UNITY_BUILD ON
+                            UNITY_BUILD_BATCH_SIZE ${DRIFTLESS_TEST_UNITY_BATCH})
+    endif()
   endforeach()
 endfunction()
 

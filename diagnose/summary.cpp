@@ -15,8 +15,6 @@
 namespace driftless::diagnose {
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
-
 // Ljung-Box portmanteau of a whitened series: Q, its p-value on lags - fitted degrees of
 // freedom, and the effect size sum rho_h^2 - lags/m (about the fraction of the residual's
 // variance its own past predicts, debiased: white noise gives ~0 on average)

@@ -3,6 +3,7 @@
 set -euo pipefail
 packages=(
   build-essential cmake pkg-config ccache git universal-ctags
+  ninja-build  # the build tool (scripts/build.sh): targets overlap, shorter start-up than make
   lld  # the linker (CMakeLists.txt: DRIFTLESS_USE_LLD), a third of GNU ld's link time
   libmujoco-dev libqhull-dev libeigen3-dev libyaml-cpp-dev libosmesa6-dev
   libpng-dev libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev libfmt-dev libfast-float-dev
