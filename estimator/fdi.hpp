@@ -9,6 +9,8 @@
 // sensor that are not on the hinge), which is what isolates the sensor and the axis.
 #pragma once
 
+#include <array>
+#include <cmath>
 #include <cstdint>
 #include <deque>
 #include <optional>
@@ -50,6 +52,16 @@ struct FdiParams {
   double isolation_margin = 40.0;      // chi-square gap between best and second hypothesis
   int max_isolation_segments = 8;      // at-rest segments to wait before reporting a best guess
   double history_s = 5.0;              // s of samples kept to find the onset of a fault
+  double lock_sigma_dps = 0.05;        // deg/s: the noise is learned only once the filter has locked,
+                                       // its estimate's sigma in the residual, sqrt(diag(H P H^T)),
+                                       // below this on every box axis (an unlocked filter's residual
+                                       // carries its estimate error, not the noise)
+  double quiet_rate_dps = 3.0;         // deg/s: box rate up to which an at-rest sample is "quiet": the
+                                       // samples the noise is learned from and the position check
+                                       // compares (a turning box adds misalignment x rate)
+  double revisit_sigma_dps = 0.02;     // deg/s: how far the residual's mean at one platform-position
+                                       // pair may move between visits without a fault (bias wander,
+                                       // g-sensitivity under changing accelerations)
   /// Throws std::invalid_argument naming the field on a bad value.
   void validate() const;
 };
@@ -82,6 +94,24 @@ struct FaultReport {
   std::string describe() const;
 };
 
+/// An alarm the platform positions explain: the residual's offset after the alarm equals its mean
+/// at the earlier visits of the same platform-position pair (a position-dependent error of
+/// uncalibrated sensors: g-sensitivity, misalignment, scale), so no step-type fault is reported.
+/// Over every explained alarm so far (the times are the latest one's).
+struct UncalibratedReport {
+  double t_alarm_s = 0.0;      // s, the latest alarm that was explained
+  double t_decided_s = 0.0;    // s, when the position check decided it
+  double offset_dps = 0.0;     // deg/s, largest |quiet innovation mean| of a checked segment (what alarmed)
+  double change_dps = 0.0;     // deg/s, largest |change| of a checked segment against its earlier visits
+  double step_chi2 = 0.0;      // largest gain of the best bias-step hypothesis over "no change"
+                               // (chi-square units; each below isolation_margin)
+  int segments = 0;            // post-alarm segments compared with earlier visits of their pair
+  int while_turning = 0;       // of them: alarms whose offset the quiet samples did not carry (it came
+                               // while the box turned: misalignment or scale x rate)
+  int alarms = 0;              // alarms explained
+  std::string describe() const;
+};
+
 /// Detector state as returned by push().
 enum class FdiStatus : std::uint8_t {
   kLearning,   // learning the residual noise
@@ -98,6 +128,7 @@ class FaultDetector {
 
   /// Consumes one sample and returns the detector state after it.
   FdiStatus push(const FdiInput& in);
+  const FdiParams& params() const { return p_; }
   /// The isolated fault, once status is kIsolated (latched: a single-fault detector).
   const std::optional<FaultReport>& fault() const { return fault_; }
   /// Time of the first alarm, if any (also for alarms later classified as faults).
@@ -109,6 +140,18 @@ class FaultDetector {
   Eigen::Vector3d residual_sigma_longrun_dps() const;
   /// Forgets the fault and restarts monitoring (keeps the learned noise).
   void reset_alarm();
+  /// The latest alarm the platform positions explained (not a fault; docs/fdi.md).
+  const std::optional<UncalibratedReport>& uncalibrated() const { return uncalibrated_; }
+  /// When the filter was first seen locked (learning starts then), s; NaN before.
+  double t_filter_locked_s() const { return t_locked_s_; }
+  /// Time of the first sample the noise is learned from, s; NaN before.
+  double t_learn_start_s() const { return t_learn_start_s_; }
+  /// Quiet at-rest samples and rest segments the noise was learned from (0 while learning).
+  long learned_samples() const { return learned_samples_; }
+  long learned_segments() const { return learned_segments_; }
+  /// True when the noise was learned from quiet samples only (box rate <= quiet_rate_dps), false
+  /// when the box was hardly ever quiet and every rest sample was used.
+  bool learned_on_quiet() const { return learned_on_quiet_; }
 
  private:
   struct Record {           // one at-rest sample kept for onset search and isolation
@@ -118,8 +161,30 @@ class FaultDetector {
     Eigen::Vector3d fused;  // fused box rate (R1 (y1-b1) + R2 (y2-b2)) / 2, deg/s
     Eigen::Matrix3d R1, R2;
     Vector6d bias;
+    bool quiet;             // box rate <= quiet_rate_dps
   };
+  // one rest segment's quiet residuals: the position check's memory of each visit
+  struct Visit {
+    long segment;
+    Eigen::Matrix3d R1, R2;
+    double n = 0;            // quiet samples
+    double n_all = 0;        // all its samples
+    Eigen::Vector3d sum_r = Eigen::Vector3d::Zero();
+    // all samples: per box axis j, sums of the fused rate w_j and of w_j^2, r_j, w_j r_j (the
+    // residual's slope on the rate at this visit: what a scale change would change)
+    Eigen::Vector3d s_w = Eigen::Vector3d::Zero(), s_ww = Eigen::Vector3d::Zero(),
+                    s_r = Eigen::Vector3d::Zero(), s_wr = Eigen::Vector3d::Zero();
+  };
+  struct PositionEvidence;
+  PositionEvidence position_evidence() const;
+  enum class PositionCheck : std::uint8_t { kDecided, kChange, kNoData };
+  PositionCheck try_position_check(double t_s, bool timeout, std::array<double, 6>* change_mag);
+  void remember_visit(const Record& rec);
+  double scale_change_z(int j) const;
+  void explain(double t_s, double offset_dps, double change_dps, double step_chi2, int segments, bool while_turning);
   void check_stuck(const FdiInput& in);
+  void resume_monitoring();
+  bool learn(const FdiInput& in, const Record& rec, const Eigen::Vector3d& nu, const Eigen::Vector3d& est_var);
   void alarm(double t_s, long onset_index);
   void feed_isolation(const Record& rec);
   void try_classify(double t_s);
@@ -133,9 +198,14 @@ class FaultDetector {
   Eigen::Matrix<double, 6, 1> last_value_;
   Eigen::Matrix<int, 6, 1> run_;
   // learning: the at-rest innovations (with their segment) of the first learn_s
-  void finish_learning();
-  std::vector<std::pair<long, Eigen::Vector3d>> learn_;
-  long learn_n_ = 0;
+  bool finish_learning(const std::vector<std::pair<long, Eigen::Vector3d>>& pieces);
+  std::vector<std::pair<long, Eigen::Vector3d>> learn_quiet_, learn_all_;  // (piece, innovation)
+  double t_learn_quiet_s_ = std::nan(""), t_learn_all_s_ = std::nan("");
+  bool learned_on_quiet_ = false;
+  long learn_piece_ = 0;         // contiguous runs of quiet rest samples (the autocovariances' unit)
+  bool learn_prev_in_ = false;
+  long learn_segment_ = -1;
+  double t_learn_start_s_ = std::nan("");
   Eigen::Vector3d sigma_ = Eigen::Vector3d::Constant(-1.0);     // of first differences / sqrt(2)
   Eigen::Vector3d sigma_sample_ = Eigen::Vector3d::Constant(-1.0);  // per sample
   Eigen::Vector3d sigma_lr_ = Eigen::Vector3d::Constant(-1.0);  // long-run (mean test, isolation)
@@ -154,12 +224,19 @@ class FaultDetector {
   // isolation state
   bool suspect_ = false;
   bool classified_ = false;
+  bool scale_waiting_ = false;  // a scale change waits for an earlier visit of its positions that turned
   FaultKind kind_ = FaultKind::kNone;
   double t_alarm_ = 0.0, t_onset_ = 0.0;
   Vector6d bias_ref_ = Vector6d::Zero();
   std::vector<Record> post_;   // records since the onset, for classification and isolation
   std::optional<FaultReport> fault_;
   std::optional<double> first_alarm_s_;
+  // learning after lock; the position check's visits (newest last, bounded)
+  double t_locked_s_ = std::nan("");
+  long learned_samples_ = 0, learned_segments_ = 0;
+  std::deque<Visit> visits_;
+  std::optional<UncalibratedReport> uncalibrated_;
+  int explained_alarms_ = 0;
 };
 
 /// Degraded mode after isolation: the healthy sensor carries on alone with its last bias estimate

@@ -15,6 +15,7 @@ const char* to_string(FdiVerdict v) {
     case FdiVerdict::kHealthy: return "healthy";
     case FdiVerdict::kAlarm: return "alarm";
     case FdiVerdict::kFault: return "fault";
+    case FdiVerdict::kUncalibrated: return "uncalibrated";
   }
   return "?";
 }
@@ -48,9 +49,14 @@ std::string FdiWatch::push(const Sample& s, est::PushStatus status, const est::D
 std::string FdiWatch::feed(const est::FdiInput& in) {
   if (in.at_rest) ++rest_samples_;
   last_ = fdi_.push(in);
-  char text[256];
+  char text[512];
   if (last_ == est::FdiStatus::kIsolated && fdi_.fault()) {
     return "fdi: fault isolated: " + fdi_.fault()->describe();
+  }
+  if (!explained_ && fdi_.uncalibrated()) {
+    explained_ = true;
+    return "fdi: uncalibrated: " + fdi_.uncalibrated()->describe() +
+           "; run with self_calibration (--estimator-config) or --calib";
   }
   if (!alarmed_ && fdi_.first_alarm_s()) {
     alarmed_ = true;
@@ -62,8 +68,11 @@ std::string FdiWatch::feed(const est::FdiInput& in) {
     learned_ = true;
     t_learned_s_ = in.t_s;
     const Eigen::Vector3d sig = fdi_.residual_sigma_longrun_dps();
-    std::snprintf(text, sizeof text, "fdi: monitoring from t=%.3f s (residual noise learned: long-run sigma %.4f %.4f %.4f deg/s)",
-                  in.t_s, sig.x(), sig.y(), sig.z());
+    std::snprintf(text, sizeof text,
+                  "fdi: monitoring from t=%.3f s (residual noise learned from t=%.3f s, after the filter locked at "
+                  "t=%.3f s, on %ld %srest samples: long-run sigma %.4f %.4f %.4f deg/s)",
+                  in.t_s, fdi_.t_learn_start_s(), fdi_.t_filter_locked_s(), fdi_.learned_samples(),
+                  fdi_.learned_on_quiet() ? "quiet " : "", sig.x(), sig.y(), sig.z());
     return text;
   }
   return {};
@@ -71,6 +80,7 @@ std::string FdiWatch::feed(const est::FdiInput& in) {
 
 FdiVerdict FdiWatch::verdict() const {
   if (fdi_.fault()) return FdiVerdict::kFault;
+  if (fdi_.uncalibrated()) return FdiVerdict::kUncalibrated;
   if (fdi_.first_alarm_s()) return FdiVerdict::kAlarm;
   return learned_ ? FdiVerdict::kHealthy : FdiVerdict::kNotMonitored;
 }

@@ -27,6 +27,8 @@ enum class FdiVerdict {
   kHealthy,       // monitored, no alarm
   kAlarm,         // an alarm that was not (yet) isolated to a sensor and axis
   kFault,         // a fault isolated: see detector().fault()
+  kUncalibrated,  // alarms only, each explained by the platform positions: uncalibrated sensors,
+                  // not a fault (detector().uncalibrated(); docs/fdi.md "The position check")
 };
 const char* to_string(FdiVerdict v);
 
@@ -59,7 +61,7 @@ class FdiWatch {
   std::size_t margin_samples_;
   std::deque<est::FdiInput> held_;  // rest samples of the last end_margin_s
   est::FdiStatus last_ = est::FdiStatus::kLearning;
-  bool learned_ = false, alarmed_ = false;
+  bool learned_ = false, alarmed_ = false, explained_ = false;
   std::uint64_t rest_samples_ = 0;
   double t_learned_s_ = kNaN;
 };

@@ -114,7 +114,7 @@ grep -q '"verdict": "fault"' "$out/f/fdi.json" || fail "--fdi: fdi.json verdict:
 grep -q '"axis": "y"' "$out/f/fdi.json" || fail "--fdi: fdi.json axis"
 grep -q "^# emu_fault: stuck on sensor 2 axis y from t=45 s" "$out/f/log.csv" || fail "--fdi: the log's metadata does not say the planted fault"
 # fault-free: healthy, exit 0; too short to learn the residual noise: not monitored, exit 1
-"$bin" hil --source emu-i2c --fdi --out "$out/h" --duration 60 > "$out/h.txt" || fail "--fdi fault-free: exit $?"
+"$bin" hil --source emu-i2c --fdi --out "$out/h" --duration 90 > "$out/h.txt" || fail "--fdi fault-free: exit $?"
 grep -q '"verdict": "healthy"' "$out/h/fdi.json" || fail "--fdi fault-free: $(cat "$out/h/fdi.json")"
 if "$bin" hil --source emu-i2c --fdi --out "$out/s" --duration 5 > /dev/null 2> "$out/s.err"; then fail "--fdi on 5 s: exit 0"; fi
 grep -q "fdi: not monitored" "$out/s.err" || fail "--fdi on 5 s: $(cat "$out/s.err")"
