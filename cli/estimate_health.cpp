@@ -47,6 +47,7 @@ const char* cause_key(est::HealthCause c) {
     case est::HealthCause::kPaperRestAngles: return "paper_rest_angles";
     case est::HealthCause::kPaperSchedule: return "paper_schedule";
     case est::HealthCause::kLockLost: return "lock_lost";
+    case est::HealthCause::kBoxDwellsRejected: return "box_dwells_rejected";
     case est::HealthCause::kReferenceMismatch: return "reference_mismatch";
     case est::HealthCause::kBoxNotAtRest: return "box_not_at_rest";
     case est::HealthCause::kAccelUnit: return "accel_unit";
@@ -114,6 +115,19 @@ std::string describe_box_motion(const est::HealthFinding& f) {
                      at_rest ? "Drop --box-at-rest (a box in a vehicle, on a ship or a turntable turns)"
                              : "Set box_dwell_updates: false in the configuration (a box in a vehicle, on a ship or "
                                "a slow turntable)");
+}
+
+std::string describe_box_dwells(const est::HealthFinding& f) {
+  const std::string refused =
+      f.value > 0.0 ? fmt::format(" ({:.0f} more quiet stretches were refused: the box rate trended through them)", f.value)
+                    : std::string();
+  return fmt::format("{} of {:.0f} box dwell updates were rejected by their gate{}: in those pauses the box still "
+                     "turned (a slow steady turn, a vehicle creeping), so the vertical rate was not the Earth's; the "
+                     "accepted ones may carry part of it into the shared bias and g-sensitivity. {}",
+                     f.count, f.suggested, refused,
+                     f.severity == est::HealthVerdict::kOk
+                         ? "A few are expected on a box that sometimes moves slowly: the rest stand"
+                         : "Set box_dwell_updates: false in the configuration if the box never truly stops");
 }
 
 std::string describe_reference(const est::HealthFinding& f) {
@@ -481,6 +495,8 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
     case est::HealthCause::kAccelEmpty:
     case est::HealthCause::kCalibUncertain:
       return describe_accel(f);
+    case est::HealthCause::kBoxDwellsRejected:
+      return describe_box_dwells(f);
     default: break;  // the flip-turn check's causes: describe_flip() above
   }
   return "?";

@@ -228,8 +228,8 @@ void write_estimate_summary(const fs::path& path, const SummaryContext& ctx, con
       json_number(s.stop_angle_deg[0]), json_number(s.stop_angle_deg[1]), json_number(s.stop_angle_deg[2]),
       json_number(s.stop_angle_deg[3]), json_number(s.stop_angle_sigma_deg[0]), json_number(s.stop_angle_sigma_deg[1]),
       json_number(s.stop_angle_sigma_deg[2]), json_number(s.stop_angle_sigma_deg[3]));
-  add("  \"box_dwells\": {{\"updates\": {}, \"rejected\": {}}},\n", s.counters.box_dwell_updates,
-      s.counters.box_dwell_rejected);
+  add("  \"box_dwells\": {{\"updates\": {}, \"rejected\": {}, \"refused_moving\": {}}},\n",
+      s.counters.box_dwell_updates, s.counters.box_dwell_rejected, s.counters.box_dwell_moving);
   const std::uint64_t flips_ok = s.counters.flip_updates - s.counters.flip_rejected;
   add("  \"flips\": {{\"updates\": {}, \"rejected\": {}, \"nis_mean\": {}, \"skipped_clipped\": {}}},\n",
       s.counters.flip_updates, s.counters.flip_rejected,

@@ -132,6 +132,9 @@ struct FilterCounters {
   // box-dwell updates of the vertical rate (box_dwell_updates; not in `updates`/`rejected`)
   std::uint64_t box_dwell_updates = 0;
   std::uint64_t box_dwell_rejected = 0;
+  // quiet stretches not used as box dwells because the box rate trended through them (a rocking or
+  // swinging box passing a turning point): box_dwell_trend() (not in box_dwell_updates)
+  std::uint64_t box_dwell_moving = 0;
   // flip updates of the scale/misalignment (flip_updates; not in `updates`/`rejected`)
   std::uint64_t flip_updates = 0;
   std::uint64_t flip_rejected = 0;
@@ -342,8 +345,20 @@ class DriftlessFilter {
     double t_s;
     Eigen::Vector3d gyro1_dps, gyro2_dps, accel1_mps2, accel2_mps2;
     double temp1_c, temp2_c;
+    Eigen::Vector3d rate_dps;  // the corrected fused body rate
+  };
+  // least-squares line of the fused rate against time over a dwell (t from its first sample)
+  struct DwellTrend {
+    double n = 0.0, st = 0.0, stt = 0.0;
+    Eigen::Vector3d sw = Eigen::Vector3d::Zero(), stw = Eigen::Vector3d::Zero(), sww = Eigen::Vector3d::Zero();
+    void add(double t_s, const Eigen::Vector3d& w);
+    // sum over the axes of (slope / its standard error)^2, the error from the scatter about the line
+    double chi2() const;
+    // deg/s, the line's largest change over the dwell on one axis (|slope| times the span)
+    double change_dps() const;
   };
   StandstillSegment dwell_;
+  DwellTrend dwell_trend_;
   std::deque<DwellSample> dwell_recent_;
   bool box_turning_ = false;  // set_box_turning()
   double dwell_quiet_since_s_ = kNaN;

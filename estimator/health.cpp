@@ -496,6 +496,23 @@ void HealthMonitor::add_lock_findings(HealthReport& h, const DriftlessFilter& fi
   }
 }
 
+namespace {
+
+// box dwells the gate rejected: the box was not at rest in them (each rejection is a 1e-4 chance
+// at rest); they are apart from the standstill updates and their rejection rate
+void add_box_dwell_finding(HealthReport& h, const FilterCounters& c) {
+  if (c.box_dwell_rejected == 0) return;
+  HealthFinding f;
+  f.cause = HealthCause::kBoxDwellsRejected;
+  f.severity = 5 * c.box_dwell_rejected > c.box_dwell_updates ? HealthVerdict::kDegraded : HealthVerdict::kOk;
+  f.count = c.box_dwell_rejected;
+  f.suggested = double(c.box_dwell_updates);
+  f.value = double(c.box_dwell_moving);
+  add(h, f);
+}
+
+}  // namespace
+
 HealthReport HealthMonitor::finish(const DriftlessFilter& filter, double duration_s, const LagCheckResult& lag) const {
   HealthReport h;
   h.signal_chain = lag;
@@ -536,6 +553,7 @@ HealthReport HealthMonitor::finish(const DriftlessFilter& filter, double duratio
     f.value = double(h.relocks);
     add(h, f);
   }
+  add_box_dwell_finding(h, filter.counters());
   return h;
 }
 

@@ -91,6 +91,9 @@ enum class HealthCause {
                          // standstill (deg/s; NaN: no ref_q), sigma = the largest change of the fused
                          // rate within one (deg/s), suggested = when (s), count = box dwell updates,
                          // components = {1 if --box-at-rest, else 0}
+  kBoxDwellsRejected,    // box dwell updates rejected by their gate: count = rejected, suggested =
+                         // dwell updates, value = quiet stretches refused as moving (a note when
+                         // at most a fifth were rejected, else degraded)
   kReferenceMismatch,    // ref_q does not turn with the gyros (reference_check.hpp): value = the
                          // misfit of the log's convention, sigma = the best misfit, suggested = the
                          // best RefConvention (as a number; kNoFit: NaN), count = turning windows,

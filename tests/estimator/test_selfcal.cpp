@@ -141,6 +141,29 @@ TEST(SelfCalTest, BoxDwellsObserveTheCommonGSensitivityOfAMovingBox) {
   EXPECT_EQ(f.counters().rejected, 0u);
 }
 
+// GIVEN a box that rocks about x, +-20 deg over 17 s (7.4 deg/s at its peak), and never pauses;
+// at each turning point its rate stays below box_dwell_rate_dps (2 deg/s) for about 1.5 s while
+// it passes linearly through zero (2.7 deg/s per s)
+// WHEN the self-calibrating filter looks for box dwells
+// THEN no such stretch is used as a dwell: each is refused as moving (its fused rate's line changes
+// by about 3 deg/s, far above the 0.25 deg/s a bias moves in a dwell), and the biases are within
+// 3 sigma. (Before, they were taken as dwells and the gate rejected most of them.)
+TEST(SelfCalTest, ARockingBoxsTurningPointsAreNotDwells) {
+  test::SynthParams p = static_box(10.0);
+  constexpr double kW = 2.0 * kPi / 17.0, kAmplitudeDeg = 20.0;
+  p.body_rate_dps = [](double t) -> Eigen::Vector3d {
+    return Eigen::Vector3d(kAmplitudeDeg * kW * std::cos(kW * t), 0.0, 0.0);
+  };
+  const DriftlessFilter f = run(p, config(true));
+  EXPECT_GT(f.counters().box_dwell_moving, 20u);  // two turning points per 17 s, after the lock
+  EXPECT_EQ(f.counters().box_dwell_updates, 0u);
+  EXPECT_EQ(f.counters().rejected, 0u);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(f.bias_dps()[i], p.b1_dps[i], 3.0 * f.sigma_dps()[i]) << i;
+    EXPECT_NEAR(f.bias_dps()[i + 3], p.b2_dps[i], 3.0 * f.sigma_dps()[i + 3]) << i;
+  }
+}
+
 // GIVEN the G2 of the first test WHEN the filter runs without self-calibration THEN the gate
 // rejects the updates at one sign of platform 2 (the failure issue 13 reports)
 TEST(SelfCalTest, WithoutSelfCalibrationTheGateRejects) {
