@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include "cli/estimate_health_accel.hpp"
 #include "cli/estimate_health_flip.hpp"
 #include "estimator/log.hpp"
 #include "estimator/numbers.hpp"
@@ -51,6 +52,9 @@ const char* cause_key(est::HealthCause c) {
     case est::HealthCause::kBoxDwellsRejected: return "box_dwells_rejected";
     case est::HealthCause::kReferenceMismatch: return "reference_mismatch";
     case est::HealthCause::kBoxNotAtRest: return "box_not_at_rest";
+    case est::HealthCause::kAccelUnit: return "accel_unit";
+    case est::HealthCause::kAccelEmpty: return "accel_empty";
+    case est::HealthCause::kCalibUncertain: return "calib_uncertain";
     default: if (is_flip_cause(c)) return flip_cause_key(c);
   }
   return "?";
@@ -162,10 +166,51 @@ std::string component_names(const std::vector<int>& components) {
   return o;
 }
 
+RunUsed run_used(const est::EstimatorConfig& cfg, est::GravitySource gravity) {
+  const est::Calibration& c = cfg.calibration;
+  RunUsed u;
+  u.selfcal = cfg.self_calibration;
+  u.tune_auto = cfg.noise_from_log;
+  u.calib = !c.empty() || c.has_g_sensitivity() || c.has_g_sigma || c.has_scale_misalign || c.has_end_stops ||
+            c.has_temp_coef;
+  u.box_at_rest = cfg.box_at_rest;
+  u.gravity = gravity;
+  return u;
+}
+
+std::string calibrate_fix(const RunUsed& u) {
+  return u.calib ? "recalibrate with 'driftless calibrate' (the calibration given does not describe these sensors now)"
+                 : "calibrate with 'driftless calibrate' and pass --calib";
+}
+
+std::string model_error_fix(const RunUsed& u) {
+  if (!u.selfcal) {
+    return fmt::format("estimate it with --selfcal (g-sensitivity, scale and misalignment states{}), or {}",
+                       u.box_at_rest ? "" : "; add --box-at-rest for a box standing still", calibrate_fix(u));
+  }
+  if (u.gravity == est::GravitySource::kNone) {
+    return "g-sensitivity cannot be estimated without accel columns or ref_q: log them (accel1_*/accel2_*, or "
+           "ref_qw..ref_qz), or " + calibrate_fix(u);
+  }
+  return "the self-calibration in this run did not absorb it: see the findings above (an accel column's unit, the "
+         "end stops), widen its priors (gsens_sigma_dps_per_g, scale_misalign_sigma_frac) in the configuration, "
+         "or " + calibrate_fix(u);
+}
+
+std::string noise_fix(const RunUsed& u) {
+  if (!u.tune_auto) return "use --tune auto";
+  return u.selfcal ? "the noise and the wander were measured from this log, so the excess is not white noise: a "
+                     "sensor error the self-calibration does not model, or a signal-chain mismatch between the "
+                     "sensors ('driftless diagnose')"
+                   : "the noise and the wander were measured from this log, so the excess is not white noise: a "
+                     "sensor error the model lacks (g-sensitivity, scale or misalignment on a moving box: --selfcal) "
+                     "or a signal-chain mismatch between the sensors";
+}
+
 namespace {
 
 // the lock: whether the filter locked, kept it, and what stayed unobserved
-std::string describe_lock(const est::HealthFinding& f, const est::EstimatorConfig& cfg) {
+std::string describe_lock(const est::HealthFinding& f, const est::EstimatorConfig& cfg, const RunUsed& u) {
   switch (f.cause) {
     case est::HealthCause::kNoUpdate:
       if (f.suggested > 0.5) {
@@ -176,8 +221,11 @@ std::string describe_lock(const est::HealthFinding& f, const est::EstimatorConfi
       return "no standstill became an update: the platforms never rested for min_standstill_s "
              "(or the angle columns are empty); check plat1_deg/plat2_deg or set standstill: gyro";
     case est::HealthCause::kAllRejected:
-      return "the NIS gate rejected every update: the sensors do not fit the configured noise or "
-             "model; try --tune auto, or check the hinge axes in the log header";
+      return fmt::format("the NIS gate rejected every update: the sensors do not fit the configured noise or "
+                         "model; {}, or check the hinge axes in the log header",
+                         u.tune_auto ? "the noise measured from this log does not explain it: check the gyro "
+                                       "columns' units ('driftless check')"
+                                     : "try --tune auto");
     case est::HealthCause::kNeverLocked:
       return fmt::format("never locked: the largest sigma of the bias correction is {:.3g} deg/s{}; {}", f.value,
                          f.components.empty() ? std::string() : ", unobservable: " + component_names(f.components),
@@ -190,7 +238,11 @@ std::string describe_lock(const est::HealthFinding& f, const est::EstimatorConfi
                                                                 "occurred; flip one platform at a time (eq. (5): "
                                                                 "(+,+) (+,-) (-,-) (-,+))",
                                                                 position_text(f.positions_deg))
-                                            : cfg.self_calibration && !cfg.box_at_rest
+                                            : u.selfcal && u.gravity == est::GravitySource::kNone
+                                                  ? "g-sensitivity cannot be estimated without accel columns or "
+                                                    "ref_q: log them (a g-sensitivity along the box vertical looks "
+                                                    "like a bias common to both sensors)"
+                                            : u.selfcal && !u.box_at_rest
                                                   ? "in self-calibrating mode a g-sensitivity that keeps its sign "
                                                     "about the box vertical looks like a bias common to both "
                                                     "sensors; if the box stands still, add --box-at-rest"
@@ -203,9 +255,11 @@ std::string describe_lock(const est::HealthFinding& f, const est::EstimatorConfi
       return fmt::format("the filter locked, then lost the lock at t = {:.1f} s (a gate re-lock widened its sigma) and "
                          "did not lock again before the end: the largest bias sigma at the end is {:.3g} deg/s, above "
                          "the lock level {:g} deg/s, so the final biases are not usable (corrected.csv: locked = 0 from "
-                         "there). The findings above name why the updates stopped fitting; a bias jump, or noise and "
-                         "bias wander larger than configured (--tune auto), are the common causes",
-                         f.suggested, f.value, f.sigma);
+                         "there). The findings above name why the updates stopped fitting; {} are the common causes",
+                         f.suggested, f.value, f.sigma,
+                         u.tune_auto ? "a bias jump, or a sensor error the model lacks (the noise was measured from "
+                                       "this log),"
+                                     : "a bias jump, or noise and bias wander larger than configured (--tune auto),");
     case est::HealthCause::kRelocks:
       return fmt::format("the filter lost lock and re-locked {:g} time(s) (see relocks): a bias jump, a new "
                          "sensor, or a model that does not fit; check the log around those times",
@@ -233,7 +287,7 @@ std::string describe_lock(const est::HealthFinding& f, const est::EstimatorConfi
 }
 
 // how the updates fit the model: the NIS, the gate's rejections, the signal chain
-std::string describe_fit(const est::HealthFinding& f, const est::EstimatorConfig& cfg) {
+std::string describe_fit(const est::HealthFinding& f, const est::EstimatorConfig& cfg, const RunUsed& u) {
   switch (f.cause) {
     case est::HealthCause::kNoiseUnderstated:
       return fmt::format("NIS mean {:.3g} above its 95 % band{}: the innovations are {:.2g}x larger than the "
@@ -243,12 +297,7 @@ std::string describe_fit(const est::HealthFinding& f, const est::EstimatorConfig
                          f.severity == est::HealthVerdict::kOk
                              ? " (inside the 99.9 % band: one consistent run in 40 lands here)"
                              : " and its 99.9 % band",
-                         std::sqrt(f.suggested), cfg.noise_density_dps_rthz,
-                         cfg.noise_from_log
-                             ? "the density and the wander were already measured from this log (--tune auto), so the "
-                               "excess is not white noise: a sensor error the model lacks (g-sensitivity, scale or "
-                               "misalignment on a moving box: --selfcal) or a signal-chain mismatch between the sensors"
-                             : "use --tune auto");
+                         std::sqrt(f.suggested), cfg.noise_density_dps_rthz, noise_fix(u));
     case est::HealthCause::kNoiseOverstated:
       return fmt::format("NIS mean {:.3g} below its 95 % band: the innovations are {:.2g}x smaller than the "
                          "filter expects, its sigma too large (data quieter or the bias steadier than configured): "
@@ -257,32 +306,33 @@ std::string describe_fit(const est::HealthFinding& f, const est::EstimatorConfig
     case est::HealthCause::kRejectionsAtPosition:
       return fmt::format("{:.0f} % of the updates at platform angles {} were rejected, few elsewhere: an error "
                          "that depends on the position and that a constant bias cannot absorb (g-sensitivity "
-                         "on a horizontal hinge, misalignment, an end-stop angle error); estimate it with "
-                         "--selfcal (g-sensitivity states; add --box-at-rest for a box standing still), or "
-                         "calibrate with 'driftless calibrate' and pass --calib",
-                         100.0 * f.value, position_text(f.positions_deg));
+                         "on a horizontal hinge, misalignment, an end-stop angle error); {}",
+                         100.0 * f.value, position_text(f.positions_deg), model_error_fix(u));
     case est::HealthCause::kRejections:
       return fmt::format("{:.1f} % of the updates were rejected by the NIS gate: noise or bias wander "
-                         "larger than configured (use --tune auto), or a model that does not fit{}",
-                         100.0 * f.value,
-                         cfg.self_calibration ? std::string()
-                                              : " (an uncalibrated MEMS gyro on a moving box: g-sensitivity, scale "
-                                                "and misalignment; estimate them with --selfcal, or calibrate with "
-                                                "'driftless calibrate' and pass --calib)");
+                         "larger than configured ({}), or a model that does not fit{}",
+                         100.0 * f.value, noise_fix(u),
+                         u.selfcal && u.gravity != est::GravitySource::kNone
+                             ? std::string()
+                             : " (an uncalibrated MEMS gyro on a moving box: g-sensitivity, scale and misalignment; " +
+                                   model_error_fix(u) + ")");
     case est::HealthCause::kLoneRejection:
       return fmt::format("one update rejected by the NIS gate (t = {:.2f} s, NIS {:.3g}): a lone outlier, "
                          "which the gate is there to remove; the estimate is unaffected. Repeated rejections "
-                         "would mean noise or bias wander larger than configured (--tune auto)",
-                         f.suggested, f.value);
+                         "would mean noise or bias wander larger than configured{}",
+                         f.suggested, f.value,
+                         u.tune_auto ? " (than the noise measured from this log)" : " (--tune auto)");
     case est::HealthCause::kSignalChainLag:
       return fmt::format("the residual follows the box's angular acceleration: sensor {} reads the rate {:.2f} ms "
                          "(+-{:.2f}) later than sensor {}, which adds {:.2g}x the white noise's variance to the "
-                         "standstill updates. No noise density describes that (--tune auto would take it for noise): "
+                         "standstill updates. No noise density describes that ({}): "
                          "a signal-chain mismatch (a sample delay, or a slower low-pass filter on one sensor); "
                          "align the two sensors' time stamps and filters, or run 'driftless diagnose' on this log "
                          "to measure each sensor's chain",
                          f.value > 0.0 ? 2 : 1, 1e3 * std::fabs(f.value), 1e3 * f.sigma, f.value > 0.0 ? 1 : 2,
-                         f.suggested);
+                         f.suggested,
+                         u.tune_auto ? "the density measured from this log took part of it for noise"
+                                     : "--tune auto would take it for noise");
     default: break;
   }
   return "?";
@@ -425,7 +475,8 @@ std::string describe_input_checks(const est::HealthFinding& f, const est::Estima
 
 }  // namespace
 
-std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cfg) {
+std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cfg, est::GravitySource gravity) {
+  const RunUsed u = run_used(cfg, gravity);
   if (is_flip_cause(f.cause)) return describe_flip(f, cfg);
   switch (f.cause) {
     case est::HealthCause::kNoUpdate:
@@ -436,14 +487,14 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
     case est::HealthCause::kRelocks:
     case est::HealthCause::kLateLock:
     case est::HealthCause::kSteadyStateAtLock:
-      return describe_lock(f, cfg);
+      return describe_lock(f, cfg, u);
     case est::HealthCause::kNoiseUnderstated:
     case est::HealthCause::kNoiseOverstated:
     case est::HealthCause::kRejectionsAtPosition:
     case est::HealthCause::kRejections:
     case est::HealthCause::kLoneRejection:
     case est::HealthCause::kSignalChainLag:
-      return describe_fit(f, cfg);
+      return describe_fit(f, cfg, u);
     case est::HealthCause::kPaperRestAngles:
     case est::HealthCause::kPaperSchedule:
     case est::HealthCause::kSaturation:
@@ -465,6 +516,10 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
       return describe_reference(f);
     case est::HealthCause::kBoxNotAtRest:
       return describe_box_motion(f);
+    case est::HealthCause::kAccelUnit:
+    case est::HealthCause::kAccelEmpty:
+    case est::HealthCause::kCalibUncertain:
+      return describe_accel(f);
     case est::HealthCause::kBoxDwellsRejected:
       return describe_box_dwells(f);
     default: break;  // the flip-turn check's causes: describe_flip() above
@@ -482,7 +537,7 @@ std::string health_json(const est::HealthReport& h, const est::EstimatorConfig& 
   for (std::size_t i = 0; i < h.findings.size(); ++i) {
     findings += fmt::format("{}\n    {{\"cause\": \"{}\", \"severity\": \"{}\", \"text\": {}}}", i ? "," : "",
                             cause_key(h.findings[i].cause), est::to_string(h.findings[i].severity),
-                            json_string(describe(h.findings[i], cfg)));
+                            json_string(describe(h.findings[i], cfg, h.gravity_source)));
   }
   findings += h.findings.empty() ? "]" : "\n  ]";
   return fmt::format(
@@ -528,7 +583,7 @@ std::vector<std::string> health_lines(const est::HealthReport& h, const est::Est
       est::to_string(h.verdict), lock_text(h),
       h.rejected, h.updates, std::isfinite(h.rejected_fraction) ? 100.0 * h.rejected_fraction : 0.0, h.nis_mean,
       h.nis_mean_band_lo, h.nis_mean_band_hi, h.relocks));
-  for (const auto& f : h.findings) lines.push_back(fmt::format("  {}: {}", est::to_string(f.severity), describe(f, cfg)));
+  for (const auto& f : h.findings) lines.push_back(fmt::format("  {}: {}", est::to_string(f.severity), describe(f, cfg, h.gravity_source)));
   return lines;
 }
 

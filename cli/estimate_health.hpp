@@ -14,8 +14,28 @@ namespace driftless::cli {
 
 /// "b1_z + b2_y" for the component indices 0..5 (b1_x .. b2_z).
 std::string component_names(const std::vector<int>& components);
-/// The finding as one line: what was measured, the likely cause and the fix.
-std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cfg);
+
+/// What the run already used. No finding's fix names one of these as the thing to try (issue 13;
+/// the outsider's F10, F19, F22): every fix text picks its alternative from here.
+struct RunUsed {
+  bool selfcal = false;      // --selfcal (self_calibration)
+  bool tune_auto = false;    // --tune auto (the noise was measured from the log: noise_from_log)
+  bool calib = false;        // --calib (a calibration is in the configuration)
+  bool box_at_rest = false;  // --box-at-rest
+  est::GravitySource gravity = est::GravitySource::kNone;  // what drove G (self-calibration)
+};
+RunUsed run_used(const est::EstimatorConfig& cfg, est::GravitySource gravity);
+/// For an error a constant bias cannot absorb (g-sensitivity, scale, misalignment): what to try.
+std::string model_error_fix(const RunUsed& u);
+/// For noise or wander larger than configured: what to try.
+std::string noise_fix(const RunUsed& u);
+/// "calibrate with 'driftless calibrate' and pass --calib", or, with a calibration in use, recalibrate.
+std::string calibrate_fix(const RunUsed& u);
+
+/// The finding as one line: what was measured, the likely cause and the fix (`gravity`: what drove
+/// the g-sensitivity states, HealthReport::gravity_source).
+std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cfg,
+                     est::GravitySource gravity = est::GravitySource::kNone);
 /// The `"health": {...}` member of summary.json (no trailing comma), indented by two spaces.
 std::string health_json(const est::HealthReport& h, const est::EstimatorConfig& cfg);
 /// The `tune` value of summary.json: what --tune auto measured, or null.

@@ -1,5 +1,7 @@
 #include "cli/estimate_health_flip.hpp"
 
+#include "cli/estimate_health.hpp"
+
 #include <cmath>
 
 #include <fmt/format.h>
@@ -119,13 +121,13 @@ std::string describe_flip(const est::HealthFinding& f, const est::EstimatorConfi
       const double wider = std::ceil(std::fabs(err) / 2.0 * 100.0) / 100.0;  // the error at 2 sigma
       return fmt::format("platform {}'s gyro reads each flip as {:.1f} % of the angle change ({} of {:g} flips): a "
                          "scale error of {:+.1f} % along its hinge, {:.1f}x scale_misalign_sigma_frac {:g}{}; set "
-                         "scale_misalign_sigma_frac: {:g} (--config) or calibrate ('driftless calibrate', --calib)",
+                         "scale_misalign_sigma_frac: {:g} (--config) or {}",
                          platform(f), 100.0 * f.value, f.count, f.suggested, 100.0 * err,
                          std::fabs(err) / cfg.scale_misalign_sigma_frac, cfg.scale_misalign_sigma_frac,
                          cfg.self_calibration ? ": the self-calibration's flip gate rejects flips that far off and leaves "
                                                 "the scale near its prior"
                                               : " (with --selfcal its flip gate would reject these flips)",
-                         wider);
+                         wider, calibrate_fix(run_used(cfg, est::GravitySource::kNone)));
     }
     case HealthCause::kFlipsTooSlow:
       return fmt::format("{} of {:g} flips took longer than flip_max_s {:g} s (the longest {:.1f} s): the "

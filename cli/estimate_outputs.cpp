@@ -216,11 +216,12 @@ void write_estimate_summary(const fs::path& path, const SummaryContext& ctx, con
                        json_number(m(0, 2)), json_number(m(1, 0)), json_number(m(1, 1)), json_number(m(1, 2)),
                        json_number(m(2, 0)), json_number(m(2, 1)), json_number(m(2, 2)));
   };
-  add("  \"self_calibration\": {{\"enabled\": {}, \"correction_sigma_dps\": {}, "
+  add("  \"self_calibration\": {{\"enabled\": {}, \"gravity_source\": \"{}\", \"correction_sigma_dps\": {}, "
       "\"g_sensitivity_dps_per_g\": [{}, {}], \"g_sensitivity_sigma_dps_per_g\": [{}, {}], "
       "\"scale_misalign_states\": {}, \"scale_misalign_frac\": [{}, {}], \"scale_misalign_sigma_frac\": [{}, {}],\n"
       "    \"end_stop_states\": {}, \"end_stop_deg\": [{}, {}, {}, {}], \"end_stop_sigma_deg\": [{}, {}, {}, {}]}},\n",
-      s.gsens_states ? "true" : "false", json_vec(s.correction_sigma_dps), mat(s.gsens_dps_per_g[0]),
+      s.gsens_states ? "true" : "false", est::to_string(s.gravity_source), json_vec(s.correction_sigma_dps),
+      mat(s.gsens_dps_per_g[0]),
       mat(s.gsens_dps_per_g[1]), mat(s.gsens_sigma_dps_per_g[0]), mat(s.gsens_sigma_dps_per_g[1]),
       s.scale_states ? "true" : "false", mat(s.scale_misalign_frac[0]), mat(s.scale_misalign_frac[1]),
       mat(s.scale_misalign_sigma_frac[0]), mat(s.scale_misalign_sigma_frac[1]), s.stop_states ? "true" : "false",

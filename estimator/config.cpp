@@ -60,6 +60,8 @@ const fields::Table<C>& config_table() {
       fields::number<C>("flip_angle_sigma", "deg", &C::flip_angle_sigma_deg),
       fields::number<C>("flip_max", "s", &C::flip_max_s),
       fields::number<C>("gsens_sigma", "dps_per_g", &C::gsens_sigma_dps_per_g),
+      fields::number<C>("ref_gravity_accel_sigma", "g", &C::ref_gravity_accel_sigma_g),
+      fields::number<C>("ref_gravity_speed", "mps", &C::ref_gravity_speed_mps),
       fields::number<C>("gyro_motion_threshold", "dps", &C::gyro_motion_threshold_dps),
       fields::number<C>("initial_bias", "dps", &C::initial_bias_dps),
       fields::number<C>("initial_plat1", "deg", &C::initial_plat1_deg),

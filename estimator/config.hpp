@@ -132,6 +132,14 @@ struct EstimatorConfig {
   // standstill also measures the fused rate about "up" (from the accel columns, else ref_q) as the
   // vertical Earth rate, Omega sin(latitude); that observes the bias common to both sensors about
   // the vertical, which eq. (2) cannot see once g-sensitivity is a state. General mode only.
+  // self-calibrating mode on a log without accel columns but with ref_q: the pipeline drives the G
+  // states with gravity from ref_q (f_i = M_i^T C^T (0, 0, g); gravity_from_ref_q, set by the pass,
+  // not a key). The box's own acceleration a is then unknown: R takes G a with a of sigma
+  // sqrt(ref_gravity_accel_sigma^2 + (ref_gravity_speed |w| / g)^2) per axis, w the standstill's
+  // fused box rate (a turn at speed v has a centripetal v w; docs/estimator.md section 1b)
+  bool gravity_from_ref_q = false;
+  double ref_gravity_accel_sigma_g = 0.05;  // g, the box's mean acceleration over a standstill (1 sigma)
+  double ref_gravity_speed_mps = 30.0;      // m/s, the fastest the box travels (a car on a highway)
   bool box_at_rest = false;
   double box_rest_rate_sigma_dps = 1e-4;  // deg/s, how still the box is about the vertical (1 sigma)
   // self-calibrating mode, a box that moves but pauses now and then (a pan/tilt unit's dwells, a

@@ -110,6 +110,8 @@ void EstimatorConfig::validate() const {
   non_negative(q_override_dps2_per_s, "q_override_dps2_per_s", "(deg/s)^2/s (0 = from spec)");
   non_negative(r_override_dps2, "r_override_dps2", "(deg/s)^2 (0 = from noise density)");
   non_negative(gsens_sigma_dps_per_g, "gsens_sigma_dps_per_g", "deg/s per g");
+  non_negative(ref_gravity_accel_sigma_g, "ref_gravity_accel_sigma_g", "g");
+  non_negative(ref_gravity_speed_mps, "ref_gravity_speed_mps", "m/s");
   non_negative(scale_misalign_sigma_frac, "scale_misalign_sigma_frac", "fraction");
   positive(box_rest_rate_sigma_dps, "box_rest_rate_sigma_dps", "deg/s");
   positive(box_dwell_rate_dps, "box_dwell_rate_dps", "deg/s");
@@ -594,12 +596,37 @@ void DriftlessFilter::residual_rows(const StandstillSegment& s, const Eigen::Mat
   const double wander = cfg_.mode == FilterMode::kPaper ? q_rate_dps2_per_s_ * s.span_s() / 12.0 : 0.0;
   const double var = cfg_.sample_variance_dps2(rate_hz) / double(s.n) + wander;
   cur.R = var * (M1 * M1.transpose() + M2 * M2.transpose());
+  if (cfg_.gravity_from_ref_q && s.n_accel > 0) cur.R += unknown_accel_cov_dps2(M1, M2, -1.0, box_rate_dps(s, M1, M2));
   // the end-stop rows need the box rate, so the bias, known first (as for the flips and dwells): a
   // rate from a bias not yet known would pass its error into the end-stop states; until then the
   // rest-angle errors are noise
   if (has_stop_states() && correction_sigma_dps().maxCoeff() < 0.1 * cfg_.box_dwell_rate_dps) stop_rows(s, M1, M2, cur);
   else if (cfg_.mode == FilterMode::kGeneral) add_rest_angle_noise(s, M1, M2, cur.R);
   if (has_scale_states()) scale_rows(s, M1, M2, cur);
+}
+
+// gravity from ref_q (no accel columns): the box's own acceleration a (g, box axes) is in the gyros
+// (G_i M_i^T a) but not in f_i; it adds D a to M1 y1 + s2 M2 y2, D = M1 G1 M1^T + s2 M2 G2 M2^T. With
+// a of variance sa^2 per axis and G_i at its estimate with independent element errors of variance
+// P_rc: Cov = sa^2 (D D^T + sum_i M_i diag(sum_c P_i,rc) M_i^T). sa^2 = ref_gravity_accel_sigma^2 +
+// (ref_gravity_speed w / g)^2, w the box rate less 3 correction sigma (a bias not yet known is no turn)
+Eigen::Matrix3d DriftlessFilter::unknown_accel_cov_dps2(const Eigen::Matrix3d& M1, const Eigen::Matrix3d& M2,
+                                                        double s2, const Eigen::Vector3d& w_box_dps) const {
+  const double w_radps = std::max(0.0, w_box_dps.norm() - 3.0 * correction_sigma_dps().maxCoeff()) * kRadPerDeg;
+  const double turn_g = cfg_.ref_gravity_speed_mps * w_radps / kStandardGravityMps2;
+  const double sa2 = cfg_.ref_gravity_accel_sigma_g * cfg_.ref_gravity_accel_sigma_g + turn_g * turn_g;
+  using RowMajor3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
+  const std::array<const Eigen::Matrix3d*, 2> M{&M1, &M2};
+  Eigen::Matrix3d D = Eigen::Matrix3d::Zero(), U = Eigen::Matrix3d::Zero();
+  for (int i = 0; i < 2; ++i) {
+    const Eigen::Index o = i == 0 ? kGSens1.start : kGSens2.start;
+    const Eigen::Matrix3d& Mi = *M[static_cast<std::size_t>(i)];
+    D += (i == 0 ? 1.0 : s2) * Mi * Eigen::Map<const RowMajor3>(x_.data() + o) * Mi.transpose();
+    const Eigen::Matrix<double, 9, 1> p = P_.diagonal().segment<9>(o);
+    const Eigen::Vector3d row_sums = Eigen::Map<const RowMajor3>(p.data()).rowwise().sum();
+    U += Mi * row_sums.asDiagonal() * Mi.transpose();
+  }
+  return sa2 * (D * D.transpose() + U);
 }
 
 // the box rate over a standstill in box axes, at the current estimate of the biases
@@ -693,6 +720,9 @@ bool DriftlessFilter::rest_row(const StandstillSegment& s, const Eigen::Matrix3d
     h.segment<9>(kScale2.start) = 0.5 * up.transpose() * gsens_jacobian(M2, last_w_dps_[1]);
   }
   var_z = 0.25 * var_r + cfg_.box_rest_rate_sigma_dps * cfg_.box_rest_rate_sigma_dps + earth_up_var_dps2;
+  if (cfg_.gravity_from_ref_q && s.n_accel > 0) {
+    var_z += 0.25 * up.dot(unknown_accel_cov_dps2(M1, M2, 1.0, box_rate_dps(s, M1, M2)) * up);
+  }
   return true;
 }
 
@@ -878,7 +908,7 @@ double DriftlessFilter::DwellTrend::change_dps() const {
 }
 
 bool DriftlessFilter::box_quiet(const Sample& s) const {
-  if (!dwell_armed_ || out_.sensors_fused != 2 || !out_.at_rest) return false;
+  if (!dwell_armed_ || box_turning_ || out_.sensors_fused != 2 || !out_.at_rest) return false;
   if (!(out_.rate_body_dps.norm() < cfg_.box_dwell_rate_dps)) return false;
   constexpr double kOneGTolerance = 0.05;  // |f| within 5 % of 1 g: no linear acceleration
   for (const Eigen::Vector3d* a : {&s.accel1_mps2, &s.accel2_mps2}) {

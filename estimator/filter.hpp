@@ -181,6 +181,9 @@ class DriftlessFilter {
   /// whose gyros were calibrated once and never again would use. Zero until set; the filter's
   /// own state is not touched.
   void set_fixed_bias_dps(const Vector6d& b) { fixed_bias_ = b; }
+  /// The box turns at this sample by a witness other than the gyros (ref_q; set before push()): no
+  /// box dwell there. With gravity from ref_q the accel columns' 1 g test cannot tell (accel_check.hpp).
+  void set_box_turning(bool turning) { box_turning_ = turning; }
   /// Every accepted update is handed to `o` (nullptr: none); for the offline smoother.
   void set_update_observer(UpdateObserver* o) { observer_ = o; }
   /// The corrected outputs of the following push() calls use state `x` (bias referred to
@@ -297,6 +300,8 @@ class DriftlessFilter {
   void check_paper_position(double plat1_deg, double plat2_deg, int pattern);
   void fuse_rate(const Sample& s, const StandstillStep& st);
   Eigen::Vector3d box_rate_dps(const StandstillSegment& s, const Eigen::Matrix3d& M1, const Eigen::Matrix3d& M2) const;
+  Eigen::Matrix3d unknown_accel_cov_dps2(const Eigen::Matrix3d& M1, const Eigen::Matrix3d& M2, double s2,
+                                         const Eigen::Vector3d& w_box_dps) const;
   void stop_rows(const StandstillSegment& s, const Eigen::Matrix3d& M1, const Eigen::Matrix3d& M2, Residual3& cur) const;
   void add_rest_angle_noise(const StandstillSegment& seg, const Eigen::Matrix3d& M1, const Eigen::Matrix3d& M2,
                             Eigen::Matrix3d& R) const;
@@ -357,6 +362,7 @@ class DriftlessFilter {
   StandstillSegment dwell_;
   DwellTrend dwell_trend_;
   std::deque<DwellSample> dwell_recent_;
+  bool box_turning_ = false;  // set_box_turning()
   double dwell_quiet_since_s_ = kNaN;
   bool dwell_armed_ = false;
   double gate1_ = 0.0, gate3_ = 0.0, gate4_ = 0.0, gate6_ = 0.0;

@@ -337,6 +337,13 @@ void add_reference_finding(HealthReport& h, const ReferenceFit& fit) {
   add(h, std::move(f));
 }
 
+void put_findings_first(HealthReport& h, std::vector<HealthFinding> first) {
+  if (first.empty()) return;
+  HealthReport front;
+  for (HealthFinding& f : first) add(front, std::move(f));
+  put_first(h, std::move(front));
+}
+
 const char* to_string(HealthVerdict v) {
   switch (v) {
     case HealthVerdict::kOk: return "ok";

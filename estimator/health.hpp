@@ -15,6 +15,7 @@
 #include "estimator/clip_detector.hpp"
 #include "estimator/filter.hpp"
 #include "estimator/flip_check.hpp"
+#include "estimator/gravity_source.hpp"
 #include "estimator/lag_check.hpp"
 #include "estimator/reference_check.hpp"
 #include "estimator/standstill_gyro.hpp"
@@ -106,6 +107,13 @@ enum class HealthCause {
                          // best RefConvention (as a number; kNoFit: NaN), count = turning windows,
                          // components = {the box axis of the example turn}, positions_deg =
                          // {{its end time s, its span s}, {gyro turn deg, ref_q turn deg about that axis}}
+  // the accel columns at the standstills (accel_check.hpp; components = {the sensor, 1 or 2},
+  // value = the median |f| in the column's numbers, count = the standstill samples)
+  kAccelUnit,            // |f| reads g in another unit (suggested: the factor to m/s^2) or in none (NaN)
+  kAccelEmpty,           // |f| far below g: the columns are empty (all zero, or not filled)
+  kCalibUncertain,       // --calib without --selfcal, and the file's G/E sigma are not small against
+                         // the values (a self-calibration's output): value = the largest sigma / |value|
+                         // ... (accel_check.hpp: calib_uncertainty)
 };
 
 /// One check that did not pass, with the numbers that describe() turns into text.
@@ -176,6 +184,9 @@ struct HealthReport {
   std::vector<int> unobservable;       // 0..5 = b1_x .. b2_z
   std::vector<HealthFinding> findings; // worst first
   LagCheckResult signal_chain;         // the residual against the angular acceleration (lag_check.hpp)
+  // what drove the g-sensitivity states (self-calibration; kNone without it): the fix texts pick
+  // their advice by it (cli/estimate_health.cpp)
+  GravitySource gravity_source = GravitySource::kNone;
 };
 
 /// Limits of the saturation finding: clipped while both platforms rest in at least this fraction
@@ -239,6 +250,9 @@ void add_box_motion_finding(HealthReport& h, const BoxMotion& m, bool box_at_res
 /// ref_q in another convention than the log's, or fitting none (reference_check.hpp): a degraded
 /// `reference_mismatch` finding (the attitude figures are withheld; the biases stand).
 void add_reference_finding(HealthReport& h, const ReferenceFit& fit);
+
+/// `first` ahead of h's findings (they are the others' cause); the verdict is the worst of all.
+void put_findings_first(HealthReport& h, std::vector<HealthFinding> first);
 
 /// Paper mode builds H from eq. (5)'s positions, +-flip_angle_deg in its fixed order: standstills
 /// that rested elsewhere or out of that order are findings ahead of the others (their cause),

@@ -8,6 +8,7 @@
 
 #include <Eigen/Cholesky>
 
+#include "estimator/accel_check.hpp"
 #include "estimator/flip_check.hpp"
 #include "estimator/stats.hpp"
 
@@ -330,12 +331,30 @@ void add_input_findings(const log::Metadata& meta, const log::LogReader* reader,
                                     : double(sum.counters.simultaneous_flips));
 }
 
+// what drove the g-sensitivity states when the log has no accel columns
+void add_gravity_source_warning(const DriftlessFilter& filter, EstimateSummary& sum) {
+  if (!filter.has_gsens_states() || sum.rows == 0) return;
+  if (sum.gravity_source == GravitySource::kRefQ) {
+    const EstimatorConfig& c = filter.config();
+    sum.warnings.push_back(gravity_from_ref_q_note(c.ref_gravity_accel_sigma_g, c.ref_gravity_speed_mps));
+  } else if (sum.gravity_source == GravitySource::kNone) {
+    sum.warnings.push_back(
+        "g-sensitivity cannot be estimated without accel columns or ref_q: log them (accel1_*/accel2_*, or "
+        "ref_qw..ref_qz); the g-sensitivity states keep their prior sigma, the flip updates were made without "
+        "them (their prior variance in R) and the box dwells not at all");
+  }
+}
+
 // the pass itself; `reader` (optional) adds the log reader's findings to the warnings
 EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const SampleSource& next,
                          const log::LogReader* reader, const EstimatorConfig& cfg, EstimateSink* sink,
                          const EstimateRunOptions& opt, bool (*should_stop)()) {
   EstimateSummary sum;
-  DriftlessFilter filter(cfg, box_geometry_from_metadata(meta));
+  // no accel columns but ref_q: the self-calibration takes gravity from ref_q (accel_check.hpp)
+  sum.gravity_source = cfg.self_calibration ? gravity_source(fields) : GravitySource::kNone;
+  EstimatorConfig run_cfg = cfg;
+  run_cfg.gravity_from_ref_q = sum.gravity_source == GravitySource::kRefQ;
+  DriftlessFilter filter(run_cfg, box_geometry_from_metadata(meta));
   filter.set_update_observer(opt.update_observer);
   add_stream_warnings(meta, sum);
   const bool have_truth = (fields & kFieldTrueBias) != 0;
@@ -350,6 +369,9 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
   FlipCheck flips(cfg.flip_max_s, cfg.settle_s);
   ReferenceCheck ref_check;
   BoxMotionCheck box_motion;
+  AccelCheck accel_check;
+  ReferenceTurn ref_turn(BoxMotionLimits{}.ref_rate_dps);
+  const bool check_accel = (fields & kFieldAccel) != 0;
 
   // the lock state changes only at updates (P shrinks there; a gate re-lock widens it)
   bool locked = false;
@@ -378,7 +400,12 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
     ++sum.rows;
     if (!std::isfinite(sum.t_first_s)) sum.t_first_s = s.t_s;
     sum.t_last_s = s.t_s;
+    if (run_cfg.gravity_from_ref_q) {
+      gravity_from_ref_q(filter, s);
+      filter.set_box_turning(ref_turn.turning(s));
+    }
     const PushStatus st = filter.push(s);
+    if (check_accel) accel_check.push(s, filter.output().at_rest);
     on_update(st, s);  // first: the row that made an update carries the state after it
     lag.push(s, filter);
     check_flip(flips, filter);
@@ -406,12 +433,7 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
 
   if (reader != nullptr) add_reader_warnings(*reader, sum);
   if (sum.rows == 0) sum.warnings.push_back("the log holds no rows");
-  if (filter.has_gsens_states() && (fields & kFieldAccel) == 0 && sum.rows > 0) {
-    sum.warnings.push_back(
-        "no accel columns: the g-sensitivity states (--selfcal) cannot be observed and keep their prior sigma; "
-        "the flip updates were made without them (their prior variance in R) and the box dwells, which need "
-        "the accelerometers, not at all. Log accel1_*/accel2_* to estimate G");
-  }
+  add_gravity_source_warning(filter, sum);
   sum.counters = filter.counters();
   add_filter_warnings(filter, sum);
   sum.bias_dps = filter.bias_dps();
@@ -439,6 +461,7 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
   score.finish();
   if (use_window) window.finish(filter);
   sum.health = health.finish(filter, sum.rows > 0 ? sum.t_last_s - sum.t_first_s : 0.0, lag.finish());
+  sum.health.gravity_source = sum.gravity_source;
   name_prior_rejection(sum.health, first_update);
   // the flip check's findings first: the input findings put first lead them (a clipping gyro or
   // rests away from the stops make the flip turns disagree with the angles)
@@ -447,6 +470,10 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
   add_reference_finding(sum.health, sum.reference);
   sum.box_motion = box_motion.finish();
   add_box_motion_finding(sum.health, sum.box_motion, cfg.box_at_rest, sum.counters.box_dwell_updates);
+  // accel columns in another unit, or empty: ahead of everything they spoil
+  if (check_accel) add_accel_findings(sum.health, accel_check.finish(), cfg.self_calibration);
+  // an uncertain calibration applied as exact (no self-calibration to refine it) leads them all
+  if (!cfg.self_calibration) add_calib_finding(sum.health, cfg.calibration);
   return sum;
 }
 

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "estimator/accel_check.hpp"
 #include "estimator/attitude.hpp"
 #include "estimator/attitude_comparison.hpp"
 #include "estimator/box_motion_check.hpp"
@@ -116,6 +117,8 @@ struct EstimateSummary {
   // self-calibrating mode: each sensor's g-sensitivity (deg/s per g, sensor axes) and its sigma,
   // and the sigma of the correction b + G f the filter applies (what "locked" looks at)
   bool gsens_states = false;
+  // what drove them: the accel columns, gravity from ref_q (no accel columns), none (accel_check.hpp)
+  GravitySource gravity_source = GravitySource::kNone;
   std::array<Eigen::Matrix3d, 2> gsens_dps_per_g{Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero()};
   std::array<Eigen::Matrix3d, 2> gsens_sigma_dps_per_g{Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero()};
   Vector6d correction_sigma_dps = Vector6d::Constant(kNaN);

@@ -40,13 +40,15 @@ grep -q "gyro1_y reads 0.1220703 deg/s in every one" "$t/stuck.out" || fail "stu
 ! grep -q "dead_axis" "$t/base/summary.json" || fail "base log: a dead axis found"
 
 # P13 GIVEN a turning box without accel columns WHEN --selfcal THEN flip updates are made and the
-# warning says G cannot be observed
+# warning says what drove G: this log has ref_q, so gravity from it (stop-27 F33; before: "cannot
+# be observed")
 "$py" "$gen" --out "$t/noaccel.csv" --motion turn --sensor bmi088 --duration 300 > /dev/null || fail "generator"
 "$bin" estimate --selfcal --log "$t/noaccel.csv" --out "$t/noaccel" > "$t/noaccel.out" 2>&1 || fail "selfcal: $(cat "$t/noaccel.out")"
 [[ $(json "$t/noaccel" "d['flips']['updates'] >= 5 and d['flips']['rejected'] == 0") == True ]] ||
   fail "selfcal without accel: flips $(json "$t/noaccel" "d['flips']")"
-grep -q "no accel columns: the g-sensitivity states (--selfcal) cannot be observed" "$t/noaccel.out" ||
+grep -q "gravity_source: ref_q: no accel columns, so the g-sensitivity states took gravity from ref_q" "$t/noaccel.out" ||
   fail "selfcal without accel: no word: $(cat "$t/noaccel.out")"
+[[ $(json "$t/noaccel" "d['self_calibration']['gravity_source']") == ref_q ]] || fail "selfcal without accel: gravity_source"
 
 # P6 GIVEN both platforms always flipping together THEN never locked, naming the positions that occurred
 "$py" "$gen" --out "$t/both.csv" --schedule both --duration 200 > /dev/null || fail "generator"
