@@ -598,17 +598,7 @@ FaultDetector::PositionCheck FaultDetector::try_position_check(double t_s, bool 
   }
   const bool decided = ev.cost[order[1]] - ev.cost[order[0]] > p_.isolation_margin;
   if (!decided && !timeout) return PositionCheck::kChange;  // a change, its source not yet told apart
-  FaultReport f;
-  f.kind = FaultKind::kBiasStep;
-  f.sensor = order[0] < 3 ? 1 : 2;
-  f.axis = order[0] % 3;
-  f.t_alarm_s = t_alarm_;
-  f.t_isolated_s = t_s;
-  f.t_onset_s = t_onset_;
-  f.magnitude = ev.mag[order[0]];
-  f.confident = decided;
-  f.bias_before_dps = bias_ref_;
-  fault_ = f;
+  record_bias_step(order[0], t_s, ev.mag[order[0]], decided);
   return PositionCheck::kDecided;
 }
 
@@ -730,17 +720,22 @@ void FaultDetector::try_isolate_mean(double t_s, bool timeout) {
   }
   const bool mostly_quiet = quiet >= 10 && 2 * quiet >= all;
   if (pc == PositionCheck::kNoData && !timeout && mostly_quiet) return;
+  // the step's size from the changes against earlier visits when there are any: the innovation's
+  // mean also carries the position-dependent offsets of uncalibrated sensors
+  record_bias_step(order[0], t_s, pc == PositionCheck::kChange ? change_mag[order[0]] : mag[order[0]], decided);
+}
+
+// the isolated bias step on channel `channel` (0-2 sensor 1's x-z, 3-5 sensor 2's) becomes the fault
+void FaultDetector::record_bias_step(int channel, double t_s, double magnitude, bool confident) {
   FaultReport f;
   f.kind = FaultKind::kBiasStep;
-  f.sensor = order[0] < 3 ? 1 : 2;
-  f.axis = order[0] % 3;
+  f.sensor = channel < 3 ? 1 : 2;
+  f.axis = channel % 3;
   f.t_alarm_s = t_alarm_;
   f.t_isolated_s = t_s;
   f.t_onset_s = t_onset_;
-  // the step's size from the changes against earlier visits when there are any: the innovation's
-  // mean also carries the position-dependent offsets of uncalibrated sensors
-  f.magnitude = pc == PositionCheck::kChange ? change_mag[order[0]] : mag[order[0]];
-  f.confident = decided;
+  f.magnitude = magnitude;
+  f.confident = confident;
   f.bias_before_dps = bias_ref_;
   fault_ = f;
 }

@@ -189,6 +189,7 @@ class FaultDetector {
   void feed_isolation(const Record& rec);
   void try_classify(double t_s);
   void try_isolate_mean(double t_s, bool timeout);
+  void record_bias_step(int channel, double t_s, double magnitude, bool confident);
 
   FdiParams p_;
   int stuck_samples_;
