@@ -15,8 +15,21 @@ if ! scratch=$(mktemp -d "$base/test.XXXXXX"); then
   echo "run_in_scratch: cannot make a scratch folder in $base ($(free_mib "$base") MiB free there)" >&2
   exit 1
 fi
+started=$(date +%s.%N)
 TMPDIR=$scratch "$@"
 rc=$?
+# DRIFTLESS_TEST_CPU_LOG (CI sets it): one line per test, its CPU seconds (user + system of the
+# test's processes), wall seconds and command, so CI can say where a suite's time goes on a
+# machine whose load would distort wall times
+if [[ -n ${DRIFTLESS_TEST_CPU_LOG:-} ]]; then
+  # 'times' in this shell (not in a subshell, which has no children): the shell's own user and
+  # system time, then its children's, as "<m>m<s>s" each
+  times > "$scratch.times"
+  cpu=$(awk 'NR == 2 { t = 0; for (i = 1; i <= 2; ++i) { split($i, p, /[ms]/); t += 60 * p[1] + p[2] } printf "%.2f", t }' "$scratch.times")
+  rm -f "$scratch.times"
+  wall=$(awk -v a="$started" -v b="$(date +%s.%N)" 'BEGIN { printf "%.2f", b - a }')
+  echo "$cpu $wall $rc $*" >> "$DRIFTLESS_TEST_CPU_LOG"
+fi
 # 77: a cli script that cannot run here (SKIP_RETURN_CODE); its files are not needed either
 if [[ $rc -eq 0 || $rc -eq 77 ]]; then
   rm -rf "$scratch"
