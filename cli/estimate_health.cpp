@@ -32,6 +32,7 @@ const char* cause_key(est::HealthCause c) {
     case est::HealthCause::kRelocks: return "relocks";
     case est::HealthCause::kLateLock: return "late_lock";
     case est::HealthCause::kSteadyStateAtLock: return "steady_state_at_lock";
+    case est::HealthCause::kLockUnreachable: return "lock_unreachable";
     case est::HealthCause::kSignalChainLag: return "signal_chain_lag";
     case est::HealthCause::kSaturation: return "saturation";
     case est::HealthCause::kAttitudeWithheld: return "attitude_withheld";
@@ -55,6 +56,7 @@ const char* cause_key(est::HealthCause c) {
     case est::HealthCause::kAccelUnit: return "accel_unit";
     case est::HealthCause::kAccelEmpty: return "accel_empty";
     case est::HealthCause::kCalibUncertain: return "calib_uncertain";
+    case est::HealthCause::kVerticalUnobserved: return "vertical_unobserved";
     default: if (is_flip_cause(c)) return flip_cause_key(c);
   }
   return "?";
@@ -107,16 +109,29 @@ std::string describe_box_motion(const est::HealthFinding& f) {
     seen += fmt::format("{}the fused rate changed by up to {:.3g} deg/s within one (the bias cannot)",
                         seen.empty() ? "" : " and ", f.sigma);
   }
-  const bool at_rest = !f.components.empty() && f.components[0] == 1;
-  const std::string claim =
-      at_rest ? std::string("--box-at-rest claims the box turns at the Earth rate only while the platforms rest")
-              : fmt::format("{} box dwells took the box as turning at the Earth rate only", f.count);
-  return fmt::format("the box was not at rest while both platforms rested: {} (e.g. t = {:.1f} s); {}, and the "
-                     "turn entered the biases and the g-sensitivity as if it were theirs. {}",
-                     seen, f.suggested, claim,
-                     at_rest ? "Drop --box-at-rest (a box in a vehicle, on a ship or a turntable turns)"
-                             : "Set box_dwell_updates: false in the configuration (a box in a vehicle, on a ship or "
-                               "a slow turntable)");
+  return fmt::format("the box was not at rest while both platforms rested: {} (e.g. t = {:.1f} s); --box-at-rest "
+                     "claims the box turns at the Earth rate only while the platforms rest, and the turn entered "
+                     "the biases and the g-sensitivity as if it were theirs. Drop --box-at-rest (a box in a "
+                     "vehicle, on a ship or a turntable turns)",
+                     seen, f.suggested);
+}
+
+// no pause of the box: the shared vertical bias stays near its g-sensitivity prior (section 1d)
+std::string describe_vertical(const est::HealthFinding& f, const est::EstimatorConfig& cfg, const RunUsed& u) {
+  const std::string turned =
+      std::isfinite(f.suggested) ? fmt::format(": ref_q turned at up to {:.3g} deg/s over the quiet standstills", f.suggested)
+                                 : std::string();
+  const double pause_s = cfg.box_dwell_min_s + 2.0 * cfg.box_dwell_margin_s;
+  return fmt::format(
+      "the bias both sensors share about the vertical was not observed: no box dwell was used (the box never "
+      "paused{}), and a g-sensitivity that keeps its sign about the box vertical (the 1 g along it) looks like that "
+      "shared bias to eq. (2). The correction is known to +-{:.3g} deg/s against its prior {:.3g} deg/s: up to {:.0f} "
+      "deg/h of heading drift. Let the box pause now and then (both platforms resting and the box not turning for "
+      "{:g} s or more: a vehicle's stop, or a straight run with ref_q logged), {}, or add --box-at-rest if the box "
+      "stands still",
+      turned, f.value, f.sigma, f.value * 3600.0, pause_s,
+      u.calib ? "or self-calibrate these sensors once on a run with pauses and use that calib.yaml instead"
+              : "or pass --calib with a calib.yaml from a self-calibrated run with pauses (--calib-out)");
 }
 
 std::string describe_box_dwells(const est::HealthFinding& f) {
@@ -210,6 +225,56 @@ std::string noise_fix(const RunUsed& u) {
 namespace {
 
 // the lock: whether the filter locked, kept it, and what stayed unobserved
+// the closed form next to a settled sigma: the same (the bias's wander sets it) or below it (the
+// self-calibration or temperature states add the rest); empty without a prediction
+std::string closed_form_text(const est::SteadyStatePrediction& p, double settled_dps) {
+  if (!p.available) return "";
+  if (p.closed.sigma_dps >= 0.9 * settled_dps) {
+    return fmt::format(" (the closed-form steady state of this q, T and R is {:.3f} deg/s)", p.closed.sigma_dps);
+  }
+  return fmt::format(" (the closed-form steady state of this q, T and R is {:.3f} deg/s for the bias alone; the "
+                     "self-calibration or temperature states' uncertainty adds the rest)",
+                     p.closed.sigma_dps);
+}
+
+// what would reach the lock level: the update interval of the prediction, or none
+std::string flip_period_fix(const est::SteadyStatePrediction& p) {
+  if (!p.available) return "flip more often (shorter rests between flips)";
+  if (!std::isfinite(p.interval_for_lock_s)) {
+    return "no flip period reaches it with this noise: a quieter sensor (or averaging both more often) is needed";
+  }
+  if (p.interval_for_lock_s > p.schedule.interval_s) {
+    return fmt::format("rest longer between flips: one flip every {:.1f} s (now {:.1f} s) brings it to {:.2g} of the "
+                       "lock level",
+                       p.interval_for_lock_s, p.schedule.interval_s, est::kSteadyStateLockMargin);
+  }
+  return fmt::format("flip more often: one flip every {:.1f} s (now {:.1f} s, the flips' {:.1f} s kept) brings it "
+                     "to {:.2g} of the lock level",
+                     p.interval_for_lock_s, p.schedule.interval_s, p.schedule.interval_s - p.schedule.window_s,
+                     est::kSteadyStateLockMargin);
+}
+
+// steady_state_at_lock's fix: the flip period when the bias's own steady state sets the settled
+// sigma; when the closed form is well below it, the flip rate does not set it, the other states do
+std::string settled_fix(const est::HealthFinding& f, const RunUsed& u) {
+  const est::SteadyStatePrediction& p = f.steady_state;
+  if (!p.available || p.closed.sigma_dps >= 0.9 * f.value) return flip_period_fix(p);
+  const std::string who = f.components.empty() ? std::string("the correction") : component_names(f.components);
+  return fmt::format("{}{}",
+                     std::isfinite(p.interval_for_lock_s)
+                         ? fmt::format("flipping more often lowers only the bias's part of {}'s sigma: one flip every "
+                                       "{:.1f} s would reach {:.2g} of the lock level only if the rest shrank with it",
+                                       who, p.interval_for_lock_s, est::kSteadyStateLockMargin)
+                         : fmt::format("flipping more often does not lower {}'s sigma (no flip period brings even the "
+                                       "bias's part low enough)",
+                                       who),
+                     u.selfcal && !u.box_at_rest
+                         ? ": with --selfcal the g-sensitivity both sensors share about the box vertical is seen only "
+                           "while the box rests (box dwells, docs/estimator.md section 1d): let the box stop now and "
+                           "then, or add --box-at-rest if it stands still"
+                         : "");
+}
+
 std::string describe_lock(const est::HealthFinding& f, const est::EstimatorConfig& cfg, const RunUsed& u) {
   switch (f.cause) {
     case est::HealthCause::kNoUpdate:
@@ -227,9 +292,17 @@ std::string describe_lock(const est::HealthFinding& f, const est::EstimatorConfi
                                        "columns' units ('driftless check')"
                                      : "try --tune auto");
     case est::HealthCause::kNeverLocked:
-      return fmt::format("never locked: the largest sigma of the bias correction is {:.3g} deg/s{}; {}", f.value,
+      return fmt::format("never locked: the largest sigma of the bias correction is {:.3g} deg/s{}{}; {}", f.value,
                          f.components.empty() ? std::string() : ", unobservable: " + component_names(f.components),
-                         f.suggested > 0.02 ? fmt::format("the gate rejected {:.0f} % of the updates, so the flips "
+                         f.steady_state.available && !f.steady_state.lock_unreachable()
+                             ? ", where it had settled (within 2 % of itself one position cycle earlier over the last "
+                               "8 updates), so a longer log gives the same sigma" +
+                                   closed_form_text(f.steady_state, f.value)
+                             : std::string(),
+                         f.steady_state.lock_unreachable()
+                             ? "the steady state of the bias sigma is above the lock level (lock_unreachable above): "
+                               "a longer log or more flips of the same kind cannot lock it"
+                         : f.suggested > 0.02 ? fmt::format("the gate rejected {:.0f} % of the updates, so the flips "
                                                           "that observe them were not used (see below)",
                                                           100.0 * f.suggested)
                                             : !f.positions_deg.empty()
@@ -277,9 +350,25 @@ std::string describe_lock(const est::HealthFinding& f, const est::EstimatorConfi
                          "(within 2 % of itself one position cycle earlier), at the lock level {:.3g} deg/s: the "
                          "bias wanders (q {:.2g} (deg/s)^2/s) by sqrt(q T) = {:.3f} deg/s between updates T = "
                          "{:.1f} s apart, as much as the updates pin down, so a longer log gives the same sigma and "
-                         "the lock came by chance; flip more often (shorter rests between flips), or compare the "
+                         "the lock came by chance{}; {}, or compare the attitude anyway with --attitude-start-sigma {:.2f}",
+                         f.value, f.count, f.sigma, q, wander_dps, f.suggested, closed_form_text(f.steady_state, f.value),
+                         settled_fix(f, u), start_dps);
+    }
+    case est::HealthCause::kLockUnreachable: {
+      const est::SteadyStatePrediction& p = f.steady_state;
+      const double start_dps = std::ceil(1.25 * f.value * 100.0) / 100.0;
+      return fmt::format("the lock level {:.3g} deg/s cannot be reached: the steady state of the bias sigma in closed "
+                         "form (the periodic Riccati fixed point) is {:.3f} deg/s, from q {:.2g} (deg/s)^2/s, updates "
+                         "T = {:.1f} s apart and standstills of {:.1f} s (R {:.2g} (deg/s)^2 per sensor), known from "
+                         "the first {} updates at t = {:.1f} s: the bias wanders by sqrt(q T) = {:.3f} deg/s between "
+                         "updates, more than they pin down, and a longer log gives the same sigma{}; {}, or compare the "
                          "attitude anyway with --attitude-start-sigma {:.2f}",
-                         f.value, f.count, f.sigma, q, wander_dps, f.suggested, start_dps);
+                         f.sigma, f.value, p.schedule.q_dps2_per_s, p.schedule.interval_s, p.schedule.window_s,
+                         p.schedule.meas_var_dps2, est::SteadyStateWatch::kScheduleUpdates, p.known_at_t_s,
+                         p.closed.walk_per_update_dps,
+                         p.other_states ? " (for the bias alone: the self-calibration or temperature states add to it)"
+                                        : "",
+                         flip_period_fix(p), start_dps);
     }
     default: break;
   }
@@ -487,6 +576,7 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
     case est::HealthCause::kRelocks:
     case est::HealthCause::kLateLock:
     case est::HealthCause::kSteadyStateAtLock:
+    case est::HealthCause::kLockUnreachable:
       return describe_lock(f, cfg, u);
     case est::HealthCause::kNoiseUnderstated:
     case est::HealthCause::kNoiseOverstated:
@@ -522,10 +612,27 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
       return describe_accel(f);
     case est::HealthCause::kBoxDwellsRejected:
       return describe_box_dwells(f);
+    case est::HealthCause::kVerticalUnobserved:
+      return describe_vertical(f, cfg, u);
     default: break;  // the flip-turn check's causes: describe_flip() above
   }
   return "?";
 }
+
+namespace {
+// the closed-form steady state of the run's first updates, or null
+std::string steady_state_json(const est::SteadyStatePrediction& p) {
+  if (!p.available) return "null";
+  return fmt::format("{{\"sigma_dps\": {}, \"sigma_low_dps\": {}, \"lock_sigma_dps\": {}, \"lock_unreachable\": {}, "
+                     "\"q_dps2_per_s\": {}, \"interval_s\": {}, \"window_s\": {}, \"meas_var_dps2\": {}, "
+                     "\"known_at_t_s\": {}, \"interval_for_lock_s\": {}, \"bias_only\": {}}}",
+                     json_number(p.closed.sigma_dps), json_number(p.closed.sigma_low_dps), json_number(p.lock_sigma_dps),
+                     p.lock_unreachable() ? "true" : "false", json_number(p.schedule.q_dps2_per_s),
+                     json_number(p.schedule.interval_s), json_number(p.schedule.window_s),
+                     json_number(p.schedule.meas_var_dps2), json_number(p.known_at_t_s),
+                     json_number(p.interval_for_lock_s), p.other_states ? "false" : "true");
+}
+}  // namespace
 
 std::string health_json(const est::HealthReport& h, const est::EstimatorConfig& cfg) {
   std::string unobs = "[";
@@ -544,14 +651,17 @@ std::string health_json(const est::HealthReport& h, const est::EstimatorConfig& 
       "  \"health\": {{\"verdict\": \"{}\", \"locked\": {}, \"lock_t_s\": {}, \"locked_at_end\": {}, \"lock_lost_t_s\": {}, "
       "\"updates\": {}, \"rejected\": {}, "
       "\"rejected_fraction\": {}, \"nis_updates\": {}, \"nis_dof_mean\": {}, \"nis_mean\": {}, "
-      "\"nis_mean_band_95\": [{}, {}], \"nis_mean_degraded_above\": {}, \"relocks\": {}, \"unobservable\": {},\n"
+      "\"nis_mean_band_95\": [{}, {}], \"nis_mean_degraded_above\": {}, \"relocks\": {}, \"lock_losses\": {}, "
+      "\"unobservable\": {},\n"
+      "  \"steady_state\": {},\n"
       "  \"signal_chain\": {{\"samples\": {}, \"lag_s\": {}, \"lag_sigma_s\": {}, \"update_excess\": {}, "
       "\"significant\": {}}},\n"
       "  \"findings\": {}}}",
       est::to_string(h.verdict), h.locked ? "true" : "false", json_number(h.lock_t_s),
       h.locked_at_end ? "true" : "false", json_number(h.lock_lost_t_s), h.updates, h.rejected,
       json_number(h.rejected_fraction), h.nis_updates, json_number(h.nis_dof_mean), json_number(h.nis_mean), json_number(h.nis_mean_band_lo),
-      json_number(h.nis_mean_band_hi), json_number(h.nis_mean_degraded_above), h.relocks, unobs, h.signal_chain.samples,
+      json_number(h.nis_mean_band_hi), json_number(h.nis_mean_degraded_above), h.relocks, h.lock_losses, unobs, steady_state_json(h.steady_state),
+      h.signal_chain.samples,
       json_number(h.signal_chain.lag_s), json_number(h.signal_chain.lag_sigma_s), json_number(h.signal_chain.update_excess),
       h.signal_chain.significant ? "true" : "false", findings);
 }

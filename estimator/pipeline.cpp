@@ -10,6 +10,7 @@
 
 #include "estimator/accel_check.hpp"
 #include "estimator/flip_check.hpp"
+#include "estimator/lock_state.hpp"
 #include "estimator/stats.hpp"
 
 namespace driftless::est {
@@ -278,24 +279,30 @@ void withhold_attitude_reference(EstimateSummary& sum) {
   sum.final_corrected = sum.final_raw = sum.final_fixed = none;
 }
 
-// after an update: is the correction locked (filter_locked at the lock level)? Records the first
-// lock, each gate re-lock and when the lock came back after it.
-// `t_s` is the time of the sample whose push made the update: the first row it corrects.
 // the flip-turn check (flip_check.hpp): one sample of the filter's output; a flip that ended is
 // measured in the frames of its start angles
-void check_flip(FlipCheck& check, const DriftlessFilter& filter) {
+void check_flip(FlipCheck& check, const DriftlessFilter& filter, const Sample& s) {
   const SampleOutput& o = filter.output();
-  if (!check.push(o.t_s, o.y1c_dps, o.y2c_dps, o.plat1_deg, o.plat2_deg, o.at_rest)) return;
+  if (!check.push(o.t_s, o.y1c_dps, o.y2c_dps, s.gyro1_dps, s.gyro2_dps, o.plat1_deg, o.plat2_deg, o.at_rest)) return;
   const BoxGeometry& box = filter.geometry();
   check.close({filter.body_from_sensor(1, check.start_deg(1)), filter.body_from_sensor(2, check.start_deg(2)),
                box.hinge1_axis.normalized(), box.hinge2_axis.normalized()});
 }
 
-bool lock_step(const DriftlessFilter& filter, double lock_sigma_dps, const UpdateRecord& u, double t_s,
+// after an update: is the correction locked (the lock level with lock_state.hpp's hysteresis)?
+// Records the first lock, each gate re-lock, each loss of the lock and when it came back.
+// `t_s` is the time of the sample whose push made the update: the first row it corrects.
+bool lock_step(LockState& lock, const DriftlessFilter& filter, const UpdateRecord& u, double t_s,
                EstimateSummary& sum) {
   if (u.relocked) sum.relocks.push_back({u.t_s, u.relock_nis, kNaN});
-  const bool locked = filter_locked(filter, lock_sigma_dps);
-  if (!locked) return false;
+  // the lock with hysteresis (lock_state.hpp): a sigma that only crosses the level keeps it
+  if (lock.on_update(filter.correction_sigma_dps().maxCoeff(), u.relocked) == LockState::Change::kLost) {
+    sum.lock_losses.push_back({u.t_s, filter.correction_sigma_dps().maxCoeff(), u.relocked, kNaN});
+  }
+  if (!lock.locked()) return false;
+  if (!sum.lock_losses.empty() && !std::isfinite(sum.lock_losses.back().locked_again_t_s)) {
+    sum.lock_losses.back().locked_again_t_s = t_s;
+  }
   if (!std::isfinite(sum.locked_from_t_s)) sum.locked_from_t_s = t_s;
   if (!sum.relocks.empty() && !std::isfinite(sum.relocks.back().locked_again_t_s)) {
     sum.relocks.back().locked_again_t_s = t_s;
@@ -375,6 +382,7 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
 
   // the lock state changes only at updates (P shrinks there; a gate re-lock widens it)
   bool locked = false;
+  LockState lock(opt.attitude_start_sigma_dps);
   std::vector<std::array<double, 2>> positions;  // the position pairs of the updates (to 0.1 deg)
   UpdateRecord first_update;
   auto on_update = [&](PushStatus st, const Sample& s) {
@@ -382,7 +390,7 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
     const UpdateRecord& u = filter.last_update();
     note_position(positions, u.plat1_deg, u.plat2_deg);
     if (u.index == 0) first_update = u;
-    locked = lock_step(filter, opt.attitude_start_sigma_dps, u, s.t_s, sum);
+    locked = lock_step(lock, filter, u, s.t_s, sum);
     if (sink != nullptr) sink->on_update(u, filter.covariance_dps2(), s, locked);
     health.on_update(u, filter);
     if (have_truth && st == PushStatus::kUpdated) score.add(filter, s);
@@ -400,15 +408,15 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
     ++sum.rows;
     if (!std::isfinite(sum.t_first_s)) sum.t_first_s = s.t_s;
     sum.t_last_s = s.t_s;
-    if (run_cfg.gravity_from_ref_q) {
-      gravity_from_ref_q(filter, s);
-      filter.set_box_turning(ref_turn.turning(s));
-    }
+    if (run_cfg.gravity_from_ref_q) gravity_from_ref_q(filter, s);
+    // ref_q witnesses the box's turns for the box dwells (with or without accel columns)
+    if (s.ref_q_wxyz.allFinite()) filter.set_box_turning(ref_turn.turning(s));
+    else filter.clear_box_turning();
     const PushStatus st = filter.push(s);
     if (check_accel) accel_check.push(s, filter.output().at_rest);
     on_update(st, s);  // first: the row that made an update carries the state after it
     lag.push(s, filter);
-    check_flip(flips, filter);
+    check_flip(flips, filter, s);
     if (sum.attitude_available) ref_check.push(s, filter);
     box_motion.push(s, filter.output());
     sum.samples_locked += locked ? 1 : 0;
@@ -469,7 +477,8 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
   add_input_findings(meta, reader, cfg, filter, positions, sum);
   add_reference_finding(sum.health, sum.reference);
   sum.box_motion = box_motion.finish();
-  add_box_motion_finding(sum.health, sum.box_motion, cfg.box_at_rest, sum.counters.box_dwell_updates);
+  add_box_motion_finding(sum.health, sum.box_motion, cfg.box_at_rest);
+  add_vertical_finding(sum.health, filter, sum.box_motion);
   // accel columns in another unit, or empty: ahead of everything they spoil
   if (check_accel) add_accel_findings(sum.health, accel_check.finish(), cfg.self_calibration);
   // an uncertain calibration applied as exact (no self-calibration to refine it) leads them all
