@@ -33,6 +33,7 @@ const char* cause_key(est::HealthCause c) {
     case est::HealthCause::kRelocks: return "relocks";
     case est::HealthCause::kLateLock: return "late_lock";
     case est::HealthCause::kSteadyStateAtLock: return "steady_state_at_lock";
+    case est::HealthCause::kLockUnreachable: return "lock_unreachable";
     case est::HealthCause::kSignalChainLag: return "signal_chain_lag";
     case est::HealthCause::kSaturation: return "saturation";
     case est::HealthCause::kAttitudeWithheld: return "attitude_withheld";
@@ -218,6 +219,56 @@ std::string quiet_fix(const RunUsed& u) {
 }
 
 // the lock: whether the filter locked, kept it, and what stayed unobserved
+// the closed form next to a settled sigma: the same (the bias's wander sets it) or below it (the
+// self-calibration or temperature states add the rest); empty without a prediction
+std::string closed_form_text(const est::SteadyStatePrediction& p, double settled_dps) {
+  if (!p.available) return "";
+  if (p.closed.sigma_dps >= 0.9 * settled_dps) {
+    return fmt::format(" (the closed-form steady state of this q, T and R is {:.3f} deg/s)", p.closed.sigma_dps);
+  }
+  return fmt::format(" (the closed-form steady state of this q, T and R is {:.3f} deg/s for the bias alone; the "
+                     "self-calibration or temperature states' uncertainty adds the rest)",
+                     p.closed.sigma_dps);
+}
+
+// what would reach the lock level: the update interval of the prediction, or none
+std::string flip_period_fix(const est::SteadyStatePrediction& p) {
+  if (!p.available) return "flip more often (shorter rests between flips)";
+  if (!std::isfinite(p.interval_for_lock_s)) {
+    return "no flip period reaches it with this noise: a quieter sensor (or averaging both more often) is needed";
+  }
+  if (p.interval_for_lock_s > p.schedule.interval_s) {
+    return fmt::format("rest longer between flips: one flip every {:.1f} s (now {:.1f} s) brings it to {:.2g} of the "
+                       "lock level",
+                       p.interval_for_lock_s, p.schedule.interval_s, est::kSteadyStateLockMargin);
+  }
+  return fmt::format("flip more often: one flip every {:.1f} s (now {:.1f} s, the flips' {:.1f} s kept) brings it "
+                     "to {:.2g} of the lock level",
+                     p.interval_for_lock_s, p.schedule.interval_s, p.schedule.interval_s - p.schedule.window_s,
+                     est::kSteadyStateLockMargin);
+}
+
+// steady_state_at_lock's fix: the flip period when the bias's own steady state sets the settled
+// sigma; when the closed form is well below it, the flip rate does not set it, the other states do
+std::string settled_fix(const est::HealthFinding& f, const RunUsed& u) {
+  const est::SteadyStatePrediction& p = f.steady_state;
+  if (!p.available || p.closed.sigma_dps >= 0.9 * f.value) return flip_period_fix(p);
+  const std::string who = f.components.empty() ? std::string("the correction") : component_names(f.components);
+  return fmt::format("{}{}",
+                     std::isfinite(p.interval_for_lock_s)
+                         ? fmt::format("flipping more often lowers only the bias's part of {}'s sigma: one flip every "
+                                       "{:.1f} s would reach {:.2g} of the lock level only if the rest shrank with it",
+                                       who, p.interval_for_lock_s, est::kSteadyStateLockMargin)
+                         : fmt::format("flipping more often does not lower {}'s sigma (no flip period brings even the "
+                                       "bias's part low enough)",
+                                       who),
+                     u.selfcal && !u.box_at_rest
+                         ? ": with --selfcal the g-sensitivity both sensors share about the box vertical is seen only "
+                           "while the box rests (box dwells, docs/estimator.md section 1d): let the box stop now and "
+                           "then, or add --box-at-rest if it stands still"
+                         : "");
+}
+
 std::string describe_lock(const est::HealthFinding& f, const est::EstimatorConfig& cfg, const RunUsed& u) {
   switch (f.cause) {
     case est::HealthCause::kNoUpdate:
@@ -237,7 +288,10 @@ std::string describe_lock(const est::HealthFinding& f, const est::EstimatorConfi
     case est::HealthCause::kNeverLocked:
       return fmt::format("never locked: the largest sigma of the bias correction is {:.3g} deg/s{}; {}", f.value,
                          f.components.empty() ? std::string() : ", unobservable: " + component_names(f.components),
-                         f.suggested > 0.02 ? fmt::format("the gate rejected {:.0f} % of the updates, so the flips "
+                         f.steady_state.lock_unreachable()
+                             ? "the steady state of the bias sigma is above the lock level (lock_unreachable above): "
+                               "a longer log or more flips of the same kind cannot lock it"
+                         : f.suggested > 0.02 ? fmt::format("the gate rejected {:.0f} % of the updates, so the flips "
                                                           "that observe them were not used (see below)",
                                                           100.0 * f.suggested)
                                             : !f.positions_deg.empty()
@@ -285,9 +339,25 @@ std::string describe_lock(const est::HealthFinding& f, const est::EstimatorConfi
                          "(within 2 % of itself one position cycle earlier), at the lock level {:.3g} deg/s: the "
                          "bias wanders (q {:.2g} (deg/s)^2/s) by sqrt(q T) = {:.3f} deg/s between updates T = "
                          "{:.1f} s apart, as much as the updates pin down, so a longer log gives the same sigma and "
-                         "the lock came by chance; flip more often (shorter rests between flips), or compare the "
+                         "the lock came by chance{}; {}, or compare the attitude anyway with --attitude-start-sigma {:.2f}",
+                         f.value, f.count, f.sigma, q, wander_dps, f.suggested, closed_form_text(f.steady_state, f.value),
+                         settled_fix(f, u), start_dps);
+    }
+    case est::HealthCause::kLockUnreachable: {
+      const est::SteadyStatePrediction& p = f.steady_state;
+      const double start_dps = std::ceil(1.25 * f.value * 100.0) / 100.0;
+      return fmt::format("the lock level {:.3g} deg/s cannot be reached: the steady state of the bias sigma in closed "
+                         "form (the periodic Riccati fixed point) is {:.3f} deg/s, from q {:.2g} (deg/s)^2/s, updates "
+                         "T = {:.1f} s apart and standstills of {:.1f} s (R {:.2g} (deg/s)^2 per sensor), known from "
+                         "the first {} updates at t = {:.1f} s: the bias wanders by sqrt(q T) = {:.3f} deg/s between "
+                         "updates, more than they pin down, and a longer log gives the same sigma{}; {}, or compare the "
                          "attitude anyway with --attitude-start-sigma {:.2f}",
-                         f.value, f.count, f.sigma, q, wander_dps, f.suggested, start_dps);
+                         f.sigma, f.value, p.schedule.q_dps2_per_s, p.schedule.interval_s, p.schedule.window_s,
+                         p.schedule.meas_var_dps2, est::SteadyStateWatch::kScheduleUpdates, p.known_at_t_s,
+                         p.closed.walk_per_update_dps,
+                         p.other_states ? " (for the bias alone: the self-calibration or temperature states add to it)"
+                                        : "",
+                         flip_period_fix(p), start_dps);
     }
     default: break;
   }
@@ -502,6 +572,7 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
     case est::HealthCause::kRelocks:
     case est::HealthCause::kLateLock:
     case est::HealthCause::kSteadyStateAtLock:
+    case est::HealthCause::kLockUnreachable:
       return describe_lock(f, cfg, u);
     case est::HealthCause::kNoiseUnderstated:
     case est::HealthCause::kNoiseOverstated:
@@ -542,6 +613,21 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
   return "?";
 }
 
+namespace {
+// the closed-form steady state of the run's first updates, or null
+std::string steady_state_json(const est::SteadyStatePrediction& p) {
+  if (!p.available) return "null";
+  return fmt::format("{{\"sigma_dps\": {}, \"sigma_low_dps\": {}, \"lock_sigma_dps\": {}, \"lock_unreachable\": {}, "
+                     "\"q_dps2_per_s\": {}, \"interval_s\": {}, \"window_s\": {}, \"meas_var_dps2\": {}, "
+                     "\"known_at_t_s\": {}, \"interval_for_lock_s\": {}, \"bias_only\": {}}}",
+                     json_number(p.closed.sigma_dps), json_number(p.closed.sigma_low_dps), json_number(p.lock_sigma_dps),
+                     p.lock_unreachable() ? "true" : "false", json_number(p.schedule.q_dps2_per_s),
+                     json_number(p.schedule.interval_s), json_number(p.schedule.window_s),
+                     json_number(p.schedule.meas_var_dps2), json_number(p.known_at_t_s),
+                     json_number(p.interval_for_lock_s), p.other_states ? "false" : "true");
+}
+}  // namespace
+
 std::string health_json(const est::HealthReport& h, const est::EstimatorConfig& cfg) {
   std::string unobs = "[";
   for (std::size_t i = 0; i < h.unobservable.size(); ++i) {
@@ -559,14 +645,17 @@ std::string health_json(const est::HealthReport& h, const est::EstimatorConfig& 
       "  \"health\": {{\"verdict\": \"{}\", \"locked\": {}, \"lock_t_s\": {}, \"locked_at_end\": {}, \"lock_lost_t_s\": {}, "
       "\"updates\": {}, \"rejected\": {}, "
       "\"rejected_fraction\": {}, \"nis_updates\": {}, \"nis_dof_mean\": {}, \"nis_mean\": {}, "
-      "\"nis_mean_band_95\": [{}, {}], \"nis_mean_degraded_above\": {}, \"relocks\": {}, \"unobservable\": {},\n"
+      "\"nis_mean_band_95\": [{}, {}], \"nis_mean_degraded_above\": {}, \"relocks\": {}, \"lock_losses\": {}, "
+      "\"unobservable\": {},\n"
+      "  \"steady_state\": {},\n"
       "  \"signal_chain\": {{\"samples\": {}, \"lag_s\": {}, \"lag_sigma_s\": {}, \"update_excess\": {}, "
       "\"significant\": {}}},\n"
       "  \"findings\": {}}}",
       est::to_string(h.verdict), h.locked ? "true" : "false", json_number(h.lock_t_s),
       h.locked_at_end ? "true" : "false", json_number(h.lock_lost_t_s), h.updates, h.rejected,
       json_number(h.rejected_fraction), h.nis_updates, json_number(h.nis_dof_mean), json_number(h.nis_mean), json_number(h.nis_mean_band_lo),
-      json_number(h.nis_mean_band_hi), json_number(h.nis_mean_degraded_above), h.relocks, unobs, h.signal_chain.samples,
+      json_number(h.nis_mean_band_hi), json_number(h.nis_mean_degraded_above), h.relocks, h.lock_losses, unobs, steady_state_json(h.steady_state),
+      h.signal_chain.samples,
       json_number(h.signal_chain.lag_s), json_number(h.signal_chain.lag_sigma_s), json_number(h.signal_chain.update_excess),
       h.signal_chain.significant ? "true" : "false", findings);
 }

@@ -262,6 +262,13 @@ void write_estimate_summary(const fs::path& path, const SummaryContext& ctx, con
         json_number(s.relocks[i].nis), json_number(s.relocks[i].locked_again_t_s));
   }
   o += "],\n";
+  o += "  \"lock_losses\": [";
+  for (std::size_t i = 0; i < s.lock_losses.size(); ++i) {
+    const est::LockLoss& l = s.lock_losses[i];
+    add("{}{{\"t_s\": {}, \"sigma_dps\": {}, \"relock\": {}, \"locked_again_t_s\": {}}}", i ? ", " : "",
+        json_number(l.t_s), json_number(l.sigma_dps), l.relock ? "true" : "false", json_number(l.locked_again_t_s));
+  }
+  o += "],\n";
   if (s.truth.available) {
     const auto& t = s.truth;
     o += "  \"truth\": {\n";

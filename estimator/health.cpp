@@ -355,15 +355,21 @@ const char* to_string(HealthVerdict v) {
 
 void HealthMonitor::on_update(const UpdateRecord& rec, const DriftlessFilter& filter) {
   ++updates_;
-  // the lock now (a gate re-lock widens P inside a rejected or an accepted update alike)
-  const double sigma_dps = filter.correction_sigma_dps().maxCoeff();
-  const bool now = sigma_dps < limits_.lock_sigma_dps;
+  // the lock now, with the hysteresis of lock_state.hpp (a gate re-lock widens P inside a rejected
+  // or an accepted update alike)
+  int widest = 0;
+  const double sigma_dps = filter.correction_sigma_dps().maxCoeff(&widest);
+  const LockState::Change change = lock_.on_update(sigma_dps, rec.relocked);
+  const bool now = lock_.locked();
   if (!locked_ && !now) {
     if (before_lock_.size() == kSettleHistory) before_lock_.erase(before_lock_.begin());
-    before_lock_.push_back({rec.t_s, sigma_dps});
+    before_lock_.push_back({rec.t_s, sigma_dps, double(widest)});
   }
-  if (locked_ && locked_now_ && !now) lost_t_s_ = rec.t_s;
-  locked_now_ = now;
+  if (change == LockState::Change::kLost) {
+    lost_t_s_ = rec.t_s;
+    ++lock_losses_;
+  }
+  steady_.on_update(rec, filter);
   PositionCount& pc = by_position_[{tenth_deg(rec.plat1_deg), tenth_deg(rec.plat2_deg)}];
   ++pc.updates;
   if (!rec.accepted) {
@@ -489,6 +495,31 @@ void HealthMonitor::add_lock_lost_finding(HealthReport& h, const DriftlessFilter
   add(h, std::move(f));
 }
 
+// the bias alone settles at or above the lock level (the closed form of the first updates'
+// schedule): named as the cause, ahead of the lock findings it explains; true if given
+bool HealthMonitor::add_unreachable_finding(HealthReport& h) const {
+  const SteadyStatePrediction& p = steady_.prediction();
+  if (!p.lock_unreachable()) return false;
+  HealthFinding f;
+  f.cause = HealthCause::kLockUnreachable;
+  f.value = p.closed.sigma_dps;
+  f.sigma = p.lock_sigma_dps;
+  f.steady_state = p;
+  add(h, std::move(f));
+  return true;
+}
+
+// the prediction with the advised interval scaled to a settled sigma the closed form does not
+// reach (the self-calibration and temperature states add to it): the interval at which the
+// closed form is the margin's share of the lock level divided by settled / closed
+SteadyStatePrediction HealthMonitor::steady_at_settled(double settled_dps) const {
+  SteadyStatePrediction p = steady_.prediction();
+  if (!p.available || !(settled_dps > 0.0)) return p;
+  const double ratio = std::max(1.0, settled_dps / p.closed.sigma_dps);
+  p.interval_for_lock_s = interval_for_sigma_s(p.schedule, kSteadyStateLockMargin * p.lock_sigma_dps / ratio);
+  return p;
+}
+
 // never locked (failed) and the components that kept their prior sigma
 void HealthMonitor::add_lock_findings(HealthReport& h, const DriftlessFilter& filter, double duration_s) const {
   const EstimatorConfig& cfg = filter.config();
@@ -507,6 +538,7 @@ void HealthMonitor::add_lock_findings(HealthReport& h, const DriftlessFilter& fi
     f.value = filter.correction_sigma_dps().maxCoeff();  // what locking waits for
     f.suggested = h.rejected_fraction;  // rejections may be why the flips did not observe them
     if (f.cause == HealthCause::kNeverLocked) f.positions_deg = positions_if_never_apart();
+    if (f.cause == HealthCause::kNeverLocked && add_unreachable_finding(h)) f.steady_state = steady_.prediction();
     if (f.cause == HealthCause::kNoUpdate) {
       // rows skipped for a missing gyro value come before "the platforms never rested"
       const FilterCounters& c = filter.counters();
@@ -517,6 +549,7 @@ void HealthMonitor::add_lock_findings(HealthReport& h, const DriftlessFilter& fi
     return;
   }
   add_lock_lost_finding(h, filter);
+  if (add_unreachable_finding(h)) return;
   if (h.nis_updates < limits_.min_updates_after_lock) {
     HealthFinding f;
     f.cause = HealthCause::kLateLock;
@@ -531,6 +564,8 @@ void HealthMonitor::add_lock_findings(HealthReport& h, const DriftlessFilter& fi
       f.sigma = limits_.lock_sigma_dps;
       f.suggested = interval_s;
       f.count = before_lock_.size();
+      f.steady_state = steady_at_settled(settled_dps);
+      f.components = {static_cast<int>(before_lock_.back()[2])};  // the component that settled
     }
     add(h, f);
   }
@@ -565,12 +600,14 @@ HealthReport HealthMonitor::finish(const DriftlessFilter& filter, double duratio
   h.signal_chain = lag;
   h.locked = locked_;
   h.lock_t_s = lock_t_s_;
-  h.locked_at_end = locked_ && locked_now_;
+  h.locked_at_end = locked_ && lock_.locked();
   h.lock_lost_t_s = h.locked_at_end ? kNaN : lost_t_s_;
   h.updates = updates_;
   h.rejected = rejected_;
   h.rejected_fraction = updates_ > 0 ? double(rejected_) / double(updates_) : kNaN;
   h.relocks = filter.counters().relocks;
+  h.lock_losses = lock_losses_;
+  h.steady_state = steady_.prediction();
   const NisSums& nis = locked_ ? nis_locked_ : nis_before_;
   h.nis_updates = nis.n;
   if (nis.n > 0) {

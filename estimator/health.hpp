@@ -17,8 +17,10 @@
 #include "estimator/flip_check.hpp"
 #include "estimator/gravity_source.hpp"
 #include "estimator/lag_check.hpp"
+#include "estimator/lock_state.hpp"
 #include "estimator/reference_check.hpp"
 #include "estimator/standstill_gyro.hpp"
+#include "estimator/steady_state_watch.hpp"
 
 namespace driftless::est {
 
@@ -73,7 +75,12 @@ enum class HealthCause {
   kSteadyStateAtLock,    // locked late (as kLateLock) because the correction sigma had settled at the
                          // lock level: a longer log gives the same sigma (value: the settled sigma,
                          // deg/s; sigma: the lock level, deg/s; suggested: the mean update
-                         // interval, s; count: the updates it settled over)
+                         // interval, s; count: the updates it settled over; components: the
+                         // component whose sigma it was; steady_state: the closed form)
+  kLockUnreachable,      // the closed-form steady state of the bias sigma (steady_state.hpp) from the
+                         // first updates' q, interval and noise is at or above the lock level: no
+                         // longer log can lock (steady_state: the prediction; value: its sigma, deg/s;
+                         // sigma: the lock level, deg/s)
   kGyroStartMidFlip,     // standstill: gyro: the log starts during a flip (a note; components: the
                          // platform; value: its hinge rate at the first sample, deg/s; sigma: the
                          // first sample, s; suggested: when the positions became known, s;
@@ -134,6 +141,9 @@ struct HealthFinding {
   // kNeverLocked: the pairs that occurred, when both platforms rested on both sides but some
   // pair of sides never came (they flipped together); empty otherwise
   std::vector<std::array<double, 2>> positions_deg;
+  // kLockUnreachable, kSteadyStateAtLock: the closed-form steady state of the run's schedule (for
+  // kSteadyStateAtLock its interval_for_lock_s is scaled by the settled sigma over the closed form)
+  SteadyStatePrediction steady_state;
   std::vector<int> components;  // kUnobservable: 0..5 = b1_x .. b2_z; kSaturation: the channel
                                 // (0..5 = gyro1_x .. gyro2_z), value: the fraction of the rows
                                 // clipped, suggested: the level in deg/s
@@ -181,6 +191,8 @@ struct HealthReport {
   double nis_mean_band_lo = kNaN, nis_mean_band_hi = kNaN;  // chi-square band of that mean
   double nis_mean_degraded_above = kNaN;  // upper end of the degraded_band_probability band
   std::uint64_t relocks = 0;
+  std::uint64_t lock_losses = 0;       // the lock lost after it was gained (lock_state.hpp's hysteresis)
+  SteadyStatePrediction steady_state;  // the closed form from the first updates (steady_state_watch.hpp)
   std::vector<int> unobservable;       // 0..5 = b1_x .. b2_z
   std::vector<HealthFinding> findings; // worst first
   LagCheckResult signal_chain;         // the residual against the angular acceleration (lag_check.hpp)
@@ -271,7 +283,7 @@ void add_flip_check_findings(HealthReport& h, const FlipCheckResult& r, const Es
 /// Watches the updates of one pass and gives the verdict at the end.
 class HealthMonitor {
  public:
-  explicit HealthMonitor(const HealthLimits& limits = {}) : limits_(limits) {}
+  explicit HealthMonitor(const HealthLimits& limits = {}) : limits_(limits), lock_(limits.lock_sigma_dps), steady_(limits.lock_sigma_dps) {}
   /// Every update the filter made (accepted or rejected), with the filter after it.
   void on_update(const UpdateRecord& rec, const DriftlessFilter& filter);
   /// The verdict after the pass: `filter` is the filter at the end, `duration_s` the log's span,
@@ -288,9 +300,14 @@ class HealthMonitor {
   void add_lock_lost_finding(HealthReport& h, const DriftlessFilter& filter) const;
   std::vector<std::array<double, 2>> positions_if_never_apart() const;
   bool settled_sigma(double& sigma_dps, double& interval_s) const;
+  bool add_unreachable_finding(HealthReport& h) const;
+  SteadyStatePrediction steady_at_settled(double settled_dps) const;
 
   HealthLimits limits_;
-  bool locked_ = false, locked_now_ = false;
+  LockState lock_;        // the lock now, with hysteresis
+  bool locked_ = false;   // locked at some update
+  std::uint64_t lock_losses_ = 0;
+  SteadyStateWatch steady_;  // the closed-form steady state from the first updates' schedule
   double lock_t_s_ = kNaN, lost_t_s_ = kNaN;
   std::uint64_t updates_ = 0, rejected_ = 0;
   struct NisSums {
@@ -303,7 +320,7 @@ class HealthMonitor {
   // the last kSettleHistory updates before the lock: time (s) and the largest correction sigma
   // after each (deg/s), oldest first; whether it had settled (settled_sigma)
   static constexpr std::size_t kSettleHistory = 8;
-  std::vector<std::array<double, 2>> before_lock_;
+  std::vector<std::array<double, 3>> before_lock_;  // ... and the component (0..5) of that sigma
 };
 
 }  // namespace driftless::est

@@ -10,6 +10,7 @@
 
 #include "estimator/accel_check.hpp"
 #include "estimator/flip_check.hpp"
+#include "estimator/lock_state.hpp"
 #include "estimator/stats.hpp"
 
 namespace driftless::est {
@@ -291,11 +292,17 @@ void check_flip(FlipCheck& check, const DriftlessFilter& filter) {
                box.hinge1_axis.normalized(), box.hinge2_axis.normalized()});
 }
 
-bool lock_step(const DriftlessFilter& filter, double lock_sigma_dps, const UpdateRecord& u, double t_s,
+bool lock_step(LockState& lock, const DriftlessFilter& filter, const UpdateRecord& u, double t_s,
                EstimateSummary& sum) {
   if (u.relocked) sum.relocks.push_back({u.t_s, u.relock_nis, kNaN});
-  const bool locked = filter_locked(filter, lock_sigma_dps);
-  if (!locked) return false;
+  // the lock with hysteresis (lock_state.hpp): a sigma that only crosses the level keeps it
+  if (lock.on_update(filter.correction_sigma_dps().maxCoeff(), u.relocked) == LockState::Change::kLost) {
+    sum.lock_losses.push_back({u.t_s, filter.correction_sigma_dps().maxCoeff(), u.relocked, kNaN});
+  }
+  if (!lock.locked()) return false;
+  if (!sum.lock_losses.empty() && !std::isfinite(sum.lock_losses.back().locked_again_t_s)) {
+    sum.lock_losses.back().locked_again_t_s = t_s;
+  }
   if (!std::isfinite(sum.locked_from_t_s)) sum.locked_from_t_s = t_s;
   if (!sum.relocks.empty() && !std::isfinite(sum.relocks.back().locked_again_t_s)) {
     sum.relocks.back().locked_again_t_s = t_s;
@@ -375,6 +382,7 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
 
   // the lock state changes only at updates (P shrinks there; a gate re-lock widens it)
   bool locked = false;
+  LockState lock(opt.attitude_start_sigma_dps);
   std::vector<std::array<double, 2>> positions;  // the position pairs of the updates (to 0.1 deg)
   UpdateRecord first_update;
   auto on_update = [&](PushStatus st, const Sample& s) {
@@ -382,7 +390,7 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
     const UpdateRecord& u = filter.last_update();
     note_position(positions, u.plat1_deg, u.plat2_deg);
     if (u.index == 0) first_update = u;
-    locked = lock_step(filter, opt.attitude_start_sigma_dps, u, s.t_s, sum);
+    locked = lock_step(lock, filter, u, s.t_s, sum);
     if (sink != nullptr) sink->on_update(u, filter.covariance_dps2(), s, locked);
     health.on_update(u, filter);
     if (have_truth && st == PushStatus::kUpdated) score.add(filter, s);

@@ -101,6 +101,15 @@ struct RelockEvent {
   double locked_again_t_s = kNaN;
 };
 
+/// The lock lost after it was gained (lock_state.hpp: a gate re-lock that widened P above the lock
+/// level, or a sigma above kUnlockFactor times it; a sigma that only crosses the level is no loss).
+struct LockLoss {
+  double t_s = kNaN;        // s, the update after which it was lost
+  double sigma_dps = kNaN;  // deg/s, the largest correction sigma after it
+  bool relock = false;      // a gate re-lock widened P there
+  double locked_again_t_s = kNaN;  // s, the first row locked again (NaN: not before the end)
+};
+
 /// What a pass produced.
 struct EstimateSummary {
   std::uint64_t rows = 0;
@@ -160,6 +169,7 @@ struct EstimateSummary {
   WindowStats window;  // with EstimateRunOptions::eval_start_s
   bool log_complete = true;
   std::vector<RelockEvent> relocks;
+  std::vector<LockLoss> lock_losses;  // each loss of the lock (with hysteresis) and when it came back
   // s, the first row whose correction was locked (the lock level of on_sample: the row that made
   // the locking update); NaN: never
   double locked_from_t_s = kNaN;

@@ -3,8 +3,12 @@
 # F27): the issue's own "10x noise, 5x instability" sensor on a car with --selfcal --tune auto
 # settles at about 0.05 deg/s, dips under it at the last (short) update, and late_lock then said
 # "record a longer log", which cannot help. Now steady_state_at_lock names the settled sigma, the
-# wander between updates and the real fixes. On the outsider's generator (tests/estimator/navgen.py,
-# written apart from twin/), 1200 s of F27's log (seed 221).
+# wander between updates, the closed-form steady state (docs/estimator.md section 6.5) and the real
+# fixes. Then the lock's hysteresis: at a lock level on that steady state the `locked` flag
+# alternated 0/1 at every update; now it changes once. Then the closed form against the filter's
+# own sigma on a static log, at a q whose steady state is below the lock level and at one above it
+# (lock_unreachable, known from the first updates). On the outsider's generator
+# (tests/estimator/navgen.py, written apart from twin/), 1200 s of F27's log (seed 221).
 # usage: estimate_steady_lock.sh <path-to-driftless> <source-dir>
 set -uo pipefail
 bin=$1; src=$2
@@ -39,4 +43,54 @@ for c in [f"sigma{i}_{x}" for i in (1, 2) for x in "xyz"]:
         sys.exit(f"{c} not settled over the last updates before the lock: {s}")
 print(f"settled at {said} deg/s; bias sigmas settled within 2 % per cycle")
 PY
-echo "steady state at the lock level: said, with the real fixes"
+grep -q "closed-form steady state of this q, T and R is 0\.0[0-9]* deg/s for the bias alone" "$t/out.txt" ||
+  { cat "$t/out.txt"; fail "the text does not give the closed form for the bias alone"; }
+grep -q "flipping more often does not lower b[12]_[xyz]'s sigma" "$t/out.txt" || fail "the text still advises flipping more often"
+
+# the hysteresis: a lock level on the settled sigma (0.054) made `locked` flicker at every update
+"$bin" estimate --log "$t/noisy.csv" --out "$t/h" --selfcal --tune auto --attitude-start-sigma 0.054 --corrected \
+  > "$t/h.txt" 2>&1 || { cat "$t/h.txt"; fail "hysteresis run: exit $?"; }
+"$py" - "$t/h" <<'PY' || fail "the locked flag flickers"
+import sys, json, numpy as np
+d = sys.argv[1]
+losses = len(json.load(open(d + "/summary.json"))["lock_losses"])
+est = np.genfromtxt(d + "/estimate.csv", delimiter=",", names=True)
+cor = np.loadtxt(d + "/corrected.csv", delimiter=",", skiprows=1, usecols=[11])
+for name, col in (("estimate.csv", est["locked"]), ("corrected.csv", cor)):
+    changes = int(np.sum(np.abs(np.diff(col))))
+    if col.max() != 1 or changes > 1 + 2 * losses:
+        sys.exit(f"{name}: locked changes {changes} times with {losses} lock losses")
+print(f"locked changes once; {losses} lock losses")
+PY
+
+# the closed form against the filter's own sigma: a static box, the noise and q given
+$nav --out "$t/static.csv" --sensor noisy --bias 3 --motion static --duration 600 --seed 229 > /dev/null ||
+  fail "navgen static"
+for q in 3e-5 1e-4; do
+  printf 'noise_density_dps_rthz: 0.05\nq_override_dps2_per_s: %s\n' "$q" > "$t/q.yaml"
+  "$bin" estimate --log "$t/static.csv" --out "$t/s$q" --config "$t/q.yaml" > "$t/s$q.txt" 2>&1
+  echo $? > "$t/s$q.rc"
+  "$py" - "$t/s$q" "$(cat "$t/s$q.rc")" <<'PY' || { cat "$t/s$q.txt"; fail "q $q: closed form against the filter"; }
+import sys, json, numpy as np
+d, rc = sys.argv[1], int(sys.argv[2])
+h = json.load(open(d + "/summary.json"))["health"]
+ss = h["steady_state"]
+a = np.genfromtxt(d + "/estimate.csv", delimiter=",", names=True)
+sig = np.array([a[f"sigma{i}_{x}"] for i in (1, 2) for x in "xyz"]).T[-5:-1]  # the last cycle (not the log's end)
+hi, lo = sig.max(), sig.min()
+if abs(ss["sigma_dps"] - hi) > 0.02 * hi or abs(ss["sigma_low_dps"] - lo) > 0.05 * lo:
+    sys.exit(f"closed form {ss['sigma_dps']:.5f}/{ss['sigma_low_dps']:.5f} against the filter's {hi:.5f}/{lo:.5f}")
+causes = [f["cause"] for f in h["findings"]]
+unreachable = ss["sigma_dps"] >= 0.05
+if unreachable != ("lock_unreachable" in causes) or unreachable != ss["lock_unreachable"]:
+    sys.exit(f"lock_unreachable {ss['lock_unreachable']}, findings {causes}, closed form {ss['sigma_dps']}")
+if unreachable and (rc != 1 or h["locked"] or not ss["interval_for_lock_s"] < ss["interval_s"]):
+    sys.exit(f"unreachable: exit {rc}, locked {h['locked']}, interval {ss['interval_for_lock_s']} of {ss['interval_s']}")
+if not unreachable and (rc != 0 or not h["locked"]):
+    sys.exit(f"reachable: exit {rc}, locked {h['locked']}")
+print(f"closed form {ss['sigma_dps']:.5f} against the filter's {hi:.5f}; unreachable {unreachable}")
+PY
+done
+grep -q "the lock level 0.05 deg/s cannot be reached" "$t/s1e-4.txt" || fail "no lock_unreachable text"
+grep -q "lock_unreachable above" "$t/s1e-4.txt" || fail "never_locked does not point to lock_unreachable"
+echo "steady state at the lock level: said, with the closed form; the lock holds through it"
