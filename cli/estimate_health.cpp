@@ -286,8 +286,13 @@ std::string describe_lock(const est::HealthFinding& f, const est::EstimatorConfi
                                        "columns' units ('driftless check')"
                                      : "try --tune auto");
     case est::HealthCause::kNeverLocked:
-      return fmt::format("never locked: the largest sigma of the bias correction is {:.3g} deg/s{}; {}", f.value,
+      return fmt::format("never locked: the largest sigma of the bias correction is {:.3g} deg/s{}{}; {}", f.value,
                          f.components.empty() ? std::string() : ", unobservable: " + component_names(f.components),
+                         f.steady_state.available && !f.steady_state.lock_unreachable()
+                             ? ", where it had settled (within 2 % of itself one position cycle earlier over the last "
+                               "8 updates), so a longer log gives the same sigma" +
+                                   closed_form_text(f.steady_state, f.value)
+                             : std::string(),
                          f.steady_state.lock_unreachable()
                              ? "the steady state of the bias sigma is above the lock level (lock_unreachable above): "
                                "a longer log or more flips of the same kind cannot lock it"

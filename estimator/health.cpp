@@ -538,7 +538,13 @@ void HealthMonitor::add_lock_findings(HealthReport& h, const DriftlessFilter& fi
     f.value = filter.correction_sigma_dps().maxCoeff();  // what locking waits for
     f.suggested = h.rejected_fraction;  // rejections may be why the flips did not observe them
     if (f.cause == HealthCause::kNeverLocked) f.positions_deg = positions_if_never_apart();
-    if (f.cause == HealthCause::kNeverLocked && add_unreachable_finding(h)) f.steady_state = steady_.prediction();
+    if (f.cause == HealthCause::kNeverLocked) {
+      // the cause when the closed form says so; else whether the sigma settled at the level
+      double settled_dps = kNaN, interval_s = kNaN;
+      if (add_unreachable_finding(h)) f.steady_state = steady_.prediction();
+      else if (settled_sigma(settled_dps, interval_s) && settled_dps >= 0.9 * limits_.lock_sigma_dps)
+        f.steady_state = steady_at_settled(settled_dps);
+    }
     if (f.cause == HealthCause::kNoUpdate) {
       // rows skipped for a missing gyro value come before "the platforms never rested"
       const FilterCounters& c = filter.counters();

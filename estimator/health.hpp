@@ -142,7 +142,9 @@ struct HealthFinding {
   // pair of sides never came (they flipped together); empty otherwise
   std::vector<std::array<double, 2>> positions_deg;
   // kLockUnreachable, kSteadyStateAtLock: the closed-form steady state of the run's schedule (for
-  // kSteadyStateAtLock its interval_for_lock_s is scaled by the settled sigma over the closed form)
+  // kSteadyStateAtLock its interval_for_lock_s is scaled by the settled sigma over the closed form);
+  // kNeverLocked: the same when lock_unreachable, or when the sigma had settled at 0.9 of the lock
+  // level or above (available only then)
   SteadyStatePrediction steady_state;
   std::vector<int> components;  // kUnobservable: 0..5 = b1_x .. b2_z; kSaturation: the channel
                                 // (0..5 = gyro1_x .. gyro2_z), value: the fraction of the rows

@@ -279,9 +279,6 @@ void withhold_attitude_reference(EstimateSummary& sum) {
   sum.final_corrected = sum.final_raw = sum.final_fixed = none;
 }
 
-// after an update: is the correction locked (filter_locked at the lock level)? Records the first
-// lock, each gate re-lock and when the lock came back after it.
-// `t_s` is the time of the sample whose push made the update: the first row it corrects.
 // the flip-turn check (flip_check.hpp): one sample of the filter's output; a flip that ended is
 // measured in the frames of its start angles
 void check_flip(FlipCheck& check, const DriftlessFilter& filter) {
@@ -292,6 +289,9 @@ void check_flip(FlipCheck& check, const DriftlessFilter& filter) {
                box.hinge1_axis.normalized(), box.hinge2_axis.normalized()});
 }
 
+// after an update: is the correction locked (the lock level with lock_state.hpp's hysteresis)?
+// Records the first lock, each gate re-lock, each loss of the lock and when it came back.
+// `t_s` is the time of the sample whose push made the update: the first row it corrects.
 bool lock_step(LockState& lock, const DriftlessFilter& filter, const UpdateRecord& u, double t_s,
                EstimateSummary& sum) {
   if (u.relocked) sum.relocks.push_back({u.t_s, u.relock_nis, kNaN});

@@ -47,6 +47,14 @@ grep -q "closed-form steady state of this q, T and R is 0\.0[0-9]* deg/s for the
   { cat "$t/out.txt"; fail "the text does not give the closed form for the bias alone"; }
 grep -q "flipping more often does not lower b[12]_[xyz]'s sigma" "$t/out.txt" || fail "the text still advises flipping more often"
 
+# the same log cut before its last (short) update never locks: never_locked says the sigma had
+# settled, so a longer log cannot help (it advised a longer log before)
+awk -F, '/^#/ || /^t,/ {print; next} $1 < 1170 {print}' "$t/noisy.csv" > "$t/cut.csv"
+"$bin" estimate --log "$t/cut.csv" --out "$t/c" --selfcal --tune auto > "$t/c.txt" 2>&1
+grep -q '"cause": "never_locked"' "$t/c/summary.json" || { cat "$t/c.txt"; fail "the cut log locked"; }
+grep -q "never locked: .*where it had settled .*so a longer log gives the same sigma" "$t/c.txt" ||
+  { cat "$t/c.txt"; fail "never_locked does not say the sigma settled"; }
+
 # the hysteresis: a lock level on the settled sigma (0.054) made `locked` flicker at every update
 "$bin" estimate --log "$t/noisy.csv" --out "$t/h" --selfcal --tune auto --attitude-start-sigma 0.054 --corrected \
   > "$t/h.txt" 2>&1 || { cat "$t/h.txt"; fail "hysteresis run: exit $?"; }
