@@ -57,6 +57,7 @@ const char* cause_key(est::HealthCause c) {
     case est::HealthCause::kAccelUnit: return "accel_unit";
     case est::HealthCause::kAccelEmpty: return "accel_empty";
     case est::HealthCause::kCalibUncertain: return "calib_uncertain";
+    case est::HealthCause::kVerticalUnobserved: return "vertical_unobserved";
     default: if (is_flip_cause(c)) return flip_cause_key(c);
   }
   return "?";
@@ -109,16 +110,29 @@ std::string describe_box_motion(const est::HealthFinding& f) {
     seen += fmt::format("{}the fused rate changed by up to {:.3g} deg/s within one (the bias cannot)",
                         seen.empty() ? "" : " and ", f.sigma);
   }
-  const bool at_rest = !f.components.empty() && f.components[0] == 1;
-  const std::string claim =
-      at_rest ? std::string("--box-at-rest claims the box turns at the Earth rate only while the platforms rest")
-              : fmt::format("{} box dwells took the box as turning at the Earth rate only", f.count);
-  return fmt::format("the box was not at rest while both platforms rested: {} (e.g. t = {:.1f} s); {}, and the "
-                     "turn entered the biases and the g-sensitivity as if it were theirs. {}",
-                     seen, f.suggested, claim,
-                     at_rest ? "Drop --box-at-rest (a box in a vehicle, on a ship or a turntable turns)"
-                             : "Set box_dwell_updates: false in the configuration (a box in a vehicle, on a ship or "
-                               "a slow turntable)");
+  return fmt::format("the box was not at rest while both platforms rested: {} (e.g. t = {:.1f} s); --box-at-rest "
+                     "claims the box turns at the Earth rate only while the platforms rest, and the turn entered "
+                     "the biases and the g-sensitivity as if it were theirs. Drop --box-at-rest (a box in a "
+                     "vehicle, on a ship or a turntable turns)",
+                     seen, f.suggested);
+}
+
+// no pause of the box: the shared vertical bias stays near its g-sensitivity prior (section 1d)
+std::string describe_vertical(const est::HealthFinding& f, const est::EstimatorConfig& cfg, const RunUsed& u) {
+  const std::string turned =
+      std::isfinite(f.suggested) ? fmt::format(": ref_q turned at up to {:.3g} deg/s over the quiet standstills", f.suggested)
+                                 : std::string();
+  const double pause_s = cfg.box_dwell_min_s + 2.0 * cfg.box_dwell_margin_s;
+  return fmt::format(
+      "the bias both sensors share about the vertical was not observed: no box dwell was used (the box never "
+      "paused{}), and a g-sensitivity that keeps its sign about the box vertical (the 1 g along it) looks like that "
+      "shared bias to eq. (2). The correction is known to +-{:.3g} deg/s against its prior {:.3g} deg/s: up to {:.0f} "
+      "deg/h of heading drift. Let the box pause now and then (both platforms resting and the box not turning for "
+      "{:g} s or more: a vehicle's stop, or a straight run with ref_q logged), {}, or add --box-at-rest if the box "
+      "stands still",
+      turned, f.value, f.sigma, f.value * 3600.0, pause_s,
+      u.calib ? "or self-calibrate these sensors once on a run with pauses and use that calib.yaml instead"
+              : "or pass --calib with a calib.yaml from a self-calibrated run with pauses (--calib-out)");
 }
 
 std::string describe_box_dwells(const est::HealthFinding& f) {
@@ -613,6 +627,8 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
       return describe_accel(f);
     case est::HealthCause::kBoxDwellsRejected:
       return describe_box_dwells(f);
+    case est::HealthCause::kVerticalUnobserved:
+      return describe_vertical(f, cfg, u);
     default: break;  // the flip-turn check's causes: describe_flip() above
   }
   return "?";

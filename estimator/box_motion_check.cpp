@@ -17,10 +17,6 @@ bool box_turned(const BoxMotion& m, const BoxMotionLimits& lim) {
   return m.ref_rate_dps > lim.ref_rate_dps || m.gyro_change_dps > lim.gyro_change_dps;
 }
 
-bool box_turned_slowly(const BoxMotion& m, const BoxMotionLimits& lim) {
-  return m.quiet_ref_rate_dps > lim.ref_rate_dps;
-}
-
 void BoxMotionCheck::push(const Sample& s, const SampleOutput& out) {
   const bool resting = out.at_rest && out.sensors_fused == 2 && std::isfinite(s.t_s) &&
                        out.rate_body_raw_dps.allFinite();

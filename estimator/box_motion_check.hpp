@@ -41,8 +41,6 @@ struct BoxMotionLimits {
 
 /// True when `m` shows the box turning while the platforms rested (by the limits `lim`).
 bool box_turned(const BoxMotion& m, const BoxMotionLimits& lim = {});
-/// True when `m` shows a slow steady turn through quiet standstills, which box dwells take for pauses.
-bool box_turned_slowly(const BoxMotion& m, const BoxMotionLimits& lim = {});
 
 /// Streams the samples of a pass (after the filter has seen each one).
 class BoxMotionCheck {

@@ -923,9 +923,12 @@ double DriftlessFilter::DwellTrend::change_dps() const {
 bool DriftlessFilter::box_quiet(const Sample& s) const {
   if (!dwell_armed_ || box_turning_ || out_.sensors_fused != 2 || !out_.at_rest) return false;
   if (!(out_.rate_body_dps.norm() < cfg_.box_dwell_rate_dps)) return false;
-  constexpr double kOneGTolerance = 0.05;  // |f| within 5 % of 1 g: no linear acceleration
+  // without a witness of the turns, |f| within 5 % of 1 g (no linear acceleration) stands for
+  // "the box rests"; with one (ref_q), the box may accelerate: the dwell row takes the measured f
+  constexpr double kOneGTolerance = 0.05;
   for (const Eigen::Vector3d* a : {&s.accel1_mps2, &s.accel2_mps2}) {
-    if (!a->allFinite() || !(std::fabs(a->norm() / kStandardGravityMps2 - 1.0) < kOneGTolerance)) return false;
+    if (!a->allFinite()) return false;
+    if (!box_turn_witnessed_ && !(std::fabs(a->norm() / kStandardGravityMps2 - 1.0) < kOneGTolerance)) return false;
   }
   return true;
 }

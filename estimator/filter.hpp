@@ -182,8 +182,14 @@ class DriftlessFilter {
   /// own state is not touched.
   void set_fixed_bias_dps(const Vector6d& b) { fixed_bias_ = b; }
   /// The box turns at this sample by a witness other than the gyros (ref_q; set before push()): no
-  /// box dwell there. With gravity from ref_q the accel columns' 1 g test cannot tell (accel_check.hpp).
-  void set_box_turning(bool turning) { box_turning_ = turning; }
+  /// box dwell there. A witnessed still box needs no 1 g test of the accel columns: a vehicle that
+  /// drives straight rests for the gyros while it accelerates, and G f takes the measured f
+  /// (accel_check.hpp; docs/estimator.md section 1d). clear_box_turning(): no witness at this sample.
+  void set_box_turning(bool turning) {
+    box_turning_ = turning;
+    box_turn_witnessed_ = true;
+  }
+  void clear_box_turning() { box_turning_ = box_turn_witnessed_ = false; }
   /// Every accepted update is handed to `o` (nullptr: none); for the offline smoother.
   void set_update_observer(UpdateObserver* o) { observer_ = o; }
   /// The corrected outputs of the following push() calls use state `x` (bias referred to
@@ -362,7 +368,8 @@ class DriftlessFilter {
   StandstillSegment dwell_;
   DwellTrend dwell_trend_;
   std::deque<DwellSample> dwell_recent_;
-  bool box_turning_ = false;  // set_box_turning()
+  bool box_turning_ = false;         // set_box_turning()
+  bool box_turn_witnessed_ = false;  // set_box_turning() since the last clear_box_turning()
   double dwell_quiet_since_s_ = kNaN;
   bool dwell_armed_ = false;
   double gate1_ = 0.0, gate3_ = 0.0, gate4_ = 0.0, gate6_ = 0.0;

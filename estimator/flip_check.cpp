@@ -30,7 +30,7 @@ void mark_wrapped(std::vector<FlipTurnRecord>& recs, int platform) {
   }
 }
 
-// the six channels (bias-corrected: a constant offset keeps the clip's runs of one value)
+// the six channels (raw, or bias-corrected: a constant offset keeps the clip's runs of one value)
 void push_clip(ClipDetector& d, const Eigen::Vector3d& y1, const Eigen::Vector3d& y2) {
   for (int i = 0; i < 3; ++i) {
     d.push(i, y1[i], false);
@@ -68,7 +68,8 @@ FlipTurn classify_flip(const Eigen::Vector3d& v, const Eigen::Vector3d& w, const
   return FlipTurn::kOther;
 }
 
-bool FlipCheck::push(double t_s, const Eigen::Vector3d& y1c_dps, const Eigen::Vector3d& y2c_dps, double plat1_deg,
+bool FlipCheck::push(double t_s, const Eigen::Vector3d& y1c_dps, const Eigen::Vector3d& y2c_dps,
+                     const Eigen::Vector3d& y1_raw_dps, const Eigen::Vector3d& y2_raw_dps, double plat1_deg,
                      double plat2_deg, bool both_rest) {
   const bool valid = std::isfinite(t_s) && y1c_dps.allFinite() && y2c_dps.allFinite();
   const double dt_s = valid && std::isfinite(t_last_s_) ? t_s - t_last_s_ : kNaN;
@@ -84,7 +85,7 @@ bool FlipCheck::push(double t_s, const Eigen::Vector3d& y1c_dps, const Eigen::Ve
     } else {
       s1_ += y1c_dps * dt_s;
       s2_ += y2c_dps * dt_s;
-      push_clip(clip_, y1c_dps, y2c_dps);
+      push_clip(clip_, y1_raw_dps, y2_raw_dps);
     }
   }
   if (both_rest && open_) {
@@ -124,7 +125,7 @@ bool FlipCheck::push(double t_s, const Eigen::Vector3d& y1c_dps, const Eigen::Ve
     s1_ = y1c_dps * dt_s;
     s2_ = y2c_dps * dt_s;
     clip_ = ClipDetector{};
-    push_clip(clip_, y1c_dps, y2c_dps);
+    push_clip(clip_, y1_raw_dps, y2_raw_dps);
   }
   was_rest_ = false;
   return false;

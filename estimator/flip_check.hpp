@@ -97,7 +97,14 @@ class FlipCheck {
   /// platform angles in force and whether both platforms rest. Returns true when a window just
   /// closed on a flip of exactly one platform: call close() with its frames.
   bool push(double t_s, const Eigen::Vector3d& y1c_dps, const Eigen::Vector3d& y2c_dps, double plat1_deg,
-            double plat2_deg, bool both_rest);
+            double plat2_deg, bool both_rest) {
+    return push(t_s, y1c_dps, y2c_dps, y1c_dps, y2c_dps, plat1_deg, plat2_deg, both_rest);
+  }
+  /// As above, with the raw readings (deg/s) for the clip test: a correction that mixes the axes
+  /// (the scale/misalignment states) breaks a clipped channel's runs of one value.
+  bool push(double t_s, const Eigen::Vector3d& y1c_dps, const Eigen::Vector3d& y2c_dps,
+            const Eigen::Vector3d& y1_raw_dps, const Eigen::Vector3d& y2_raw_dps, double plat1_deg, double plat2_deg,
+            bool both_rest);
   /// The platform angles at the start of the flip that push() just closed.
   double start_deg(int platform) const { return platform == 1 ? p1_start_ : p2_start_; }
   /// Measures the flip push() just closed (frames at its start angles).

@@ -305,21 +305,32 @@ void add_gyro_standstill_findings(HealthReport& h, const GyroFlipTracker& tracke
   put_first(h, std::move(first));
 }
 
-void add_box_motion_finding(HealthReport& h, const BoxMotion& m, bool box_at_rest, std::uint64_t dwell_updates) {
-  // --box-at-rest claims every standstill; a dwell only the quiet ones (below box_dwell_rate_dps)
-  const bool fired = box_at_rest ? box_turned(m) : dwell_updates > 0 && box_turned_slowly(m);
-  if (!fired) return;
+void add_box_motion_finding(HealthReport& h, const BoxMotion& m, bool box_at_rest) {
+  // --box-at-rest claims every standstill (a box dwell only a stretch that ref_q, where logged,
+  // saw still: the filter refuses the others itself)
+  if (!box_at_rest || !box_turned(m)) return;
   HealthFinding f;
   f.cause = HealthCause::kBoxNotAtRest;
-  f.value = box_at_rest ? m.ref_rate_dps : m.quiet_ref_rate_dps;
-  f.sigma = box_at_rest ? m.gyro_change_dps : kNaN;
-  const bool by_ref = f.value > BoxMotionLimits{}.ref_rate_dps;
-  f.suggested = !box_at_rest ? m.quiet_ref_rate_t_s : by_ref ? m.ref_rate_t_s : m.gyro_change_t_s;
-  f.count = dwell_updates;
-  f.components = {box_at_rest ? 1 : 0};
+  f.value = m.ref_rate_dps;
+  f.sigma = m.gyro_change_dps;
+  f.suggested = f.value > BoxMotionLimits{}.ref_rate_dps ? m.ref_rate_t_s : m.gyro_change_t_s;
   HealthReport first;
   add(first, std::move(f));
   put_first(h, std::move(first));
+}
+
+void add_vertical_finding(HealthReport& h, const DriftlessFilter& filter, const BoxMotion& m) {
+  if (!filter.uses_box_dwells() || !filter.has_gsens_states() || filter.counters().box_dwell_updates > 0) return;
+  // a g-sensitivity element times the 1 g along the box vertical: the shared bias's prior
+  const double prior_dps = filter.config().gsens_sigma_dps_per_g;
+  const double sigma_dps = filter.correction_sigma_dps().maxCoeff();
+  if (!(sigma_dps > 0.5 * prior_dps)) return;
+  HealthFinding f;
+  f.cause = HealthCause::kVerticalUnobserved;
+  f.value = sigma_dps;
+  f.sigma = prior_dps;
+  f.suggested = m.quiet_ref_rate_dps;
+  add(h, std::move(f));
 }
 
 void add_reference_finding(HealthReport& h, const ReferenceFit& fit) {

@@ -101,11 +101,11 @@ enum class HealthCause {
   kFlipTurnRatio,        // about the hinge by a ratio none of the above
   kFlipScale,            // 1 ± a few % beyond 3 sigma of the scale prior (value: the median ratio)
   kFlipsTooSlow,         // flips longer than flip_max_s (value: the longest, s): no flip update
-  kBoxNotAtRest,         // --box-at-rest or box dwells, yet the box turned while both platforms
-                         // rested (box_motion_check.hpp): value = ref_q's largest turn rate over a
+  kBoxNotAtRest,         // --box-at-rest, yet the box turned while both platforms rested
+                         // (box_motion_check.hpp): value = ref_q's largest turn rate over a
                          // standstill (deg/s; NaN: no ref_q), sigma = the largest change of the fused
-                         // rate within one (deg/s), suggested = when (s), count = box dwell updates,
-                         // components = {1 if --box-at-rest, else 0}
+                         // rate within one (deg/s), suggested = when (s). (Box dwells need no such
+                         // check: ref_q, where logged, refuses them while the box turns.)
   kBoxDwellsRejected,    // box dwell updates rejected by their gate: count = rejected, suggested =
                          // dwell updates, value = quiet stretches refused as moving (a note when
                          // at most a fifth were rejected, else degraded)
@@ -120,6 +120,11 @@ enum class HealthCause {
   kAccelEmpty,           // |f| far below g: the columns are empty (all zero, or not filled)
   kCalibUncertain,       // --calib without --selfcal, and the file's G/E sigma are not small against
                          // the values (a self-calibration's output): value = the largest sigma / |value|
+  kVerticalUnobserved,   // --selfcal with box dwells on, none used (no pause), and the correction's
+                         // sigma still above half the g-sensitivity prior's (1 g along the vertical):
+                         // the bias both sensors share about the vertical is not observed. value =
+                         // the largest correction sigma (deg/s), sigma = its prior (deg/s), suggested
+                         // = ref_q's slowest turn over the quiet standstills (deg/s; NaN: no ref_q)
                          // ... (accel_check.hpp: calib_uncertainty)
 };
 
@@ -257,9 +262,14 @@ void add_attitude_withheld_finding(HealthReport& h, AttitudeWithheld why, double
 /// time gap after which the positions were recovered (a note) or not (degraded).
 void add_gyro_standstill_findings(HealthReport& h, const GyroFlipTracker& tracker, double flip_angle_deg);
 
-/// --box-at-rest, or box dwells used (`dwell_updates` > 0), on a box that turned while the
-/// platforms rested (box_turned): `box_not_at_rest` ahead of the other findings (their cause).
-void add_box_motion_finding(HealthReport& h, const BoxMotion& m, bool box_at_rest, std::uint64_t dwell_updates);
+/// --box-at-rest on a box that turned while the platforms rested (box_turned): `box_not_at_rest`
+/// ahead of the other findings (their cause).
+void add_box_motion_finding(HealthReport& h, const BoxMotion& m, bool box_at_rest);
+
+/// Self-calibrating mode with box dwells, none used (the box never paused: ref_q turned, or |f|
+/// was never 1 g), and the correction still near the g-sensitivity prior: `vertical_unobserved`
+/// (degraded). `m`: ref_q's turn over the quiet standstills, the evidence where logged.
+void add_vertical_finding(HealthReport& h, const DriftlessFilter& filter, const BoxMotion& m);
 
 /// ref_q in another convention than the log's, or fitting none (reference_check.hpp): a degraded
 /// `reference_mismatch` finding (the attitude figures are withheld; the biases stand).

@@ -281,9 +281,9 @@ void withhold_attitude_reference(EstimateSummary& sum) {
 
 // the flip-turn check (flip_check.hpp): one sample of the filter's output; a flip that ended is
 // measured in the frames of its start angles
-void check_flip(FlipCheck& check, const DriftlessFilter& filter) {
+void check_flip(FlipCheck& check, const DriftlessFilter& filter, const Sample& s) {
   const SampleOutput& o = filter.output();
-  if (!check.push(o.t_s, o.y1c_dps, o.y2c_dps, o.plat1_deg, o.plat2_deg, o.at_rest)) return;
+  if (!check.push(o.t_s, o.y1c_dps, o.y2c_dps, s.gyro1_dps, s.gyro2_dps, o.plat1_deg, o.plat2_deg, o.at_rest)) return;
   const BoxGeometry& box = filter.geometry();
   check.close({filter.body_from_sensor(1, check.start_deg(1)), filter.body_from_sensor(2, check.start_deg(2)),
                box.hinge1_axis.normalized(), box.hinge2_axis.normalized()});
@@ -408,15 +408,15 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
     ++sum.rows;
     if (!std::isfinite(sum.t_first_s)) sum.t_first_s = s.t_s;
     sum.t_last_s = s.t_s;
-    if (run_cfg.gravity_from_ref_q) {
-      gravity_from_ref_q(filter, s);
-      filter.set_box_turning(ref_turn.turning(s));
-    }
+    if (run_cfg.gravity_from_ref_q) gravity_from_ref_q(filter, s);
+    // ref_q witnesses the box's turns for the box dwells (with or without accel columns)
+    if (s.ref_q_wxyz.allFinite()) filter.set_box_turning(ref_turn.turning(s));
+    else filter.clear_box_turning();
     const PushStatus st = filter.push(s);
     if (check_accel) accel_check.push(s, filter.output().at_rest);
     on_update(st, s);  // first: the row that made an update carries the state after it
     lag.push(s, filter);
-    check_flip(flips, filter);
+    check_flip(flips, filter, s);
     if (sum.attitude_available) ref_check.push(s, filter);
     box_motion.push(s, filter.output());
     sum.samples_locked += locked ? 1 : 0;
@@ -477,7 +477,8 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
   add_input_findings(meta, reader, cfg, filter, positions, sum);
   add_reference_finding(sum.health, sum.reference);
   sum.box_motion = box_motion.finish();
-  add_box_motion_finding(sum.health, sum.box_motion, cfg.box_at_rest, sum.counters.box_dwell_updates);
+  add_box_motion_finding(sum.health, sum.box_motion, cfg.box_at_rest);
+  add_vertical_finding(sum.health, filter, sum.box_motion);
   // accel columns in another unit, or empty: ahead of everything they spoil
   if (check_accel) add_accel_findings(sum.health, accel_check.finish(), cfg.self_calibration);
   // an uncertain calibration applied as exact (no self-calibration to refine it) leads them all

@@ -79,13 +79,21 @@ void NoiseTuner::use_piece(const StandstillSegment& seg) {
     const Regressors dx = x - block_x_;
     MotionFit& m = motion_[key];
     m.xx += w * dx * dx.transpose();
+    m.xsx += w * dx * dx.transpose();
+    if (have_pair_) m.xsx -= (pair_w_ * w / double(block_n_)) * (pair_dx_ * dx.transpose() + dx * pair_dx_.transpose());
+    have_pair_ = true;
+    pair_w_ = w;
+    pair_dx_ = dx;
     m.xr += w * dx * dr.transpose();
     m.rr += w * dr.squaredNorm();
     ++m.pairs;
     ++noise_pairs_;
-  } else if (!same_standstill) {
-    close_visit();
-    visit_key_ = key;
+  } else {
+    have_pair_ = false;
+    if (!same_standstill) {
+      close_visit();
+      visit_key_ = key;
+    }
   }
   have_block_ = seg.end == SegmentEnd::kSplit;
   block_rest_s_ = seg.t_rest_s;
@@ -141,7 +149,8 @@ void NoiseTuner::MotionFit::solve() {
   if (!(c.topRows<3>().cwiseAbs().maxCoeff() < kMaxRateCoefficient)) return;
   fitted = true;
   coef = c;
-  xx_inv = scale.asDiagonal() * cod.pseudoInverse() * scale.asDiagonal();
+  const Eigen::Matrix<double, 6, 6> xx_inv = scale.asDiagonal() * cod.pseudoInverse() * scale.asDiagonal();
+  coef_cov = xx_inv * xsx * xx_inv;
   ss = ss_fit;
   dof = dof_fit;
 }
@@ -172,10 +181,10 @@ TuneResult NoiseTuner::finish() {
   for (const auto& p : wander_) {
     const auto m = motion_.find(p.key);
     Eigen::Vector3d motion = Eigen::Vector3d::Zero();
-    double coef_error = 0.0;  // E|(coef - true)^T dx|^2 = 6 sigma^2 dx^T (X^T W X)^-1 dx
+    double coef_error = 0.0;  // E|(coef - true)^T dx|^2 = 3 * 2 sigma^2 dx^T coef_cov dx
     if (m != motion_.end() && m->second.fitted) {
       motion = m->second.coef.transpose() * p.dx;
-      coef_error = 6.0 * sigma2 * p.dx.dot(m->second.xx_inv * p.dx);
+      coef_error = std::max(0.0, 6.0 * sigma2 * p.dx.dot(m->second.coef_cov * p.dx));
     }
     num += (p.dr - motion).squaredNorm() - 6.0 * sigma2 * p.inv_n - coef_error;
     den += 6.0 * (p.dt_s - p.window_s);

@@ -72,6 +72,10 @@ class NoiseTuner {
   // per position pair: the weighted normal equations of r_a - r_b on x_a - x_b (w = 1 / (1/n_a + 1/n_b))
   struct MotionFit {
     Eigen::Matrix<double, 6, 6> xx = Eigen::Matrix<double, 6, 6>::Zero();
+    // the pairs' noise covariance seen through dx, over 2 sigma^2: sum w dx dx^T less, for two
+    // pairs that share a block (a standstill's consecutive pairs), w_a w_b / n_shared (dx_a dx_b^T
+    // + dx_b dx_a^T): their dr have the shared block's mean with opposite signs
+    Eigen::Matrix<double, 6, 6> xsx = Eigen::Matrix<double, 6, 6>::Zero();
     Eigen::Matrix<double, 6, 3> xr = Eigen::Matrix<double, 6, 3>::Zero();
     double rr = 0.0;
     std::uint64_t pairs = 0;
@@ -79,7 +83,9 @@ class NoiseTuner {
     // than noise would (chi-square test at kMotionFitSignificance), else coef = 0 and ss = rr
     bool fitted = false;
     Eigen::Matrix<double, 6, 3> coef = Eigen::Matrix<double, 6, 3>::Zero();
-    Eigen::Matrix<double, 6, 6> xx_inv = Eigen::Matrix<double, 6, 6>::Zero();  // pseudo-inverse
+    // Cov(coef column) / (2 sigma^2): the sandwich xx^+ xsx xx^+ (xx^+ the pseudo-inverse); a
+    // smooth motion's consecutive pairs telescope, so this is far below xx^+ there
+    Eigen::Matrix<double, 6, 6> coef_cov = Eigen::Matrix<double, 6, 6>::Zero();
     double ss = 0.0;    // weighted residual sum of squares after the fit
     double dof = 0.0;   // 3 (pairs - rank), or 3 pairs without a fit
     void solve();
@@ -99,6 +105,10 @@ class NoiseTuner {
   std::size_t block_n_ = 0;
   Eigen::Vector3d block_r_ = Eigen::Vector3d::Zero();
   Regressors block_x_ = Regressors::Zero();
+  // the previous pair of the current standstill (it shares block_ with the next one)
+  bool have_pair_ = false;
+  double pair_w_ = 0.0;
+  Regressors pair_dx_ = Regressors::Zero();
   std::map<std::pair<long, long>, MotionFit> motion_;  // per position pair (0.1 deg keys)
   std::uint64_t noise_pairs_ = 0;
   struct WanderPair {
