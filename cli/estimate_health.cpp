@@ -58,6 +58,7 @@ const char* cause_key(est::HealthCause c) {
     case est::HealthCause::kAccelEmpty: return "accel_empty";
     case est::HealthCause::kCalibUncertain: return "calib_uncertain";
     case est::HealthCause::kVerticalUnobserved: return "vertical_unobserved";
+    case est::HealthCause::kClippedFlipsScale: return "clipped_flips_scale";
     default: if (is_flip_cause(c)) return flip_cause_key(c);
   }
   return "?";
@@ -115,6 +116,23 @@ std::string describe_box_motion(const est::HealthFinding& f) {
                      "the biases and the g-sensitivity as if it were theirs. Drop --box-at-rest (a box in a "
                      "vehicle, on a ship or a turntable turns)",
                      seen, f.suggested);
+}
+
+// flips skipped for clipping on a turning box: the hinges' scale stays at its prior (section 1f)
+std::string describe_clipped_flips(const est::HealthFinding& f, const RunUsed& u) {
+  const std::string turned =
+      std::isfinite(f.value) && f.value > est::BoxMotionLimits{}.ref_rate_dps
+          ? fmt::format(" (ref_q turned at up to {:.3g} deg/s over a standstill)", f.value)
+          : std::string(" (the fused rate changed within a standstill)");
+  return fmt::format(
+      "{} of the flips were skipped because a gyro clipped in them ({:.0f} flip updates used): no flip measured "
+      "the scale along the hinges, which stays at its prior, and the box turned{}: a scale error along a hinge "
+      "is that fraction of every turn of the box about it, in the heading too (navgen's car, uncalibrated "
+      "MPU6050: 32-46 deg/h with 1 s flips, 0-5 with 2 s flips). Flip slower, so that the hinge rate stays "
+      "inside the range, or record with a larger full scale (MPU6050: FS_SEL), or {}",
+      f.count, f.suggested, turned,
+      u.calib ? "calibrate the scale again with 'driftless calibrate'"
+              : "calibrate the scale with 'driftless calibrate' and pass --calib");
 }
 
 // no pause of the box: the shared vertical bias stays near its g-sensitivity prior (section 1d)
@@ -629,6 +647,8 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
       return describe_box_dwells(f);
     case est::HealthCause::kVerticalUnobserved:
       return describe_vertical(f, cfg, u);
+    case est::HealthCause::kClippedFlipsScale:
+      return describe_clipped_flips(f, u);
     default: break;  // the flip-turn check's causes: describe_flip() above
   }
   return "?";

@@ -333,6 +333,17 @@ void add_vertical_finding(HealthReport& h, const DriftlessFilter& filter, const 
   add(h, std::move(f));
 }
 
+void add_clipped_flips_finding(HealthReport& h, const DriftlessFilter& filter, const BoxMotion& m) {
+  const FilterCounters& c = filter.counters();
+  if (!filter.uses_flips() || !(c.flip_clipped > c.flip_updates) || !box_turned(m)) return;
+  HealthFinding f;
+  f.cause = HealthCause::kClippedFlipsScale;
+  f.count = c.flip_clipped;
+  f.suggested = double(c.flip_updates);
+  f.value = m.ref_rate_dps;
+  add(h, std::move(f));
+}
+
 void add_reference_finding(HealthReport& h, const ReferenceFit& fit) {
   if (fit.verdict != RefFitVerdict::kOtherConvention && fit.verdict != RefFitVerdict::kNoFit) return;
   HealthFinding f;

@@ -125,6 +125,11 @@ enum class HealthCause {
                          // the bias both sensors share about the vertical is not observed. value =
                          // the largest correction sigma (deg/s), sigma = its prior (deg/s), suggested
                          // = ref_q's slowest turn over the quiet standstills (deg/s; NaN: no ref_q)
+  kClippedFlipsScale,    // --selfcal with flip updates: most flips skipped because a gyro clipped in
+                         // them, and the box turned while the platforms rested: the scale along the
+                         // hinges is not observed and enters every turn of the box about them.
+                         // count = flips skipped, suggested = flip updates used, value = ref_q's
+                         // largest turn rate over a standstill (deg/s; NaN: no ref_q)
                          // ... (accel_check.hpp: calib_uncertainty)
 };
 
@@ -270,6 +275,11 @@ void add_box_motion_finding(HealthReport& h, const BoxMotion& m, bool box_at_res
 /// was never 1 g), and the correction still near the g-sensitivity prior: `vertical_unobserved`
 /// (degraded). `m`: ref_q's turn over the quiet standstills, the evidence where logged.
 void add_vertical_finding(HealthReport& h, const DriftlessFilter& filter, const BoxMotion& m);
+
+/// Flip updates on, most flips skipped for a clipping gyro (FilterCounters::flip_clipped), on a
+/// box that turned (box_turned): `clipped_flips_scale` (degraded), the scale along the hinges
+/// then being at its prior while the box's turns multiply it.
+void add_clipped_flips_finding(HealthReport& h, const DriftlessFilter& filter, const BoxMotion& m);
 
 /// ref_q in another convention than the log's, or fitting none (reference_check.hpp): a degraded
 /// `reference_mismatch` finding (the attitude figures are withheld; the biases stand).

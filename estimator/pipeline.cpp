@@ -479,6 +479,7 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
   sum.box_motion = box_motion.finish();
   add_box_motion_finding(sum.health, sum.box_motion, cfg.box_at_rest);
   add_vertical_finding(sum.health, filter, sum.box_motion);
+  add_clipped_flips_finding(sum.health, filter, sum.box_motion);
   // accel columns in another unit, or empty: ahead of everything they spoil
   if (check_accel) add_accel_findings(sum.health, accel_check.finish(), cfg.self_calibration);
   // an uncertain calibration applied as exact (no self-calibration to refine it) leads them all
