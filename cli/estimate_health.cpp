@@ -1,5 +1,6 @@
 #include "cli/estimate_health.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -242,6 +243,13 @@ std::string noise_fix(const RunUsed& u) {
 
 namespace {
 
+// for noise or wander smaller than configured (NIS below its band): measure them, unless the run did
+std::string quiet_fix(const RunUsed& u) {
+  if (!u.tune_auto) return "use --tune auto to measure the noise density and the bias random walk from this log";
+  return "the noise and the wander were measured from this log already, so what stays too large is a bound: the "
+         "random walk's upper bound where the revisits show no wander above the noise, or a sensor-error prior";
+}
+
 // the lock: whether the filter locked, kept it, and what stayed unobserved
 // the closed form next to a settled sigma: the same (the bias's wander sets it) or below it (the
 // self-calibration or temperature states add the rest); empty without a prediction
@@ -405,11 +413,18 @@ std::string describe_fit(const est::HealthFinding& f, const est::EstimatorConfig
                              ? " (inside the 99.9 % band: one consistent run in 40 lands here)"
                              : " and its 99.9 % band",
                          std::sqrt(f.suggested), cfg.noise_density_dps_rthz, noise_fix(u));
-    case est::HealthCause::kNoiseOverstated:
-      return fmt::format("NIS mean {:.3g} below its 95 % band: the innovations are {:.2g}x smaller than the "
-                         "filter expects, its sigma too large (data quieter or the bias steadier than configured): "
-                         "safe, the estimates are trusted less than they deserve",
-                         f.value, std::sqrt(f.suggested));
+    case est::HealthCause::kNoiseOverstated: {
+      // S is too large by 1 / (NIS per dof): the sigma the configuration gives (noise and wander
+      // together) by its square root
+      const double over = 1.0 / std::sqrt(std::max(f.suggested, 1e-12));
+      return fmt::format("NIS mean {:.3g} below its 95 % band: the innovations are {:.2g}x the size the filter "
+                         "expects, so the configured noise is {:.2g}x too large as a sigma ({:.3g}x as a variance; "
+                         "noise_density_dps_rthz {:.3g}, bias random walk {:.3g} (deg/s)^2/s): the data are quieter "
+                         "or the bias steadier than configured; safe, but the estimates are trusted less than they "
+                         "deserve (slower lock, a looser gate); {}",
+                         f.value, std::sqrt(f.suggested), over, over * over, cfg.noise_density_dps_rthz,
+                         cfg.q_dps2_per_s(), quiet_fix(u));
+    }
     case est::HealthCause::kRejectionsAtPosition:
       return fmt::format("{:.0f} % of the updates at platform angles {} were rejected, few elsewhere: an error "
                          "that depends on the position and that a constant bias cannot absorb (g-sensitivity "

@@ -629,10 +629,23 @@ Eigen::Matrix3d DriftlessFilter::unknown_accel_cov_dps2(const Eigen::Matrix3d& M
   return sa2 * (D * D.transpose() + U);
 }
 
-// the box rate over a standstill in box axes, at the current estimate of the biases
+// the box rate over a standstill in box axes at the current correction, as the outputs take it:
+// each sensor's mean reading less o_i = b_i + G_i f_i (f_i the standstill's own specific force),
+// E_i removed to first order, (I - E_i)(y_i - o_i), fused. Its error is the correction's: with b_i
+// alone, a sensor whose G column along gravity is observed (a horizontal hinge) would read its
+// G_i f_i (~0.06 deg/s for an MPU6050) as a box rate
 Eigen::Vector3d DriftlessFilter::box_rate_dps(const StandstillSegment& s, const Eigen::Matrix3d& M1,
                                               const Eigen::Matrix3d& M2) const {
-  return 0.5 * (M1 * (s.mean_gyro1_dps() - bias1_dps()) + M2 * (s.mean_gyro2_dps() - bias2_dps()));
+  std::array<Eigen::Vector3d, 2> u{s.mean_gyro1_dps() - bias1_dps(), s.mean_gyro2_dps() - bias2_dps()};
+  const std::array<Eigen::Vector3d, 2> sum_accel{s.sum_accel1_mps2, s.sum_accel2_mps2};
+  for (int i = 0; i < 2; ++i) {
+    const auto iu = static_cast<std::size_t>(i);
+    if (has_gsens_states() && s.n_accel > 0) {
+      u[iu] -= g_sensitivity_dps_per_g(i + 1) * (sum_accel[iu] / (double(s.n_accel) * kStandardGravityMps2));
+    }
+    if (has_scale_states()) u[iu] -= scale_misalign(i + 1) * u[iu];
+  }
+  return 0.5 * (M1 * u[0] + M2 * u[1]);
 }
 
 // end-stop states: a rest angle off by d_i about a_i gives M_i y_i = w - d_i (a_i x w) + ..., so
@@ -671,20 +684,20 @@ void DriftlessFilter::add_rest_angle_noise(const StandstillSegment& s, const Eig
 
 // self-calibration: y_i = (I + E_i) w_i + ..., so eq. (2) gains M1 E1 w1 - M2 E2 w2 with w_i the
 // true rate over the standstill in sensor-i axes. Averages are linear: the mean rate enters. It is
-// taken from the fused body rate w = (M1 (y1 - b1) + M2 (y2 - b2)) / 2 at the current estimate
-// (an error of the estimate times E is second order), w_i = M_i^T w. While the bias is not yet
-// known, that error is not small: each row of M_i E_i dw carries 3 terms of variance
-// sigma_E^2 sigma_b^2 per sensor, added to R (6 sigma_E^2 sigma_b^2, the largest sigmas). A box that barely turns
+// taken from the fused body rate at the current correction (box_rate_dps), w_i = M_i^T w (an error
+// of the estimate times E is second order). While the correction is not yet known, that error is
+// not small: each row of M_i E_i dw carries 3 terms of variance sigma_E^2 sigma_o^2 per sensor,
+// added to R (6 sigma_E^2 sigma_o^2, the largest sigmas), sigma_o the correction's (b_i + G_i f_i),
+// not the bias's: a zero-g bias unobservable on its own (b_1 with G_1's column along a vertical
+// hinge: sigma ~ the G prior, 0.058 deg/s) is no error of the rate. A box that barely turns
 // (w ~ the Earth rate) leaves E at its prior; a box turning through a standstill observes the
 // sensors' relative E along the axes it turns about (docs/estimator.md section 1c)
 void DriftlessFilter::scale_rows(const StandstillSegment& s, const Eigen::Matrix3d& M1, const Eigen::Matrix3d& M2,
                                  Residual3& cur) {
-  const double sb = std::sqrt(P_.diagonal().head<kStateDim>().maxCoeff());
+  const double so = correction_sigma_dps().maxCoeff();
   const double se = std::sqrt(P_.diagonal().segment<18>(kScale1.start).maxCoeff());
-  cur.R.diagonal().array() += 6.0 * se * se * sb * sb;
-  // each sensor's rate with the current E removed, (I - E_i)(y_i - b_i), fused in box axes
-  const Eigen::Vector3d u1 = s.mean_gyro1_dps() - bias1_dps(), u2 = s.mean_gyro2_dps() - bias2_dps();
-  const Eigen::Vector3d w_body = 0.5 * (M1 * (u1 - scale_misalign(1) * u1) + M2 * (u2 - scale_misalign(2) * u2));
+  cur.R.diagonal().array() += 6.0 * se * se * so * so;
+  const Eigen::Vector3d w_body = box_rate_dps(s, M1, M2);
   last_w_dps_ = {M1.transpose() * w_body, M2.transpose() * w_body};
   cur.H.block<3, 9>(0, kScale1.start) = gsens_jacobian(M1, last_w_dps_[0]);
   cur.H.block<3, 9>(0, kScale2.start) = -gsens_jacobian(M2, last_w_dps_[1]);
@@ -1052,11 +1065,12 @@ void DriftlessFilter::use_flip() {
     H.col(stop_index(m, flips_.start_deg())) += fr.H_stop_start;
     H.col(stop_index(r, flips_.rest_deg())) += fr.H_stop_rest;
   }
-  // the regressors use the estimate: its error times E (3 terms per sensor, as in scale_rows)
-  const double sb = std::sqrt(P_.diagonal().head<kStateDim>().maxCoeff());
+  // the regressors use the corrected rates: the correction's error times E (3 terms per sensor, as
+  // in scale_rows)
+  const double so = correction_sigma_dps().maxCoeff();
   const double se = std::sqrt(P_.diagonal().segment<18>(kScale1.start).maxCoeff());
   Eigen::Matrix3d R = fr.R_deg2;
-  R.diagonal().array() += 6.0 * se * se * sb * sb * fr.span_s * fr.span_s;
+  R.diagonal().array() += 6.0 * se * se * so * so * fr.span_s * fr.span_s;
   predict_to(std::max(0.5 * (flips_.t_start_s() + flips_.t_end_s()), t_filter_s_));
   UpdateRecord rec;  // not emitted: the standstill updates' record and counts stay theirs
   const bool ok = update<3>(fr.z_deg, H, R, rec, false);
