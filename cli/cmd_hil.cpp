@@ -131,20 +131,30 @@ void refuse_options_no_source_uses(const CLI::App& cmd, const HilOptions& o) {
   }
 }
 
-// the bias lines are the filter's start value until it locked (estimate's lock level): say so, and
-// why when the samples never had both triads
-void warn_if_never_locked(const est::DriftlessFilter& filter) {
+// the bias lines are the filter's start value until it locked (estimate's lock level, with its
+// hysteresis: LiveStats steps it at each update as 'estimate' does): say so when it never locked
+// or lost the lock by the end, and why when the samples never had both triads
+void warn_about_lock(const est::DriftlessFilter& filter, const hil::LiveStats& st) {
+  if (st.locked_at_end) return;
   const double lock_dps = est::HealthLimits{}.lock_sigma_dps;
   const double sigma_dps = filter.correction_sigma_dps().maxCoeff();
-  if (sigma_dps < lock_dps) return;
   const est::FilterCounters& c = filter.counters();
+  const std::string invalid =
+      c.invalid > 0 ? fmt::format("; {} of {} samples lacked a gyro value (an empty column: a dead axis or "
+                                  "a missing sensor?)", c.invalid, c.samples)
+                    : "";
+  if (st.ever_locked) {
+    fmt::print(stderr,
+               "driftless hil: warning: the filter lost its lock before the end (largest sigma {:.3g} deg/s; it "
+               "locks below {:g} and loses the lock above {:g} or at a gate re-lock; {} update(s), {} rejected, {} "
+               "re-lock(s)): the biases above are not estimates{}\n",
+               sigma_dps, lock_dps, est::kUnlockFactor * lock_dps, c.updates, c.rejected, c.relocks, invalid);
+    return;
+  }
   fmt::print(stderr,
              "driftless hil: warning: the filter never locked (largest sigma {:.3g} deg/s, locked below {:g}; {} "
              "update(s), {} rejected): the biases above are not estimates{}\n",
-             sigma_dps, lock_dps, c.updates, c.rejected,
-             c.invalid > 0 ? fmt::format("; {} of {} samples lacked a gyro value (an empty column: a dead axis or "
-                                         "a missing sensor?)", c.invalid, c.samples)
-                           : "");
+             sigma_dps, lock_dps, c.updates, c.rejected, invalid);
 }
 
 // The log states one sample_rate_hz and the estimator's noise per sample (R) is set from it, so a
@@ -269,7 +279,7 @@ int run_hil(const HilOptions& o) {
   fmt::print("filter: {} updates, {} rejected by the NIS gate, {} source switches\n", filter.counters().updates,
              filter.counters().rejected, filter.counters().source_switches);
   fmt::print("log: {}\n", log_path.string());
-  warn_if_never_locked(filter);
+  warn_about_lock(filter, st);
   if (!st.complete) throw std::runtime_error("hil: " + st.end_reason + "; the log so far is " + log_path.string() +
                                              " (complete: false)");
   if (switch_missed) {

@@ -1,5 +1,7 @@
 #include "hil_bridge/live_loop.hpp"
 
+#include "estimator/health.hpp"
+
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
@@ -15,8 +17,17 @@ void LiveParams::validate() const {
 }
 
 LiveLoop::LiveLoop(LiveParams p, Clock& clock, log::LogWriter* log, est::DriftlessFilter* filter)
-    : p_(p), clock_(clock), log_(log), filter_(filter) {
+    : p_(p), clock_(clock), log_(log), filter_(filter), lock_(est::HealthLimits{}.lock_sigma_dps) {
   p_.validate();
+}
+
+// after a push: an update (accepted, or rejected by the gate, which may re-lock) steps the lock
+void LiveLoop::step_lock(est::PushStatus pushed) {
+  if (pushed != est::PushStatus::kUpdated && pushed != est::PushStatus::kRejected) return;
+  stats_.sigma_at_end_dps = filter_->correction_sigma_dps().maxCoeff();
+  lock_.on_update(stats_.sigma_at_end_dps, filter_->last_update().relocked);
+  stats_.ever_locked = stats_.ever_locked || lock_.locked();
+  stats_.locked_at_end = lock_.locked();
 }
 
 void LiveLoop::event(const std::string& text) {
@@ -195,6 +206,7 @@ LiveStats LiveLoop::run_loop(SampleSource& first, SampleSource* second, const st
     }
     if (pump_) pump_->write(s);
     const est::PushStatus pushed = filter_ ? filter_->push(s) : est::PushStatus::kInvalid;
+    if (filter_) step_lock(pushed);
     t_last_ = s.t_s;
     if (fdi_ && filter_) {
       if (const std::string e = fdi_->push(s, pushed, *filter_); !e.empty()) event(e);
@@ -214,7 +226,7 @@ LiveStats LiveLoop::run_loop(SampleSource& first, SampleSource* second, const st
   src->deactivate();
   // the stream ended (whatever ended it): a standstill still open is good data, as at the end of a
   // log in 'estimate' (DriftlessFilter::finish), so the session and 'estimate' on its log agree
-  if (filter_) filter_->finish();
+  if (filter_) step_lock(filter_->finish());
   return stats_;
 }
 

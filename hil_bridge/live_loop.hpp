@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "estimator/filter.hpp"
+#include "estimator/lock_state.hpp"
 #include "estimator/log.hpp"
 #include "hil_bridge/clock.hpp"
 #include "hil_bridge/fdi_watch.hpp"
@@ -47,6 +48,11 @@ struct LiveStats {
   double t_switch_s = kNaN;                  // session time of the first row of the second source
   bool complete = false;             // ended by duration, end of stream or Ctrl-C (not a failure)
   std::string end_reason;
+  // the filter's lock, stepped at each update as 'estimate' steps it (estimator/lock_state.hpp:
+  // the lock level with hysteresis), so a sigma that sits on the level does not read as no lock
+  bool ever_locked = false;    // the correction locked at some update
+  bool locked_at_end = false;  // and was locked after the session's last update
+  double sigma_at_end_dps = kNaN;  // deg/s, the largest sigma of the correction at the end
 };
 
 class LiveLoop {
@@ -98,6 +104,8 @@ class LiveLoop {
   std::function<void(const Sample&, SampleSource&)> on_sample_;
   std::function<void(double, const std::string&)> on_event_;
   LiveStats stats_;
+  est::LockState lock_;
+  void step_lock(est::PushStatus pushed);
   double t_last_ = kNaN;  // session time of the last row
   std::vector<SourceEvent> pending_;
 };

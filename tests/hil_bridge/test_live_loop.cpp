@@ -19,6 +19,7 @@
 #include <gtest/gtest.h>
 
 #include "estimator/filter.hpp"
+#include "estimator/health.hpp"
 #include "estimator/log.hpp"
 #include "hil_bridge/i2c/emulated_bus.hpp"
 #include "hil_bridge/i2c/i2c_source.hpp"
@@ -106,6 +107,12 @@ TEST(LiveLoop, EmulatedI2cRunConvergesAndLogsEveryRow) {
     writer.finish(st.complete, st.end_reason);
     EXPECT_TRUE(st.complete);
     EXPECT_EQ(st.samples, 12000u);
+    // AND the session's lock was stepped at its updates ('driftless hil' warns from it): locked,
+    // and still locked at the end with the filter's own last sigma
+    EXPECT_TRUE(st.ever_locked);
+    EXPECT_TRUE(st.locked_at_end);
+    EXPECT_DOUBLE_EQ(st.sigma_at_end_dps, filter.correction_sigma_dps().maxCoeff());
+    EXPECT_LT(st.sigma_at_end_dps, est::HealthLimits{}.lock_sigma_dps);
   }
   // THEN every sample is a row, 10 ms apart, and the estimate is near the emulated biases
   const Result r = read_back(path, {});
