@@ -14,13 +14,9 @@ cd "$root"
 # nice value only ranks a process inside its session's group: the group's nice is set too
 echo 19 > /proc/self/autogroup 2> /dev/null || true
 at() { echo "== second pass: $1 at CI second $(( $(date +%s) - ci_start ))"; }
-drop_intermediates() {
-  # with CI=true (a clean clone, built once) a build drops what only the compiler and linker need
-  # once its programs are linked (objects, static libraries, precompiled headers: 150 MB a build);
-  # ccache keeps the objects for the next clone
-  [[ ${CI:-} == true ]] || return 0
-  find "$1" -type f \( -name '*.o' -o -name '*.a' -o -name '*.gch' \) -delete
-}
+# drop_intermediates BUILD_DIR: .ci/run's, exported to this script (with CI=true a build drops its
+# objects once its programs are linked; ccache keeps them)
+
 # The sanitizer build links our libraries as shared libraries: each of its test programs then holds
 # its own code only, not a copy of the libraries under ASan (build-asan took 4.0 GB of disk,
 # 2026-11-24). It compiles only what its suite runs: no benchmarks, and not the programs of the
