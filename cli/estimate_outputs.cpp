@@ -228,8 +228,9 @@ void write_estimate_summary(const fs::path& path, const SummaryContext& ctx, con
       json_number(s.stop_angle_deg[0]), json_number(s.stop_angle_deg[1]), json_number(s.stop_angle_deg[2]),
       json_number(s.stop_angle_deg[3]), json_number(s.stop_angle_sigma_deg[0]), json_number(s.stop_angle_sigma_deg[1]),
       json_number(s.stop_angle_sigma_deg[2]), json_number(s.stop_angle_sigma_deg[3]));
-  add("  \"box_dwells\": {{\"updates\": {}, \"rejected\": {}, \"refused_moving\": {}}},\n",
-      s.counters.box_dwell_updates, s.counters.box_dwell_rejected, s.counters.box_dwell_moving);
+  add("  \"box_dwells\": {{\"updates\": {}, \"rejected\": {}, \"refused_moving\": {}, \"refused_turning\": {}}},\n",
+      s.counters.box_dwell_updates, s.counters.box_dwell_rejected, s.counters.box_dwell_moving,
+      s.counters.box_dwell_turned);
   const std::uint64_t flips_ok = s.counters.flip_updates - s.counters.flip_rejected;
   add("  \"flips\": {{\"updates\": {}, \"rejected\": {}, \"nis_mean\": {}, \"skipped_clipped\": {}}},\n",
       s.counters.flip_updates, s.counters.flip_rejected,

@@ -37,25 +37,6 @@ void gravity_from_ref_q(const DriftlessFilter& filter, Sample& s) {
   if (std::isfinite(s.plat2_deg)) s.accel2_mps2 = filter.body_from_sensor(2, s.plat2_deg).transpose() * f_box;
 }
 
-bool ReferenceTurn::turning(const Sample& s) {
-  if (!s.ref_q_wxyz.allFinite() || !(s.ref_q_wxyz.norm() > 0.0)) return false;
-  const Eigen::Quaterniond q =
-      Eigen::Quaterniond(s.ref_q_wxyz[0], s.ref_q_wxyz[1], s.ref_q_wxyz[2], s.ref_q_wxyz[3]).normalized();
-  if (!std::isfinite(t0_s_) || s.t_s < t0_s_) {
-    t0_s_ = s.t_s;
-    q0_ = q;
-    return last_window_turning_;
-  }
-  const double angle_deg = q0_.angularDistance(q) * kDegPerRad;
-  const bool fast = angle_deg > limit_dps_ * kWindowS;
-  if (s.t_s - t0_s_ >= kWindowS) {
-    last_window_turning_ = angle_deg > limit_dps_ * (s.t_s - t0_s_);
-    t0_s_ = s.t_s;
-    q0_ = q;
-  }
-  return last_window_turning_ || fast;
-}
-
 AccelSensorReading classify_accel(double median_norm, std::uint64_t samples) {
   AccelSensorReading r;
   r.median_norm = median_norm;

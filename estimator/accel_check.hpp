@@ -32,23 +32,6 @@ void gravity_from_ref_q(const DriftlessFilter& filter, Sample& s);
 /// acceleration that went into R (EstimatorConfig::ref_gravity_accel_sigma_g, ref_gravity_speed_mps).
 std::string gravity_from_ref_q_note(double accel_sigma_g, double speed_mps);
 
-/// Whether ref_q turns: over its last whole window of kWindowS, or by more than that window's
-/// allowance since (a turn that starts is seen at once). The box dwells' witness of a pause when
-/// gravity comes from ref_q (no accel columns to show an acceleration).
-class ReferenceTurn {
- public:
-  static constexpr double kWindowS = 1.0;
-  explicit ReferenceTurn(double limit_dps) : limit_dps_(limit_dps) {}
-  /// True when the box turns faster than limit_dps at `s` (false while ref_q is not finite).
-  bool turning(const Sample& s);
-
- private:
-  double limit_dps_;
-  double t0_s_ = kNaN;
-  Eigen::Quaterniond q0_ = Eigen::Quaterniond::Identity();
-  bool last_window_turning_ = false;
-};
-
 /// What a sensor's accel columns read at the standstills, against gravity.
 enum class AccelReading : std::uint8_t {
   kNotChecked,  // no standstill sample with accel values

@@ -29,6 +29,21 @@ constexpr double kDwellTrendChangeDps = 0.25;
 
 bool finite(double v) { return std::isfinite(v); }
 
+// a sample's ref_q (q_enu_from_body, w x y z), normalised; false when it has none
+bool ref_q_of(const Eigen::Vector4d& wxyz, Eigen::Quaterniond& q) {
+  if (!wxyz.allFinite() || !(wxyz.norm() > 0.0)) return false;
+  q = Eigen::Quaterniond(wxyz[0], wxyz[1], wxyz[2], wxyz[3]).normalized();
+  return true;
+}
+
+// the rotation (deg, in the axes of `from`) that turns `from` into `to`
+Eigen::Vector3d rotation_deg(const Eigen::Quaterniond& from, const Eigen::Quaterniond& to) {
+  Eigen::Quaterniond d = from.conjugate() * to;
+  if (d.w() < 0.0) d.coeffs() *= -1.0;
+  const Eigen::AngleAxisd aa(d);
+  return aa.axis() * (aa.angle() * kDegPerRad);
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -921,14 +936,17 @@ double DriftlessFilter::DwellTrend::change_dps() const {
 }
 
 bool DriftlessFilter::box_quiet(const Sample& s) const {
-  if (!dwell_armed_ || box_turning_ || out_.sensors_fused != 2 || !out_.at_rest) return false;
+  if (!dwell_armed_ || out_.sensors_fused != 2 || !out_.at_rest) return false;
   if (!(out_.rate_body_dps.norm() < cfg_.box_dwell_rate_dps)) return false;
   // without a witness of the turns, |f| within 5 % of 1 g (no linear acceleration) stands for
-  // "the box rests"; with one (ref_q), the box may accelerate: the dwell row takes the measured f
+  // "the box rests"; with one (ref_q), the box may accelerate: the dwell row takes the measured f,
+  // and ref_q's mean turn over the dwell decides at its end (use_box_dwell)
   constexpr double kOneGTolerance = 0.05;
+  Eigen::Quaterniond q;
+  const bool witnessed = ref_q_of(s.ref_q_wxyz, q);
   for (const Eigen::Vector3d* a : {&s.accel1_mps2, &s.accel2_mps2}) {
     if (!a->allFinite()) return false;
-    if (!box_turn_witnessed_ && !(std::fabs(a->norm() / kStandardGravityMps2 - 1.0) < kOneGTolerance)) return false;
+    if (!witnessed && !(std::fabs(a->norm() / kStandardGravityMps2 - 1.0) < kOneGTolerance)) return false;
   }
   return true;
 }
@@ -946,7 +964,8 @@ void DriftlessFilter::track_box_dwell(const Sample& s) {
   }
   if (s.t_s - dwell_quiet_since_s_ < cfg_.box_dwell_margin_s) return;  // the start margin
   dwell_recent_.push_back(
-      {s.t_s, s.gyro1_dps, s.gyro2_dps, s.accel1_mps2, s.accel2_mps2, s.temp1_c, s.temp2_c, out_.rate_body_dps});
+      {s.t_s, s.gyro1_dps, s.gyro2_dps, s.accel1_mps2, s.accel2_mps2, s.temp1_c, s.temp2_c, out_.rate_body_dps,
+       s.ref_q_wxyz});
   // samples older than the end margin can no longer be spoiled by the motion that ends the dwell
   while (dwell_recent_.front().t_s < s.t_s - cfg_.box_dwell_margin_s) {
     const DwellSample& d = dwell_recent_.front();
@@ -959,6 +978,15 @@ void DriftlessFilter::track_box_dwell(const Sample& s) {
     dwell_.sum_accel1_mps2 += d.accel1_mps2;
     dwell_.sum_accel2_mps2 += d.accel2_mps2;
     dwell_trend_.add(d.t_s - dwell_.t_first_s, d.rate_dps);
+    Eigen::Quaterniond q;
+    if (ref_q_of(d.ref_q_wxyz, q)) {
+      if (!finite(dwell_ref_.t0_s)) {
+        dwell_ref_.t0_s = d.t_s;
+        dwell_ref_.q0 = q;
+      }
+      dwell_ref_.t1_s = d.t_s;
+      dwell_ref_.q1 = q;
+    }
     if (finite(d.temp1_c) && finite(d.temp2_c)) {
       ++dwell_.n_temp;
       dwell_.sum_temp1_c += d.temp1_c;
@@ -981,6 +1009,7 @@ void DriftlessFilter::close_box_dwell(double temp1_c, double temp2_c) {
   }
   dwell_ = StandstillSegment{};
   dwell_trend_ = DwellTrend{};
+  dwell_ref_ = DwellRefTurn{};
   dwell_recent_.clear();
   dwell_quiet_since_s_ = kNaN;
 }
@@ -1003,6 +1032,19 @@ void DriftlessFilter::use_box_dwell(const StandstillSegment& seg) {
   Eigen::Matrix<double, 1, kFullStateDim> h;
   Eigen::Matrix<double, 1, 1> z, var_z;
   if (!rest_row(seg, M1, M2, var_r, h, z(0), var_z(0))) return;
+  // the row takes the box's rate for the Earth's: the box's own mean rate over the samples it
+  // averages (ref_q's turn from the dwell's first sample to its last, over that span) is an error
+  // the row would take for the sensors'. Above the row's sigma it biases the update by more than
+  // the update resolves (a steady slow yaw, the end of a turn inside the dwell): refused. Below it
+  // (a shake that averaged out) its square joins the row's variance
+  const double ref_span_s = dwell_ref_.t1_s - dwell_ref_.t0_s;
+  const double turn_dps = ref_span_s > 0.0 ? rotation_deg(dwell_ref_.q0, dwell_ref_.q1).norm() / ref_span_s : 0.0;
+  const double turn2_dps2 = turn_dps * turn_dps;
+  if (turn2_dps2 > var_z(0)) {
+    ++counters_.box_dwell_turned;
+    return;
+  }
+  var_z(0) += turn2_dps2;
   UpdateRecord rec;  // not emitted: the platform updates' record and counts stay theirs
   const bool ok = update<1>(z, h, var_z, rec, false, wander);
   ++counters_.box_dwell_updates;

@@ -135,6 +135,9 @@ struct FilterCounters {
   // quiet stretches not used as box dwells because the box rate trended through them (a rocking or
   // swinging box passing a turning point): box_dwell_trend() (not in box_dwell_updates)
   std::uint64_t box_dwell_moving = 0;
+  // quiet stretches not used as box dwells because ref_q turned through them: the box's mean rate
+  // over the dwell's samples (ref_q's slope) above the dwell row's sigma (not in box_dwell_updates)
+  std::uint64_t box_dwell_turned = 0;
   // flip updates of the scale/misalignment (flip_updates; not in `updates`/`rejected`)
   std::uint64_t flip_updates = 0;
   std::uint64_t flip_rejected = 0;
@@ -181,15 +184,6 @@ class DriftlessFilter {
   /// whose gyros were calibrated once and never again would use. Zero until set; the filter's
   /// own state is not touched.
   void set_fixed_bias_dps(const Vector6d& b) { fixed_bias_ = b; }
-  /// The box turns at this sample by a witness other than the gyros (ref_q; set before push()): no
-  /// box dwell there. A witnessed still box needs no 1 g test of the accel columns: a vehicle that
-  /// drives straight rests for the gyros while it accelerates, and G f takes the measured f
-  /// (accel_check.hpp; docs/estimator.md section 1d). clear_box_turning(): no witness at this sample.
-  void set_box_turning(bool turning) {
-    box_turning_ = turning;
-    box_turn_witnessed_ = true;
-  }
-  void clear_box_turning() { box_turning_ = box_turn_witnessed_ = false; }
   /// Every accepted update is handed to `o` (nullptr: none); for the offline smoother.
   void set_update_observer(UpdateObserver* o) { observer_ = o; }
   /// The corrected outputs of the following push() calls use state `x` (bias referred to
@@ -354,6 +348,7 @@ class DriftlessFilter {
     Eigen::Vector3d gyro1_dps, gyro2_dps, accel1_mps2, accel2_mps2;
     double temp1_c, temp2_c;
     Eigen::Vector3d rate_dps;  // the corrected fused body rate
+    Eigen::Vector4d ref_q_wxyz;  // the sample's ref_q (NaN: none)
   };
   // least-squares line of the fused rate against time over a dwell (t from its first sample)
   struct DwellTrend {
@@ -368,8 +363,13 @@ class DriftlessFilter {
   StandstillSegment dwell_;
   DwellTrend dwell_trend_;
   std::deque<DwellSample> dwell_recent_;
-  bool box_turning_ = false;         // set_box_turning()
-  bool box_turn_witnessed_ = false;  // set_box_turning() since the last clear_box_turning()
+  // ref_q at the dwell's first and last samples that have it (t0_s NaN: none yet): the turn between
+  // them over their span is the box's mean rate over the dwell (docs/estimator.md section 1d)
+  struct DwellRefTurn {
+    double t0_s = kNaN, t1_s = kNaN;
+    Eigen::Quaterniond q0 = Eigen::Quaterniond::Identity(), q1 = Eigen::Quaterniond::Identity();
+  };
+  DwellRefTurn dwell_ref_;
   double dwell_quiet_since_s_ = kNaN;
   bool dwell_armed_ = false;
   double gate1_ = 0.0, gate3_ = 0.0, gate4_ = 0.0, gate6_ = 0.0;

@@ -377,7 +377,6 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
   ReferenceCheck ref_check;
   BoxMotionCheck box_motion;
   AccelCheck accel_check;
-  ReferenceTurn ref_turn(BoxMotionLimits{}.ref_rate_dps);
   const bool check_accel = (fields & kFieldAccel) != 0;
 
   // the lock state changes only at updates (P shrinks there; a gate re-lock widens it)
@@ -409,9 +408,6 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
     if (!std::isfinite(sum.t_first_s)) sum.t_first_s = s.t_s;
     sum.t_last_s = s.t_s;
     if (run_cfg.gravity_from_ref_q) gravity_from_ref_q(filter, s);
-    // ref_q witnesses the box's turns for the box dwells (with or without accel columns)
-    if (s.ref_q_wxyz.allFinite()) filter.set_box_turning(ref_turn.turning(s));
-    else filter.clear_box_turning();
     const PushStatus st = filter.push(s);
     if (check_accel) accel_check.push(s, filter.output().at_rest);
     on_update(st, s);  // first: the row that made an update carries the state after it

@@ -29,7 +29,7 @@ grep -q '"g_sensitivity_sigma_dps_per_g": \[\[\[' "$t/sc/summary.json" || fail "
 "$bin" estimate --log "$t/sim/log.csv" --out "$t/dw" --selfcal --strict > /dev/null 2> "$t/dw.err" ||
   fail "--selfcal (box dwells): exit $?: $(cat "$t/dw.err")"
 [[ $(verdict "$t/dw") == ok ]] || fail "--selfcal (box dwells): verdict $(verdict "$t/dw")"
-grep -Eq '"box_dwells": \{"updates": [1-9][0-9]*, "rejected": 0, "refused_moving": 0\}' "$t/dw/summary.json" ||
+grep -Eq '"box_dwells": \{"updates": [1-9][0-9]*, "rejected": 0, "refused_moving": 0, "refused_turning": 0\}' "$t/dw/summary.json" ||
   fail "--selfcal: no box dwell updates: $(grep -o '"box_dwells": {[^}]*}' "$t/dw/summary.json")"
 grep -Eq '"flips": \{"updates": [1-9][0-9]*, "rejected": 0, "nis_mean": [0-9.]+, "skipped_clipped": 0\}' "$t/dw/summary.json" ||
   fail "--selfcal: no flip updates: $(grep -o '"flips": {[^}]*}' "$t/dw/summary.json")"

@@ -123,6 +123,11 @@ def box_motion(t, args):
     elif args.motion == "slowyaw":
         w = math.radians(args.yaw_rate)
         psi = w * t; psid = np.full(n, w)
+    elif args.motion == "shake":
+        # a box that holds its pose but shakes about up: a zero-mean yaw rate (a servo's hold, a
+        # mount's vibration), the angle 0 .. 2 A / (2 pi f) and back every period
+        A = math.radians(args.shake_dps); w = 2 * math.pi * args.shake_hz
+        psi = A / w * (1 - np.cos(w * t)); psid = A * np.sin(w * t)
     elif args.motion == "rock":
         A = math.radians(20); w = 2 * math.pi / 17.0
         phi = A * np.sin(w * t); phid = A * w * np.cos(w * t)
@@ -178,7 +183,7 @@ def main():
     ap.add_argument("--stick", type=float, default=None, help="platform 2 sticks from t (s)")
     ap.add_argument("--stick-report", default="command", choices=["command", "readback"])
     ap.add_argument("--endstop", action="store_true", help="angles empty while moving")
-    ap.add_argument("--motion", default="static", choices=["static", "car", "rock", "slowyaw"])
+    ap.add_argument("--motion", default="static", choices=["static", "car", "rock", "slowyaw", "shake"])
     ap.add_argument("--lowpass", type=float, default=0.0, help="1st-order low-pass Hz (both), 0 = none")
     ap.add_argument("--lowpass2", type=float, default=None, help="sensor 2 low-pass Hz (default = --lowpass)")
     ap.add_argument("--delay2", type=float, default=0.0, help="sensor 2 reads the truth this late (s)")
@@ -196,6 +201,8 @@ def main():
     ap.add_argument("--step", default=None, help="T:SENSOR(1|2):AXIS(0-2):DPS bias step")
     ap.add_argument("--oneway", action="store_true", help="every flip turns +180 (reported angle wrapped to [-180,180))")
     ap.add_argument("--yaw-rate", type=float, default=0.05, help="slowyaw: deg/s")
+    ap.add_argument("--shake-dps", type=float, default=0.2, help="shake: yaw rate amplitude deg/s")
+    ap.add_argument("--shake-hz", type=float, default=2.0, help="shake: frequency Hz")
     ap.add_argument("--chunk", type=float, default=600.0)
     ap.add_argument("--truth-out", default=None, help="write the constant truth (json)")
     args = ap.parse_args()

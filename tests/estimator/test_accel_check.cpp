@@ -99,44 +99,6 @@ TEST(AccelCheck, GravityFromRefQIsUpInEachSensorsAxes) {
   EXPECT_FALSE(s.accel1_mps2.allFinite());
 }
 
-// ref_q turning at `rate_dps` about z for 3 s at 100 Hz: whether the last sample counts as turning
-bool turning_at(double rate_dps, double limit_dps) {
-  ReferenceTurn turn(limit_dps);
-  Sample s;
-  bool last = false;
-  for (int k = 0; k <= 300; ++k) {
-    s.t_s = 0.01 * k;
-    const Eigen::Quaterniond q(Eigen::AngleAxisd(rate_dps * s.t_s * kRadPerDeg, Eigen::Vector3d::UnitZ()));
-    s.ref_q_wxyz = Eigen::Vector4d(q.w(), q.x(), q.y(), q.z());
-    last = turn.turning(s);
-  }
-  return last;
-}
-
-TEST(AccelCheck, RefQTurningFasterThanTheLimitIsATurn) {
-  EXPECT_FALSE(turning_at(0.0, 0.01));
-  EXPECT_FALSE(turning_at(0.005, 0.01));  // half the limit
-  EXPECT_TRUE(turning_at(0.02, 0.01));    // twice it
-  EXPECT_TRUE(turning_at(30.0, 0.01));    // a car's turn
-}
-
-TEST(AccelCheck, TurnSeenAtOnceWhenItStarts) {
-  // still for 2 s, then 10 deg/s: the sample 0.05 s into the turn (0.5 deg) is already a turn
-  ReferenceTurn turn(0.01);
-  Sample s;
-  bool at_start = true, after = false;
-  for (int k = 0; k <= 205; ++k) {
-    s.t_s = 0.01 * k;
-    const double angle_deg = s.t_s > 2.0 ? 10.0 * (s.t_s - 2.0) : 0.0;
-    const Eigen::Quaterniond q(Eigen::AngleAxisd(angle_deg * kRadPerDeg, Eigen::Vector3d::UnitZ()));
-    s.ref_q_wxyz = Eigen::Vector4d(q.w(), q.x(), q.y(), q.z());
-    const bool t = turn.turning(s);
-    if (k == 199) at_start = t;
-    after = t;
-  }
-  EXPECT_FALSE(at_start);
-  EXPECT_TRUE(after);
-}
 
 TEST(AccelCheck, UncertainCalibrationElementsByTheirSigmaAgainstTheirValue) {
   Calibration cal;
