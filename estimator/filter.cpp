@@ -26,6 +26,11 @@ constexpr double kBiasInstabilityFactor = 0.6642824702679600;  // sqrt(2 ln 2 / 
 // a box rocking 20 deg over 17 s 2.8 deg/s
 constexpr double kDwellTrendChi2 = 50.0;
 constexpr double kDwellTrendChangeDps = 0.25;
+// a dwell is kept in pieces of this length, of which up to kDwellEdgePieces at each end may be
+// dropped where ref_q turned in them (the end of the move before, the start of the one after: a
+// car's turn slows to below the 2 deg/s quiet limit over its last 0.5 s)
+constexpr double kDwellPieceS = 0.5;
+constexpr int kDwellEdgePieces = 4;
 
 bool finite(double v) { return std::isfinite(v); }
 
@@ -34,6 +39,22 @@ bool ref_q_of(const Eigen::Vector4d& wxyz, Eigen::Quaterniond& q) {
   if (!wxyz.allFinite() || !(wxyz.norm() > 0.0)) return false;
   q = Eigen::Quaterniond(wxyz[0], wxyz[1], wxyz[2], wxyz[3]).normalized();
   return true;
+}
+
+// `b`'s samples added to `a` (b follows a in time)
+void add_segment(StandstillSegment& a, const StandstillSegment& b) {
+  if (b.n == 0) return;
+  if (a.n == 0) a.t_first_s = b.t_first_s;
+  a.t_last_s = b.t_last_s;
+  a.n += b.n;
+  a.n_accel += b.n_accel;
+  a.sum_gyro1_dps += b.sum_gyro1_dps;
+  a.sum_gyro2_dps += b.sum_gyro2_dps;
+  a.sum_accel1_mps2 += b.sum_accel1_mps2;
+  a.sum_accel2_mps2 += b.sum_accel2_mps2;
+  a.n_temp += b.n_temp;
+  a.sum_temp1_c += b.sum_temp1_c;
+  a.sum_temp2_c += b.sum_temp2_c;
 }
 
 // the rotation (deg, in the axes of `from`) that turns `from` into `to`
@@ -969,29 +990,21 @@ void DriftlessFilter::track_box_dwell(const Sample& s) {
   // samples older than the end margin can no longer be spoiled by the motion that ends the dwell
   while (dwell_recent_.front().t_s < s.t_s - cfg_.box_dwell_margin_s) {
     const DwellSample& d = dwell_recent_.front();
-    if (dwell_.n == 0) dwell_.t_first_s = d.t_s;
-    dwell_.t_last_s = d.t_s;
-    ++dwell_.n;
-    ++dwell_.n_accel;
-    dwell_.sum_gyro1_dps += d.gyro1_dps;
-    dwell_.sum_gyro2_dps += d.gyro2_dps;
-    dwell_.sum_accel1_mps2 += d.accel1_mps2;
-    dwell_.sum_accel2_mps2 += d.accel2_mps2;
-    dwell_trend_.add(d.t_s - dwell_.t_first_s, d.rate_dps);
-    Eigen::Quaterniond q;
-    if (ref_q_of(d.ref_q_wxyz, q)) {
-      if (!finite(dwell_ref_.t0_s)) {
-        dwell_ref_.t0_s = d.t_s;
-        dwell_ref_.q0 = q;
-      }
-      dwell_ref_.t1_s = d.t_s;
-      dwell_ref_.q1 = q;
-    }
+    StandstillSegment one;
+    one.t_first_s = one.t_last_s = d.t_s;
+    one.n = one.n_accel = 1;
+    one.sum_gyro1_dps = d.gyro1_dps;
+    one.sum_gyro2_dps = d.gyro2_dps;
+    one.sum_accel1_mps2 = d.accel1_mps2;
+    one.sum_accel2_mps2 = d.accel2_mps2;
     if (finite(d.temp1_c) && finite(d.temp2_c)) {
-      ++dwell_.n_temp;
-      dwell_.sum_temp1_c += d.temp1_c;
-      dwell_.sum_temp2_c += d.temp2_c;
+      one.n_temp = 1;
+      one.sum_temp1_c = d.temp1_c;
+      one.sum_temp2_c = d.temp2_c;
     }
+    add_segment(dwell_, one);
+    dwell_trend_.add(d.t_s - dwell_.t_first_s, d.rate_dps);
+    add_dwell_piece(one, d.ref_q_wxyz);
     dwell_recent_.pop_front();
   }
 }
@@ -1003,20 +1016,92 @@ void DriftlessFilter::close_box_dwell(double temp1_c, double temp2_c) {
     if (dwell_trend_.chi2() > kDwellTrendChi2 && dwell_trend_.change_dps() > kDwellTrendChangeDps) {
       ++counters_.box_dwell_moving;
     } else {
-      use_box_dwell(dwell_);
+      use_box_dwell();
       predict_temperature(temp1_c, temp2_c);
     }
   }
   dwell_ = StandstillSegment{};
   dwell_trend_ = DwellTrend{};
-  dwell_ref_ = DwellRefTurn{};
+  dwell_pieces_.clear();
   dwell_recent_.clear();
   dwell_quiet_since_s_ = kNaN;
 }
 
-void DriftlessFilter::use_box_dwell(const StandstillSegment& seg) {
-  const Eigen::Matrix3d M1 = body_from_sensor(1, seg.plat1_deg);
-  const Eigen::Matrix3d M2 = body_from_sensor(2, seg.plat2_deg);
+void DriftlessFilter::DwellPiece::add(const DwellPiece& later) {
+  add_segment(seg, later.seg);
+  if (!finite(later.t0_s)) return;
+  if (!finite(t0_s)) {
+    t0_s = later.t0_s;
+    q0 = later.q0;
+  }
+  t1_s = later.t1_s;
+  q1 = later.q1;
+}
+
+void DriftlessFilter::add_dwell_piece(const StandstillSegment& one, const Eigen::Vector4d& ref_q_wxyz) {
+  if (dwell_pieces_.empty() || one.t_first_s - dwell_pieces_.back().seg.t_first_s >= kDwellPieceS) {
+    // the pieces between the edges are merged: at most kDwellEdgePieces, one, kDwellEdgePieces
+    constexpr std::size_t kMaxPieces = 2 * kDwellEdgePieces + 1;
+    if (dwell_pieces_.size() == kMaxPieces) {
+      dwell_pieces_[kDwellEdgePieces].add(dwell_pieces_[kDwellEdgePieces + 1]);
+      dwell_pieces_.erase(dwell_pieces_.begin() + kDwellEdgePieces + 1);
+    }
+    dwell_pieces_.emplace_back();
+  }
+  DwellPiece& p = dwell_pieces_.back();
+  add_segment(p.seg, one);
+  Eigen::Quaterniond q;
+  if (!ref_q_of(ref_q_wxyz, q)) return;
+  if (!finite(p.t0_s)) {
+    p.t0_s = one.t_first_s;
+    p.q0 = q;
+  }
+  p.t1_s = one.t_first_s;
+  p.q1 = q;
+}
+
+// The row takes the box's rate for the Earth's: the box's own mean rate over the samples it averages
+// (ref_q's turn from their first to their last, over that span) is an error it would take for the
+// sensors'. Above the row's sigma it biases the update by more than the update resolves (a steady
+// slow yaw, the end of a turn inside the dwell); below it (a shake that averaged out) it is noise.
+// The longest run of the dwell's pieces, dropping up to kDwellEdgePieces at each end, whose turn
+// is below its row's sigma: `seg` and that turn; false when there is none
+bool DriftlessFilter::unturned_dwell(const Eigen::Matrix3d& M1, const Eigen::Matrix3d& M2, StandstillSegment& seg,
+                                     double& turn_dps) const {
+  const int n_pieces = static_cast<int>(dwell_pieces_.size());
+  bool found = false;
+  for (int i = 0; i <= std::min(kDwellEdgePieces, n_pieces - 1); ++i) {
+    for (int j = n_pieces - 1; j >= std::max(i, n_pieces - 1 - kDwellEdgePieces); --j) {
+      DwellPiece c = dwell_pieces_[static_cast<std::size_t>(i)];
+      for (int k = i + 1; k <= j; ++k) c.add(dwell_pieces_[static_cast<std::size_t>(k)]);
+      if (c.seg.n < 2 || !(c.seg.span_s() > 0.0) || c.seg.span_s() < cfg_.box_dwell_min_s) continue;
+      if (found && c.seg.n <= seg.n) continue;
+      const double ref_span_s = c.t1_s - c.t0_s;
+      const double turn = ref_span_s > 0.0 ? rotation_deg(c.q0, c.q1).norm() / ref_span_s : 0.0;
+      const double var_r = 2.0 * cfg_.sample_variance_dps2(double(c.seg.n - 1) / c.seg.span_s()) / double(c.seg.n);
+      Eigen::Matrix<double, 1, kFullStateDim> h;
+      double z = 0.0, var_z = 0.0;
+      if (!rest_row(c.seg, M1, M2, var_r, h, z, var_z) || turn * turn > var_z) continue;
+      // the whole dwell: its own sums (the pieces' add up in another order)
+      seg = i == 0 && j == n_pieces - 1 ? dwell_ : c.seg;
+      turn_dps = turn;
+      found = true;
+    }
+  }
+  return found;
+}
+
+void DriftlessFilter::use_box_dwell() {
+  const Eigen::Matrix3d M1 = body_from_sensor(1, dwell_.plat1_deg);
+  const Eigen::Matrix3d M2 = body_from_sensor(2, dwell_.plat2_deg);
+  StandstillSegment seg;
+  double turn_dps = 0.0;
+  if (!unturned_dwell(M1, M2, seg, turn_dps)) {
+    ++counters_.box_dwell_turned;
+    return;
+  }
+  seg.plat1_deg = dwell_.plat1_deg;
+  seg.plat2_deg = dwell_.plat2_deg;
   const double to_g = 1.0 / (double(seg.n_accel) * kStandardGravityMps2);
   last_f_g_ = {seg.sum_accel1_mps2 * to_g, seg.sum_accel2_mps2 * to_g};
   // the box turns at the Earth rate only (0.004 deg/s): E times it stays below 1e-4 deg/s, far under
@@ -1032,19 +1117,7 @@ void DriftlessFilter::use_box_dwell(const StandstillSegment& seg) {
   Eigen::Matrix<double, 1, kFullStateDim> h;
   Eigen::Matrix<double, 1, 1> z, var_z;
   if (!rest_row(seg, M1, M2, var_r, h, z(0), var_z(0))) return;
-  // the row takes the box's rate for the Earth's: the box's own mean rate over the samples it
-  // averages (ref_q's turn from the dwell's first sample to its last, over that span) is an error
-  // the row would take for the sensors'. Above the row's sigma it biases the update by more than
-  // the update resolves (a steady slow yaw, the end of a turn inside the dwell): refused. Below it
-  // (a shake that averaged out) its square joins the row's variance
-  const double ref_span_s = dwell_ref_.t1_s - dwell_ref_.t0_s;
-  const double turn_dps = ref_span_s > 0.0 ? rotation_deg(dwell_ref_.q0, dwell_ref_.q1).norm() / ref_span_s : 0.0;
-  const double turn2_dps2 = turn_dps * turn_dps;
-  if (turn2_dps2 > var_z(0)) {
-    ++counters_.box_dwell_turned;
-    return;
-  }
-  var_z(0) += turn2_dps2;
+  var_z(0) += turn_dps * turn_dps;  // a turn below the row's sigma (unturned_dwell) is noise
   UpdateRecord rec;  // not emitted: the platform updates' record and counts stay theirs
   const bool ok = update<1>(z, h, var_z, rec, false, wander);
   ++counters_.box_dwell_updates;

@@ -312,7 +312,9 @@ class DriftlessFilter {
   bool box_quiet(const Sample& s) const;
   void track_box_dwell(const Sample& s);
   void close_box_dwell(double temp1_c, double temp2_c);
-  void use_box_dwell(const StandstillSegment& seg);
+  void add_dwell_piece(const StandstillSegment& one, const Eigen::Vector4d& ref_q_wxyz);
+  void use_box_dwell();
+  bool unturned_dwell(const Eigen::Matrix3d& M1, const Eigen::Matrix3d& M2, StandstillSegment& seg, double& turn_dps) const;
   // flip updates (cfg_.flip_updates, docs/estimator.md section 1f)
   SensorErrors errors_of(int sensor) const;
   void use_flip();
@@ -363,13 +365,17 @@ class DriftlessFilter {
   StandstillSegment dwell_;
   DwellTrend dwell_trend_;
   std::deque<DwellSample> dwell_recent_;
-  // ref_q at the dwell's first and last samples that have it (t0_s NaN: none yet): the turn between
-  // them over their span is the box's mean rate over the dwell (docs/estimator.md section 1d)
-  struct DwellRefTurn {
+  // the dwell in pieces of kDwellPieceS (filter.cpp), each with ref_q at its first and last sample
+  // that has it (t0_s NaN: none): the turn between two pieces' ref_q over that span is the box's mean
+  // rate there (docs/estimator.md section 1d). The first and last kDwellEdgePieces stay apart (the
+  // end or start of a move ref_q sees there is dropped), the ones between are merged into one
+  struct DwellPiece {
+    StandstillSegment seg;
     double t0_s = kNaN, t1_s = kNaN;
     Eigen::Quaterniond q0 = Eigen::Quaterniond::Identity(), q1 = Eigen::Quaterniond::Identity();
+    void add(const DwellPiece& later);
   };
-  DwellRefTurn dwell_ref_;
+  std::vector<DwellPiece> dwell_pieces_;
   double dwell_quiet_since_s_ = kNaN;
   bool dwell_armed_ = false;
   double gate1_ = 0.0, gate3_ = 0.0, gate4_ = 0.0, gate6_ = 0.0;
