@@ -119,10 +119,11 @@ std::string describe_flip(const est::HealthFinding& f, const est::EstimatorConfi
     case HealthCause::kFlipScale: {
       const double err = f.value - 1.0;
       const double wider = std::ceil(std::fabs(err) / 2.0 * 100.0) / 100.0;  // the error at 2 sigma
-      return fmt::format("platform {}'s gyro reads each flip as {:.1f} % of the angle change ({} of {:g} flips): a "
-                         "scale error of {:+.1f} % along its hinge, {:.1f}x scale_misalign_sigma_frac {:g}{}; set "
-                         "scale_misalign_sigma_frac: {:g} (--config) or {}",
-                         platform(f), 100.0 * f.value, f.count, f.suggested, 100.0 * err,
+      const std::string pm = std::isfinite(f.sigma) ? fmt::format(" +- {:.2f}", 100.0 * f.sigma) : std::string();
+      return fmt::format("platform {}'s gyro reads each flip as {:.2f}{} % of the angle change ({} of {:g} flips, "
+                         "the bias from the rest before each): a scale error of {:+.1f} % along its hinge, {:.1f}x "
+                         "scale_misalign_sigma_frac {:g}{}; set scale_misalign_sigma_frac: {:g} (--config) or {}",
+                         platform(f), 100.0 * f.value, pm, f.count, f.suggested, 100.0 * err,
                          std::fabs(err) / cfg.scale_misalign_sigma_frac, cfg.scale_misalign_sigma_frac,
                          cfg.self_calibration ? ": the self-calibration's flip gate rejects flips that far off and leaves "
                                                 "the scale near its prior"

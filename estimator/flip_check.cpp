@@ -17,6 +17,16 @@ double median(std::vector<double> v) {
   return 0.5 * (hi + *std::max_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(h)));
 }
 
+// the standard error of the median from the spread: 1.4826 MAD is sigma for a normal spread, and
+// the median's error is sqrt(pi/2) = 1.2533 times the mean's; NaN for fewer than 3 values
+double median_sigma(const std::vector<double>& v) {
+  if (v.size() < 3) return kNaN;
+  const double m = median(v);
+  std::vector<double> dev(v.size());
+  for (std::size_t i = 0; i < v.size(); ++i) dev[i] = std::fabs(v[i] - m);
+  return 1.2533 * 1.4826 * median(std::move(dev)) / std::sqrt(double(v.size()));
+}
+
 // a platform whose every flip turned the same way has its "−1" flips wrapped, not signed wrong
 void mark_wrapped(std::vector<FlipTurnRecord>& recs, int platform) {
   int pos = 0, neg = 0;
@@ -68,24 +78,33 @@ FlipTurn classify_flip(const Eigen::Vector3d& v, const Eigen::Vector3d& w, const
   return FlipTurn::kOther;
 }
 
-bool FlipCheck::push(double t_s, const Eigen::Vector3d& y1c_dps, const Eigen::Vector3d& y2c_dps,
-                     const Eigen::Vector3d& y1_raw_dps, const Eigen::Vector3d& y2_raw_dps, double plat1_deg,
+// the rest's mean readings: a running mean, exponential with kRestMeanS once the rest is longer
+void FlipCheck::rest_sample(const Eigen::Vector3d& y1_dps, const Eigen::Vector3d& y2_dps, double dt_s) {
+  rest_n_ += 1.0;
+  const double w = std::max(1.0 / rest_n_, std::isfinite(dt_s) ? std::min(1.0, dt_s / kRestMeanS) : 0.0);
+  rest1_ += w * (y1_dps - rest1_);
+  rest2_ += w * (y2_dps - rest2_);
+}
+
+bool FlipCheck::push(double t_s, const Eigen::Vector3d& y1_dps, const Eigen::Vector3d& y2_dps, double plat1_deg,
                      double plat2_deg, bool both_rest) {
-  const bool valid = std::isfinite(t_s) && y1c_dps.allFinite() && y2c_dps.allFinite();
+  const bool valid = std::isfinite(t_s) && y1_dps.allFinite() && y2_dps.allFinite();
   const double dt_s = valid && std::isfinite(t_last_s_) ? t_s - t_last_s_ : kNaN;
   t_last_s_ = valid ? t_s : kNaN;
-  if (!valid) {  // a flip with a hole in it is not measured
+  if (!valid) {  // a flip with a hole in it is not measured, nor is a rest with one its bias
     open_ = was_rest_ = false;
     t_back_s_ = kNaN;
+    rest_n_ = 0.0;
     return false;
   }
   if (open_) {
     if (!std::isfinite(dt_s)) {
       open_ = false;
     } else {
-      s1_ += y1c_dps * dt_s;
-      s2_ += y2c_dps * dt_s;
-      push_clip(clip_, y1_raw_dps, y2_raw_dps);
+      s1_ += y1_dps * dt_s;
+      s2_ += y2_dps * dt_s;
+      window_s_ += dt_s;
+      push_clip(clip_, y1_dps, y2_dps);
     }
   }
   if (both_rest && open_) {
@@ -105,7 +124,9 @@ bool FlipCheck::push(double t_s, const Eigen::Vector3d& y1c_dps, const Eigen::Ve
     if (closing) {
       t_end_s_ = t_back_s_;  // the flip's length leaves the settle time out
       t_back_s_ = kNaN;
+      rest_n_ = 0.0;  // the next flip's bias comes from the rest after this one's settle time
     }
+    if (was_rest_) rest_sample(y1_dps, y2_dps, dt_s);
     p1_rest_ = plat1_deg;
     p2_rest_ = plat2_deg;
     if (!closing || !was_rest_) return false;
@@ -117,16 +138,20 @@ bool FlipCheck::push(double t_s, const Eigen::Vector3d& y1c_dps, const Eigen::Ve
     const double d1 = std::fabs(p1_end_ - p1_start_), d2 = std::fabs(p2_end_ - p2_start_);
     return std::isfinite(d1 + d2) && std::max(d1, d2) > 0.0 && std::min(d1, d2) < 0.05 * std::max(d1, d2);
   }
-  if (!open_ && was_rest_ && std::isfinite(dt_s)) {
+  if (!open_ && was_rest_ && rest_n_ > 0.0 && std::isfinite(dt_s)) {
     open_ = true;
     p1_start_ = p1_rest_;
     p2_start_ = p2_rest_;
     t_start_s_ = t_rest_s_;
-    s1_ = y1c_dps * dt_s;
-    s2_ = y2c_dps * dt_s;
+    s1_ = y1_dps * dt_s;
+    s2_ = y2_dps * dt_s;
+    window_s_ = dt_s;
+    start_rest1_ = rest1_;
+    start_rest2_ = rest2_;
     clip_ = ClipDetector{};
-    push_clip(clip_, y1_raw_dps, y2_raw_dps);
+    push_clip(clip_, y1_dps, y2_dps);
   }
+  rest_n_ = 0.0;
   was_rest_ = false;
   return false;
 }
@@ -138,12 +163,14 @@ void FlipCheck::close(const Frames& f) {
   const Eigen::Matrix3d& Mm = m1 ? f.M1_start : f.M2_start;
   const Eigen::Matrix3d& Ms = m1 ? f.M2_start : f.M1_start;
   const Eigen::Matrix3d C0 = Mm.transpose() * Ms;  // resting sensor -> moving sensor at its start
-  const Eigen::Vector3d& Sm = m1 ? s1_ : s2_;
-  const Eigen::Vector3d& Ss = m1 ? s2_ : s1_;
+  // each sensor's turn over the window, its bias (and Earth rate) from the rest before taken out
+  const Eigen::Vector3d Sm = (m1 ? s1_ : s2_) - window_s_ * (m1 ? start_rest1_ : start_rest2_);
+  const Eigen::Vector3d Ss = (m1 ? s2_ : s1_) - window_s_ * (m1 ? start_rest2_ : start_rest1_);
   const Eigen::Vector3d a = (Mm.transpose() * (m1 ? f.hinge1_box : f.hinge2_box)).normalized();
   const Eigen::Vector3d v = Sm - C0 * Ss, w = Ss - C0.transpose() * Sm;
   r.t_start_s = t_start_s_;
   r.duration_s = t_end_s_ - t_start_s_;
+  r.window_s = window_s_;
   r.dtheta_deg = m1 ? p1_end_ - p1_start_ : p2_end_ - p2_start_;
   r.turn_deg = a.dot(v);
   r.ratio = r.turn_deg / r.dtheta_deg;
@@ -165,6 +192,7 @@ FlipCheckResult FlipCheck::finish() const {
     PlatformFlipSummary& s = out.platform[static_cast<std::size_t>(p - 1)];
     s.first_t_s.fill(kNaN);
     s.median_ratio.fill(kNaN);
+    s.median_ratio_sigma.fill(kNaN);
     std::array<std::vector<double>, kFlipTurnKinds> ratios;
     for (const FlipTurnRecord& r : recs) {
       if (r.platform != p) continue;
@@ -177,9 +205,15 @@ FlipCheckResult FlipCheck::finish() const {
       s.hinge_sensor = r.hinge_sensor;
       if (r.duration_s > flip_max_s_) ++s.slower_than_max;
       s.longest_s = std::max(s.longest_s, r.duration_s);
+      if (std::fabs(r.dtheta_deg) > 0.0) {
+        s.rate_to_ratio_s_per_deg = std::max(s.rate_to_ratio_s_per_deg, r.window_s / std::fabs(r.dtheta_deg));
+      }
       if (r.kind != FlipTurn::kAgrees && r.kind != FlipTurn::kWrapped) ++out.disagree;
     }
-    for (int k = 0; k < kFlipTurnKinds; ++k) s.median_ratio[k] = median(ratios[k]);
+    for (int k = 0; k < kFlipTurnKinds; ++k) {
+      s.median_ratio[k] = median(ratios[k]);
+      s.median_ratio_sigma[k] = median_sigma(ratios[k]);
+    }
     if (s.axis_sensor.norm() > 0.0) s.axis_sensor.normalize();
     out.flips += s.flips;
   }

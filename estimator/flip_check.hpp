@@ -13,6 +13,13 @@
 // The sums are linear in the readings: with C0 = M_m0^T M_s (resting sensor to moving sensor at
 // its start angle, constant over the flip), sum (y_m - C0 y_s) dt = S_m - C0 S_s, so the check
 // keeps S_1 and S_2 and decides which platform moved when the flip ends.
+//
+// The biases are taken from the rest just before the flip, not from the filter: there the same
+// difference reads ȳ_m - C0 ȳ_s = b_m - C0 b_s (the box's rate cancels exactly, as in the flip), so
+// v = (S_m - T ȳ_m) - C0 (S_s - T ȳ_s) over the window's T. The filter's estimate can be far off in
+// a direction its updates do not observe (uncalibrated MPU6050 on paper_fig4: b1_z + b2_y kept its
+// 14 deg/s prior when the g-sensitivity's rejections left two position pairs out), and that error
+// times the flip's ~2 s read as a "scale error" of +17.5 % along hinge 1 whose truth is +0.5 %.
 #pragma once
 
 #include <array>
@@ -52,6 +59,7 @@ struct FlipTurnRecord {
   int platform = 0;            // 1 or 2
   double t_start_s = kNaN;     // s, the last sample at rest before the flip
   double duration_s = kNaN;    // s, from there to the first sample at rest after it
+  double window_s = kNaN;      // s, the integrated window (duration and the settle time)
   double dtheta_deg = kNaN;    // the angle column's change (as read)
   double turn_deg = kNaN;      // the gyro turn about the hinge (a_m . v)
   double ratio = kNaN;         // turn_deg / dtheta_deg
@@ -66,9 +74,14 @@ struct PlatformFlipSummary {
   std::array<std::uint64_t, kFlipTurnKinds> count{};        // by FlipTurn
   std::array<double, kFlipTurnKinds> first_t_s{};           // s, the first of each kind (NaN: none)
   std::array<double, kFlipTurnKinds> median_ratio{};        // turn/Δθ, median over each kind
+  // the median's standard error from the ratios' spread (1.2533 x 1.4826 MAD / sqrt(n); NaN below 3)
+  std::array<double, kFlipTurnKinds> median_ratio_sigma{};
   Eigen::Vector3d axis_sensor = Eigen::Vector3d::Zero();    // kAxis: mean measured axis (unit)
   Eigen::Vector3d hinge_sensor = Eigen::Vector3d::Zero();   // the header's hinge, sensor axes
   std::uint64_t slower_than_max = 0;                        // flips longer than flip_max_s
+  // s/deg, the largest window / |Δθ|: a rate error of x deg/s that the rest before a flip does not
+  // give (a g-sensitivity term changing as the platform turns) moves its ratio by up to x times this
+  double rate_to_ratio_s_per_deg = 0.0;
   double longest_s = 0.0;                                   // s, the longest flip
   std::uint64_t of(FlipTurn k) const { return count[static_cast<int>(k)]; }
 };
@@ -83,6 +96,10 @@ struct FlipCheckResult {
 };
 
 /// Fed each sample of the estimate pass; finish() sums the flips up.
+/// s: the rest mean before a flip weighs the last this many seconds (a bias's slow drift over a long
+/// rest stays out; the white noise it averages is below 0.01 deg/s on an MPU6050 at 100 Hz)
+inline constexpr double kRestMeanS = 10.0;
+
 class FlipCheck {
  public:
   /// `settle_s`: integrate on this long after both rest again (a sensor's low-pass filter still
@@ -93,18 +110,12 @@ class FlipCheck {
     Eigen::Matrix3d M1_start, M2_start;   // sensor 1 / 2 at its angle before the flip
     Eigen::Vector3d hinge1_box, hinge2_box;
   };
-  /// One sample: its time, the bias-corrected readings (deg/s, sensor axes, NaN = invalid), the
-  /// platform angles in force and whether both platforms rest. Returns true when a window just
-  /// closed on a flip of exactly one platform: call close() with its frames.
-  bool push(double t_s, const Eigen::Vector3d& y1c_dps, const Eigen::Vector3d& y2c_dps, double plat1_deg,
-            double plat2_deg, bool both_rest) {
-    return push(t_s, y1c_dps, y2c_dps, y1c_dps, y2c_dps, plat1_deg, plat2_deg, both_rest);
-  }
-  /// As above, with the raw readings (deg/s) for the clip test: a correction that mixes the axes
-  /// (the scale/misalignment states) breaks a clipped channel's runs of one value.
-  bool push(double t_s, const Eigen::Vector3d& y1c_dps, const Eigen::Vector3d& y2c_dps,
-            const Eigen::Vector3d& y1_raw_dps, const Eigen::Vector3d& y2_raw_dps, double plat1_deg, double plat2_deg,
-            bool both_rest);
+  /// One sample: its time, the readings as logged (deg/s, sensor axes, NaN = invalid: no bias
+  /// correction is needed, the rest before each flip gives it), the platform angles in force and
+  /// whether both platforms rest. Returns true when a window just closed on a flip of exactly one
+  /// platform: call close() with its frames.
+  bool push(double t_s, const Eigen::Vector3d& y1_dps, const Eigen::Vector3d& y2_dps, double plat1_deg,
+            double plat2_deg, bool both_rest);
   /// The platform angles at the start of the flip that push() just closed.
   double start_deg(int platform) const { return platform == 1 ? p1_start_ : p2_start_; }
   /// Measures the flip push() just closed (frames at its start angles).
@@ -119,6 +130,13 @@ class FlipCheck {
   double t_last_s_ = kNaN, t_rest_s_ = kNaN, p1_rest_ = kNaN, p2_rest_ = kNaN;
   double p1_start_ = kNaN, p2_start_ = kNaN, p1_end_ = kNaN, p2_end_ = kNaN, t_start_s_ = kNaN, t_end_s_ = kNaN;
   Eigen::Vector3d s1_ = Eigen::Vector3d::Zero(), s2_ = Eigen::Vector3d::Zero();  // deg, integrated readings
+  double window_s_ = 0.0;  // s, the window's length (the sum of its steps)
+  // deg/s, the readings' mean over the current rest (a running mean, exponential after kRestMeanS)
+  // and frozen at the flip's start; rest_n_: the rest's samples so far
+  Eigen::Vector3d rest1_ = Eigen::Vector3d::Zero(), rest2_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d start_rest1_ = Eigen::Vector3d::Zero(), start_rest2_ = Eigen::Vector3d::Zero();
+  double rest_n_ = 0.0;
+  void rest_sample(const Eigen::Vector3d& y1_dps, const Eigen::Vector3d& y2_dps, double dt_s);
   std::vector<FlipTurnRecord> records_;
   ClipDetector clip_;             // the window's readings (a clipped flip reads short: left out)
   std::uint64_t clipped_ = 0;

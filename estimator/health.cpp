@@ -152,6 +152,10 @@ void add_flip_check_findings(HealthReport& h, const FlipCheckResult& r, const Es
       f.cause = HealthCause::kFlipScale;
       f.severity = selfcal;
       f.value = ratio;
+      // the spread's standard error and what the rest before each flip cannot take out: the
+      // g-sensitivity's change as the platform turns (its prior x 1 g over the window), in quadrature
+      f.sigma = std::hypot(s.median_ratio_sigma[static_cast<int>(FlipTurn::kAgrees)],
+                           cfg.gsens_sigma_dps_per_g * s.rate_to_ratio_s_per_deg);
       f.components = {p};
       f.count = s.of(FlipTurn::kAgrees);
       f.suggested = double(s.flips);

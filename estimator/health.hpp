@@ -99,7 +99,9 @@ enum class HealthCause {
   kFlipSensorsSwapped,   // the resting sensor's column turned about the moving hinge
   kFlipAxis,             // the turn is about another axis than the header's hinge (measured_axis)
   kFlipTurnRatio,        // about the hinge by a ratio none of the above
-  kFlipScale,            // 1 ± a few % beyond 3 sigma of the scale prior (value: the median ratio)
+  kFlipScale,            // 1 ± a few % beyond 3 sigma of the scale prior (value: the median ratio;
+                         // sigma: its standard error from the flips' spread, NaN below 3 flips,
+                         // and the g-sensitivity prior's change over a flip, in quadrature)
   kFlipsTooSlow,         // flips longer than flip_max_s (value: the longest, s): no flip update
   kBoxNotAtRest,         // --box-at-rest, yet the box turned while both platforms rested
                          // (box_motion_check.hpp): value = ref_q's largest turn rate over a

@@ -279,11 +279,11 @@ void withhold_attitude_reference(EstimateSummary& sum) {
   sum.final_corrected = sum.final_raw = sum.final_fixed = none;
 }
 
-// the flip-turn check (flip_check.hpp): one sample of the filter's output; a flip that ended is
-// measured in the frames of its start angles
+// the flip-turn check (flip_check.hpp): one sample, the readings as logged (the check takes the
+// biases from the rest before each flip); a flip that ended is measured in the frames of its start angles
 void check_flip(FlipCheck& check, const DriftlessFilter& filter, const Sample& s) {
   const SampleOutput& o = filter.output();
-  if (!check.push(o.t_s, o.y1c_dps, o.y2c_dps, s.gyro1_dps, s.gyro2_dps, o.plat1_deg, o.plat2_deg, o.at_rest)) return;
+  if (!check.push(o.t_s, s.gyro1_dps, s.gyro2_dps, o.plat1_deg, o.plat2_deg, o.at_rest)) return;
   const BoxGeometry& box = filter.geometry();
   check.close({filter.body_from_sensor(1, check.start_deg(1)), filter.body_from_sensor(2, check.start_deg(2)),
                box.hinge1_axis.normalized(), box.hinge2_axis.normalized()});
