@@ -23,8 +23,16 @@ struct RunUsed {
   bool calib = false;        // --calib (a calibration is in the configuration)
   bool box_at_rest = false;  // --box-at-rest
   est::GravitySource gravity = est::GravitySource::kNone;  // what drove G (self-calibration)
+  // what the run saw (HealthReport; unknown: as a box that may stand still, no columns)
+  bool box_turned = false;             // ref_q or the fused rate showed the box turning at a rest
+  std::uint64_t box_still = 0;         // standstills in which ref_q saw it still (pauses)
+  double box_ref_rate_dps = kNaN;      // ref_q's largest turn rate over a standstill, deg/s
+  double box_gyro_change_dps = kNaN;   // the fused rate's largest change within one, deg/s
+  bool ref_q = false, accel = false;   // the log has ref_q / accel columns
 };
 RunUsed run_used(const est::EstimatorConfig& cfg, est::GravitySource gravity);
+/// The same with what the run saw: the box's motion at the rests and the log's columns.
+RunUsed run_used(const est::EstimatorConfig& cfg, const est::HealthReport& h);
 /// For an error a constant bias cannot absorb (g-sensitivity, scale, misalignment): what to try.
 std::string model_error_fix(const RunUsed& u);
 /// For noise or wander larger than configured: what to try.
@@ -36,6 +44,8 @@ std::string calibrate_fix(const RunUsed& u);
 /// the g-sensitivity states, HealthReport::gravity_source).
 std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cfg,
                      est::GravitySource gravity = est::GravitySource::kNone);
+/// The same, the fixes picked by what the run saw (h: its gravity source, box motion and columns).
+std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cfg, const est::HealthReport& h);
 /// The `"health": {...}` member of summary.json (no trailing comma), indented by two spaces.
 std::string health_json(const est::HealthReport& h, const est::EstimatorConfig& cfg);
 /// The `tune` value of summary.json: what --tune auto measured, or null.

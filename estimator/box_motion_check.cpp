@@ -71,6 +71,7 @@ void BoxMotionCheck::close() {
   const double rate_dps = geo::rotvec_rad(q0.conjugate() * q1).norm() * kDegPerRad / span_s;
   if (larger(m_.ref_rate_dps, rate_dps) != m_.ref_rate_dps) m_.ref_rate_t_s = ref_last_t_s_;
   m_.ref_rate_dps = larger(m_.ref_rate_dps, rate_dps);
+  if (rate_dps <= lim_.ref_rate_dps && change_dps_ < lim_.gyro_change_dps) ++m_.still_standstills;
   if (change_dps_ < lim_.gyro_change_dps && rate_dps < lim_.dwell_rate_dps) {
     if (larger(m_.quiet_ref_rate_dps, rate_dps) != m_.quiet_ref_rate_dps) m_.quiet_ref_rate_t_s = ref_last_t_s_;
     m_.quiet_ref_rate_dps = larger(m_.quiet_ref_rate_dps, rate_dps);

@@ -29,6 +29,9 @@ struct BoxMotion {
   double gyro_change_dps = kNaN;
   double gyro_change_t_s = kNaN;
   std::uint64_t standstills = 0;  // standstills of both platforms checked
+  // standstills in which ref_q (over at least min_span_s) turned slower than ref_rate_dps and the
+  // fused rate changed less than gyro_change_dps: pauses, in which a box dwell observes the vertical
+  std::uint64_t still_standstills = 0;
 };
 
 struct BoxMotionLimits {

@@ -323,7 +323,34 @@ void add_box_motion_finding(HealthReport& h, const BoxMotion& m, bool box_at_res
   put_first(h, std::move(first));
 }
 
+namespace {
+
+// without --selfcal: G is not modelled; when the updates show an error a bias does not explain and
+// the box never paused, its part both sensors share about the vertical is in neither the estimate
+// nor its sigma, and nothing in the log observes it
+void add_vertical_unmodelled_finding(HealthReport& h, const EstimatorConfig& cfg, const BoxMotion& m) {
+  if (cfg.box_at_rest || cfg.calibration.has_g_sensitivity() || !box_turned(m) || m.still_standstills > 0) return;
+  const bool misfit = std::any_of(h.findings.begin(), h.findings.end(), [](const HealthFinding& f) {
+    return f.severity != HealthVerdict::kOk &&
+           (f.cause == HealthCause::kRejections || f.cause == HealthCause::kRejectionsAtPosition ||
+            f.cause == HealthCause::kNoiseUnderstated || f.cause == HealthCause::kAllRejected);
+  });
+  if (!misfit) return;
+  HealthFinding f;
+  f.cause = HealthCause::kVerticalUnobserved;
+  f.value = kNaN;  // not modelled: no sigma
+  f.sigma = cfg.gsens_sigma_dps_per_g;
+  f.suggested = m.quiet_ref_rate_dps;
+  add(h, std::move(f));
+}
+
+}  // namespace
+
 void add_vertical_finding(HealthReport& h, const DriftlessFilter& filter, const BoxMotion& m) {
+  if (!filter.config().self_calibration) {
+    add_vertical_unmodelled_finding(h, filter.config(), m);
+    return;
+  }
   if (!filter.uses_box_dwells() || !filter.has_gsens_states() || filter.counters().box_dwell_updates > 0) return;
   // a g-sensitivity element times the 1 g along the box vertical: the shared bias's prior
   const double prior_dps = filter.config().gsens_sigma_dps_per_g;

@@ -126,7 +126,10 @@ enum class HealthCause {
                          // sigma still above half the g-sensitivity prior's (1 g along the vertical):
                          // the bias both sensors share about the vertical is not observed. value =
                          // the largest correction sigma (deg/s), sigma = its prior (deg/s), suggested
-                         // = ref_q's slowest turn over the quiet standstills (deg/s; NaN: no ref_q)
+                         // = ref_q's slowest turn over the quiet standstills (deg/s; NaN: no ref_q).
+                         // Without --selfcal (stop 30; value NaN: not modelled): no G from --calib,
+                         // no --box-at-rest, the box turned in every standstill, and a degraded
+                         // gate or NIS finding shows an error a bias does not explain
   kClippedFlipsScale,    // --selfcal with flip updates: most flips skipped because a gyro clipped in
                          // them, and the box turned while the platforms rested: the scale along the
                          // hinges is not observed and enters every turn of the box about them.
@@ -213,6 +216,10 @@ struct HealthReport {
   // what drove the g-sensitivity states (self-calibration; kNone without it): the fix texts pick
   // their advice by it (cli/estimate_health.cpp)
   GravitySource gravity_source = GravitySource::kNone;
+  // what the box did while both platforms rested (box_motion_check.hpp) and whether the log has
+  // ref_q and accel columns: the fix texts pick their advice by them (cli/estimate_health.cpp)
+  BoxMotion box_motion;
+  bool ref_q_logged = false, accel_logged = false;
 };
 
 /// Limits of the saturation finding: clipped while both platforms rest in at least this fraction
@@ -275,7 +282,9 @@ void add_box_motion_finding(HealthReport& h, const BoxMotion& m, bool box_at_res
 
 /// Self-calibrating mode with box dwells, none used (the box never paused: ref_q turned, or |f|
 /// was never 1 g), and the correction still near the g-sensitivity prior: `vertical_unobserved`
-/// (degraded). `m`: ref_q's turn over the quiet standstills, the evidence where logged.
+/// (degraded). `m`: ref_q's turn over the quiet standstills, the evidence where logged. Without
+/// the self-calibration (G not modelled, none from --calib, no --box-at-rest): the same finding
+/// when the box turned in every standstill and h already has a degraded rejections or NIS finding.
 void add_vertical_finding(HealthReport& h, const DriftlessFilter& filter, const BoxMotion& m);
 
 /// Flip updates on, most flips skipped for a clipping gyro (FilterCounters::flip_clipped), on a

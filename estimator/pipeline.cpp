@@ -477,6 +477,9 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
   add_input_findings(meta, reader, cfg, filter, positions, sum);
   add_reference_finding(sum.health, sum.reference);
   sum.box_motion = box_motion.finish();
+  sum.health.box_motion = sum.box_motion;
+  sum.health.ref_q_logged = (fields & kFieldRefQ) != 0;
+  sum.health.accel_logged = (fields & kFieldAccel) != 0;
   add_box_motion_finding(sum.health, sum.box_motion, cfg.box_at_rest);
   add_vertical_finding(sum.health, filter, sum.box_motion);
   add_clipped_flips_finding(sum.health, filter, sum.box_motion);

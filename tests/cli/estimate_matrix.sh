@@ -38,6 +38,20 @@ uncal=(--sensor mpu6050 --bias 2 --scale 0.01 --misalign 0.3 --gsens 0.05)
 # AND the shared vertical bias is named as unobserved, with the pause as the fix
 [ "$(json "$t/r/summary.json" "'vertical_unobserved' in $causes")" = True ] || fail "rock: vertical not named: $(cat "$t/r.out")"
 grep -q "not observed: no box dwell was used.*Let the box pause" "$t/r.out" || fail "rock: no cause or fix: $(cat "$t/r.out")"
+# AND (stop 30) no fix assumes the box at rest: never_locked and vertical_unobserved say the box
+# turned at the rests (ref_q), where main advised "if the box stands still, add --box-at-rest"
+if grep -q "add --box-at-rest" "$t/r.out"; then fail "rock: --box-at-rest advised on a rocking box: $(cat "$t/r.out")"; fi
+[ "$(grep -c "ref_q turned at up to [0-9.]* deg/s over a standstill and was still in none), so assuming it at rest is no fix" "$t/r.out")" = 2 ] ||
+  fail "rock: never_locked and vertical_unobserved do not both name the turning box: $(cat "$t/r.out")"
+# GIVEN the same rock WHEN estimate --tune auto runs without --selfcal THEN (stop 30) the unmodelled
+# g-sensitivity's shared vertical part is named (main: degraded by the position rejections only, the
+# fix "--selfcal; add --box-at-rest for a box standing still"; DriftLess 203 deg/h, 195 with the bias fixed)
+"$bin" estimate --log "$t/rock.csv" --out "$t/r0" --tune auto > "$t/r0.out" 2>&1
+[ "$(json "$t/r0/summary.json" "[f['severity'] for f in d['health']['findings'] if f['cause'] == 'vertical_unobserved']")" = "['degraded']" ] ||
+  fail "rock without --selfcal: no vertical_unobserved: $(cat "$t/r0.out")"
+grep -q "not modelled without --selfcal.*nothing in this log observes that.*ref_q turned at up to [0-9.]* deg/s over a standstill and was still in none" "$t/r0.out" ||
+  fail "rock without --selfcal: no cause: $(cat "$t/r0.out")"
+if grep -q "add --box-at-rest" "$t/r0.out"; then fail "rock without --selfcal: --box-at-rest advised: $(cat "$t/r0.out")"; fi
 
 # GIVEN the static box, 300 s WHEN estimate --selfcal runs THEN the clipped flips are no scale error
 "$py" "$gen" --out "$t/static.csv" "${uncal[@]}" --motion static --duration 300 > /dev/null 2>&1 || fail "generator"
@@ -66,6 +80,11 @@ grep -q "no flip measured the scale along the hinges.*Flip slower" "$t/c.out" ||
   fail "car, 2 s flips: exit $?: $(cat "$t/c2.out")"
 [ "$(json "$t/c2/summary.json" "d['box_dwells']['updates'] > 0 and abs(d['attitude_drift_deg_per_h']['with_driftless']) < 0.2 * abs(d['attitude_drift_deg_per_h']['bias_fixed_at_start'])")" = True ] ||
   fail "car, 2 s flips: dwells $(json "$t/c2/summary.json" "d['box_dwells']"), drift $(json "$t/c2/summary.json" "d['attitude_drift_deg_per_h']")"
+# AND without --selfcal the car, which pauses on its straight runs, gets no vertical_unobserved (the
+# box dwells of --selfcal observe it there: the fix is --selfcal, which the NIS finding names)
+"$bin" estimate --log "$t/car2.csv" --out "$t/c20" --tune auto > "$t/c20.out" 2>&1
+[ "$(json "$t/c20/summary.json" "'vertical_unobserved' not in $causes and d['health']['verdict'] != 'ok'")" = True ] ||
+  fail "car without --selfcal: $(cat "$t/c20.out")"
 
 # GIVEN that car without accel columns (gravity from ref_q) THEN ok, no box_not_at_rest (main: degraded by it)
 "$py" "$gen" --out "$t/carna.csv" "${uncal[@]}" --motion car --flip-s 2 --duration 600 --no-accel > /dev/null 2>&1 ||
