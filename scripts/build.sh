@@ -14,6 +14,11 @@ export CCACHE_MAXSIZE=${CCACHE_MAXSIZE:-1G}
 # the tests share a precompiled header; ccache caches the files compiled with it only when told
 # that the header's definitions and time stamps do not change the result
 export CCACHE_SLOPPINESS=${CCACHE_SLOPPINESS:-pch_defines,time_macros,include_file_mtime,include_file_ctime}
+# ccache's depend mode: on a miss it reads the compiler's own dependency file (-MD, which Ninja and
+# make ask for) instead of running the preprocessor once more before compiling: 207 preprocessor
+# runs, 16 s of CPU, in a cold Release build (2 % of it). Hits are looked up as before (direct mode),
+# so objects cached without it are still found, from any clone.
+export CCACHE_DEPEND=${CCACHE_DEPEND:-1}
 # Ninja for a new build folder (scripts/setup.sh installs ninja-build): it starts a target's objects
 # while the libraries it links are still linking, and its start-up is shorter than make's. A folder
 # already configured keeps its generator (CMake refuses to change it in place).

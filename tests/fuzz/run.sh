@@ -18,6 +18,7 @@ if [[ $step != run ]]; then
   command -v clang++ >/dev/null || { echo "fuzz: clang++ not found (scripts/setup.sh installs clang)"; exit 1; }
   export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$root} CCACHE_NOHASHDIR=${CCACHE_NOHASHDIR:-1}
   export CCACHE_MAXSIZE=${CCACHE_MAXSIZE:-1G}   # bounded, as in scripts/build.sh
+  export CCACHE_DEPEND=${CCACHE_DEPEND:-1}       # no second preprocessor run on a miss (scripts/build.sh)
   CC=clang CXX=clang++ cmake -S "$root/tests/fuzz" -B "$build" -DCMAKE_BUILD_TYPE=None >/dev/null
   cmake --build "$build" -j "$(nproc 2>/dev/null || echo 2)"
 fi
