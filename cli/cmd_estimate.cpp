@@ -21,6 +21,7 @@
 #include "cli/estimate_outputs.hpp"
 #include "estimator/calibration.hpp"
 #include "estimator/pipeline.hpp"
+#include "estimator/selfcal_choice.hpp"
 #include "estimator/smoother.hpp"
 #include "estimator/tune.hpp"
 #include "calibration/calib_file.hpp"
@@ -44,6 +45,7 @@ struct EstimateArgs {
   bool corrected = false;  // write corrected.csv (--corrected)
   bool smooth = false;     // corrected.csv from the fixed-interval smoother (--smooth)
   bool selfcal = false;   // self-calibrating mode: g-sensitivity states (docs/estimator.md section 1b)
+  bool no_selfcal = false;  // the six-state model even where it does not fit (no automatic choice, section 1i)
   bool box_at_rest = false;  // the box stands still on the Earth: the vertical Earth rate is a measurement
   bool strict = false;    // exit 1 on a degraded health verdict too (failed always exits 1)
   std::string tune;       // "auto": noise density and bias wander from the log (docs/estimator.md section 6.2)
@@ -193,7 +195,8 @@ void print_attitude_line(const est::EstimateSummary& summary) {
   }
 }
 
-int run_estimate_cmd(const EstimateArgs& a) {
+// the configuration before the log is read: --config, --mode and the flags
+est::EstimatorConfig base_config(const EstimateArgs& a) {
   est::EstimatorConfig cfg;
   if (!a.config.empty()) {
     std::ifstream in(a.config);
@@ -204,108 +207,164 @@ int run_estimate_cmd(const EstimateArgs& a) {
   }
   if (!a.mode.empty()) est::set_config_value(cfg, "mode", a.mode);
   if (a.selfcal) cfg.self_calibration = true;
+  if (a.no_selfcal) cfg.self_calibration = false;
   if (a.box_at_rest) cfg.box_at_rest = true;
   if (!a.calib_out.empty() && !cfg.self_calibration) {
     throw std::invalid_argument("--calib-out needs --selfcal (or self_calibration: true in --config): without it "
                                 "the g-sensitivity is not estimated");
   }
-  // parse the column groups the pass uses (the accelerometers only for a g-sensitivity calibration;
-  // the temperatures drive the bias temperature states)
+  return cfg;
+}
+
+// --calib: the calibrated matrices M replace R in eq. (1)-(2) (docs/calibration.md)
+void apply_calib(const EstimateArgs& a, const log::Metadata& meta, est::EstimatorConfig& cfg) {
+  const calib::CalibFile c = calib::load_calib(a.calib);
+  if ((c.hinge1_axis.normalized() - meta.hinge1_axis().normalized()).norm() > 1e-6 ||
+      (c.hinge2_axis.normalized() - meta.hinge2_axis().normalized()).norm() > 1e-6) {
+    throw std::invalid_argument(fmt::format(
+        "--calib {}: calibrated for hinge axes [{} {} {}] / [{} {} {}] but the log {} has [{} {} {}] / "
+        "[{} {} {}]: not the same box", a.calib, c.hinge1_axis.x(), c.hinge1_axis.y(), c.hinge1_axis.z(),
+        c.hinge2_axis.x(), c.hinge2_axis.y(), c.hinge2_axis.z(), a.log, meta.hinge1_axis().x(),
+        meta.hinge1_axis().y(), meta.hinge1_axis().z(), meta.hinge2_axis().x(), meta.hinge2_axis().y(),
+        meta.hinge2_axis().z()));
+  }
+  // M (unless nominal); G and E: with --selfcal the prior of their states (value and sigma),
+  // else fixed corrections (y <- y - G f / g with the log's accelerometer columns, samples
+  // without them stay as they are; M (I + E)^-1 for M); the temperature states start at the
+  // calibrated coefficients
+  cfg.calibration = c.to_filter_calibration();
+}
+
+// the column groups a pass parses: the accelerometers only for a g-sensitivity calibration or
+// the self-calibration; the temperatures drive the bias temperature states
+log::ReaderOptions reader_options(const EstimateArgs& a, const est::EstimatorConfig& cfg) {
   log::ReaderOptions read_opt;
   read_opt.fields = kFieldRefQ | kFieldTrueBias | kFieldTemp;
   if (!a.calib.empty() || cfg.self_calibration || cfg.box_at_rest) read_opt.fields |= kFieldAccel;
-  log::LogReader reader(a.log, read_opt);
-  // --calib: the calibrated matrices M replace R in eq. (1)-(2) (docs/calibration.md)
-  if (!a.calib.empty()) {
-    const calib::CalibFile c = calib::load_calib(a.calib);
-    const auto& meta = reader.metadata();
-    if ((c.hinge1_axis.normalized() - meta.hinge1_axis().normalized()).norm() > 1e-6 ||
-        (c.hinge2_axis.normalized() - meta.hinge2_axis().normalized()).norm() > 1e-6) {
-      throw std::invalid_argument(fmt::format(
-          "--calib {}: calibrated for hinge axes [{} {} {}] / [{} {} {}] but the log {} has [{} {} {}] / "
-          "[{} {} {}]: not the same box", a.calib, c.hinge1_axis.x(), c.hinge1_axis.y(), c.hinge1_axis.z(),
-          c.hinge2_axis.x(), c.hinge2_axis.y(), c.hinge2_axis.z(), a.log, meta.hinge1_axis().x(),
-          meta.hinge1_axis().y(), meta.hinge1_axis().z(), meta.hinge2_axis().x(), meta.hinge2_axis().y(),
-          meta.hinge2_axis().z()));
-    }
-    // M (unless nominal); G and E: with --selfcal the prior of their states (value and sigma),
-    // else fixed corrections (y <- y - G f / g with the log's accelerometer columns, samples
-    // without them stay as they are; M (I + E)^-1 for M); the temperature states start at the
-    // calibrated coefficients
-    cfg.calibration = c.to_filter_calibration();
-  }
-  cfg.validate();
-  est::TuneResult tune;
-  if (a.tune == "auto") tune = tune_config(a, cfg);
+  return read_opt;
+}
 
-  const bool truth = (reader.fields() & kFieldTrueBias) != 0;
-  const bool attitude = (reader.fields() & kFieldRefQ) != 0;
-  fs::create_directories(a.out);
-  const fs::path dir(a.out);
-  if (a.corrected) {
-    // corrected.csv: about 110 bytes per log row; the log's rows from its size (about 370 bytes each
-    // for a twin log, fewer for hardware logs: the estimate errs on the large side)
-    std::error_code ec;
-    const double log_bytes = static_cast<double>(fs::file_size(a.log, ec));
-    if (!ec) warn_if_disk_too_small("estimate", dir, 0.6 * log_bytes, "corrected.csv");
+// what drives the g-sensitivity states is in the log: both accel triads (by name: a pass without
+// the self-calibration does not parse them) or ref_q
+bool gravity_logged(const log::LogReader& reader) {
+  if ((reader.fields() & kFieldRefQ) != 0) return true;
+  for (const char* c : {"accel1_x", "accel1_y", "accel1_z", "accel2_x", "accel2_y", "accel2_z"}) {
+    if (reader.column_index(c) < 0) return false;
   }
-  {
-    std::ostringstream used;
-    est::write_estimator_config(used, cfg);
-    io::write_file(dir / "config_used.txt", used.str());
-  }
-  EstimateFilesOptions file_opt;
-  file_opt.truth = truth;
-  file_opt.corrected = a.corrected;
-  file_opt.smoothed = a.smooth;
-  file_opt.keep_series = a.plot;
+  return true;
+}
+
+// one pass of the filter over the log into `dir`: its files stay uncommitted (a pass that is not
+// kept leaves nothing behind)
+struct EstimatePass {
+  est::EstimatorConfig cfg;
+  log::ReaderOptions read_opt;
+  std::unique_ptr<EstimateFiles> files;
+  std::unique_ptr<est::FixedIntervalSmoother> smoother;
+  est::EstimateSummary summary;
+  fs::path dir;
+};
+
+EstimatePass run_filter_pass(const EstimateArgs& a, const est::EstimatorConfig& cfg, log::LogReader& reader,
+                             const fs::path& dir, EstimateFilesOptions file_opt) {
+  EstimatePass p;
+  p.cfg = cfg;
+  p.dir = dir;
+  p.read_opt = reader_options(a, cfg);
   file_opt.t_end_s = reader.metadata().get_number("duration_s", kNaN);
-  EstimateFiles files(dir, file_opt);
+  p.files = std::make_unique<EstimateFiles>(dir, file_opt);
   est::EstimateRunOptions run_opt;
   run_opt.attitude_start_sigma_dps = a.attitude_start_sigma_dps;
-  std::unique_ptr<est::FixedIntervalSmoother> smoother;
-  if (a.smooth) smoother = std::make_unique<est::FixedIntervalSmoother>(cfg.q_dps2_per_s());
-  run_opt.update_observer = smoother.get();
-  const auto summary = est::run_estimate(reader, cfg, &files, run_opt, &stop_polled);
-  // --smooth: corrected.csv holds the smoother's rows only when its second pass ran to the end
-  double stopped_at_t_s = summary.t_last_s;
-  bool smoothed = false;
-  if (smoother && !stop_requested().load()) {
-    stopped_at_t_s = write_smoothed(a, read_opt, cfg, *smoother, files, summary);
-    smoothed = !stop_requested().load();
-  }
-  files.commit();
-  const bool interrupted = stop_requested().load();
+  if (a.smooth) p.smoother = std::make_unique<est::FixedIntervalSmoother>(cfg.q_dps2_per_s());
+  run_opt.update_observer = p.smoother.get();
+  p.summary = est::run_estimate(reader, cfg, p.files.get(), run_opt, &stop_polled);
+  return p;
+}
 
-  auto warnings = summary.warnings;
-  std::vector<FigureOutcome> figures;
-  if (a.plot && !interrupted) {
-    double rate = reader.metadata().sample_rate_hz();
-    if (!std::isfinite(rate) && summary.rows > 1) rate = double(summary.rows - 1) / (summary.t_last_s - summary.t_first_s);
-    EstimateFigureInputs fig{&files.series(), truth, attitude, rate, summary.locked_from_t_s,
-                             a.attitude_start_sigma_dps, summary.attitude_start_s};
-    figures = write_estimate_figures(dir, fig);
-    for (const auto& f : figures) {
-      if (!f.written) warnings.push_back(fmt::format("{} not drawn: {}", f.stem, f.reason));
-    }
-  } else if (a.plot) {
-    warnings.push_back("figures not drawn: the run was interrupted");
+// the default model choice (estimator/selfcal_choice.hpp): when the six-state pass shows an error
+// the self-calibration models, the log again with it, in a folder of its own; the better pass is
+// kept. `choice` records what was done for summary.json.
+EstimatePass choose_model(const EstimateArgs& a, EstimatePass six, const EstimateFilesOptions& file_opt,
+                          bool gravity, SelfcalChoice& choice) {
+  const est::SelfcalTrigger trig = est::selfcal_trigger(six.summary.health, gravity);
+  if (choice.mode != est::SelfcalMode::kAuto || !trig.wanted || stop_requested().load()) return six;
+  if (!fs::is_regular_file(a.log)) {
+    // a stream (a FIFO) cannot be read a second time
+    fmt::print(stderr, "driftless estimate: the six-state model does not fit this log (finding {}), and the log is "
+                       "not a regular file, so it cannot be read again in the self-calibrating mode: save it and "
+                       "run with --selfcal\n", cause_key(trig.cause));
+    return six;
   }
-  auto final_summary = summary;
-  final_summary.warnings = warnings;
-  SummaryContext ctx;
-  ctx.log_path = a.log;
-  ctx.mode = cfg.mode;
-  ctx.complete = !interrupted;
-  ctx.stopped_at_t_s = stopped_at_t_s;
-  ctx.smooth_requested = a.smooth;
-  ctx.smoothed = smoothed;
-  ctx.figures = &figures;
-  ctx.config = &cfg;
-  ctx.tune = a.tune == "auto" ? &tune : nullptr;
-  write_estimate_summary(dir / "summary.json", ctx, final_summary);
+  choice.tried = true;
+  choice.cause = trig.cause;
+  choice.six_state = six.summary.health;
+  const est::HealthReport& h = six.summary.health;
+  fmt::print(stderr,
+             "driftless estimate: the six-state model does not fit this log (verdict {}, finding {}; {} of {} "
+             "updates rejected, NIS mean {:.3g}): estimating again in the self-calibrating mode (--selfcal: "
+             "g-sensitivity, scale/misalignment and end-stop states; --no-selfcal keeps the six-state model)\n",
+             est::to_string(h.verdict), cause_key(trig.cause), h.rejected, h.updates, h.nis_mean);
+  est::EstimatorConfig cfg = six.cfg;
+  cfg.self_calibration = true;
+  cfg.validate();
+  const fs::path staging = six.dir / ".selfcal-pass";
+  fs::create_directories(staging);
+  log::LogReader again(a.log, reader_options(a, cfg));
+  EstimatePass sc = run_filter_pass(a, cfg, again, staging, file_opt);
+  choice.selfcal = sc.summary.health;
+  choice.interrupted = stop_requested().load();
+  choice.used = !choice.interrupted && est::selfcal_pass_better(sc.summary.health, six.summary.health);
+  if (!choice.used) {
+    sc.files.reset();  // discards its files
+    fs::remove_all(staging);
+    return six;
+  }
+  six.files.reset();
+  return sc;
+}
 
-  for (const auto& w : warnings) fmt::print(stderr, "driftless estimate: warning: {}\n", w);
+// config_used.txt: the configuration of the pass whose results the outputs hold
+void write_config_used(const fs::path& dir, const est::EstimatorConfig& cfg) {
+  std::ostringstream used;
+  est::write_estimator_config(used, cfg);
+  io::write_file(dir / "config_used.txt", used.str());
+}
+
+// the kept pass's files into place: a self-calibrating pass wrote into its own folder
+void commit_pass(EstimatePass& p, const fs::path& dir) {
+  p.files->commit();
+  if (p.dir == dir) return;
+  for (const char* name : {"estimate.csv", "attitude.csv", "corrected.csv"}) {
+    if (fs::exists(p.dir / name)) fs::rename(p.dir / name, dir / name);
+  }
+  fs::remove_all(p.dir);
+}
+
+// the console line after a self-calibrating pass that was tried
+void print_choice(const SelfcalChoice& c) {
+  if (!c.tried) return;
+  const auto rej = [](const est::HealthReport& h) { return 100.0 * h.rejected_fraction; };
+  if (c.interrupted) {
+    fmt::print(stderr, "driftless estimate: the self-calibrating pass was interrupted: the outputs are the "
+                       "six-state pass's\n");
+  } else if (c.used) {
+    fmt::print("  self-calibration (auto): used; its verdict {} ({:.1f} % rejected) against the six-state "
+               "model's {} ({:.1f} % rejected)\n",
+               est::to_string(c.selfcal.verdict), rej(c.selfcal), est::to_string(c.six_state.verdict),
+               rej(c.six_state));
+  } else {
+    fmt::print(stderr,
+               "driftless estimate: self-calibration (auto) tried and not used: it fits no better (verdict {}, "
+               "{:.1f} % rejected, NIS mean {:.3g} against the top of its band {:.3g}; the six-state model: {}, "
+               "{:.1f} % rejected), so these are the six-state results; an excess both models leave is noise or "
+               "wander larger than configured, or an error neither models (see the findings)\n",
+               est::to_string(c.selfcal.verdict), rej(c.selfcal), c.selfcal.nis_mean, c.selfcal.nis_mean_band_hi,
+               est::to_string(c.six_state.verdict), rej(c.six_state));
+  }
+}
+
+// the console summary of the kept pass
+void print_results(const EstimateArgs& a, const est::EstimateSummary& summary, bool truth, bool interrupted) {
   const auto& b = summary.bias_dps;
   const auto& sg = summary.sigma_dps;
   fmt::print("{}: {} rows, {} updates ({} rejected)\n", a.log, summary.rows, summary.counters.updates,
@@ -325,10 +384,100 @@ int run_estimate_cmd(const EstimateArgs& a) {
              interrupted ? fmt::format(" (interrupted at t = {:.3f} s: summary.json says complete: false)",
                                        summary.t_last_s)
                          : "");
+}
+
+// --plot: the figures of the kept pass, each drawn or the reason it was not (as a warning)
+std::vector<FigureOutcome> draw_figures(const EstimateArgs& a, const log::Metadata& meta, const EstimatePass& p,
+                                        bool truth, bool attitude, bool interrupted,
+                                        std::vector<std::string>& warnings) {
+  std::vector<FigureOutcome> figures;
+  if (!a.plot) return figures;
+  if (interrupted) {
+    warnings.push_back("figures not drawn: the run was interrupted");
+    return figures;
+  }
+  const auto& summary = p.summary;
+  double rate = meta.sample_rate_hz();
+  if (!std::isfinite(rate) && summary.rows > 1) rate = double(summary.rows - 1) / (summary.t_last_s - summary.t_first_s);
+  EstimateFigureInputs fig{&p.files->series(), truth, attitude, rate, summary.locked_from_t_s,
+                           a.attitude_start_sigma_dps, summary.attitude_start_s};
+  figures = write_estimate_figures(p.dir, fig);
+  for (const auto& f : figures) {
+    if (!f.written) warnings.push_back(fmt::format("{} not drawn: {}", f.stem, f.reason));
+  }
+  return figures;
+}
+
+int run_estimate_cmd(const EstimateArgs& a) {
+  est::EstimatorConfig cfg = base_config(a);
+  SelfcalChoice choice;
+  choice.mode = a.no_selfcal ? est::SelfcalMode::kOff : cfg.self_calibration ? est::SelfcalMode::kOn
+                                                                             : est::SelfcalMode::kAuto;
+  // the first pass's reader: its header and columns decide the outputs
+  log::LogReader reader(a.log, reader_options(a, cfg));
+  if (!a.calib.empty()) apply_calib(a, reader.metadata(), cfg);
+  cfg.validate();
+  est::TuneResult tune;
+  if (a.tune == "auto") tune = tune_config(a, cfg);
+
+  const bool truth = (reader.fields() & kFieldTrueBias) != 0;
+  const bool attitude = (reader.fields() & kFieldRefQ) != 0;
+  fs::create_directories(a.out);
+  const fs::path dir(a.out);
+  if (a.corrected) {
+    // corrected.csv: about 110 bytes per log row; the log's rows from its size (about 370 bytes each
+    // for a twin log, fewer for hardware logs: the estimate errs on the large side)
+    std::error_code ec;
+    const double log_bytes = static_cast<double>(fs::file_size(a.log, ec));
+    if (!ec) warn_if_disk_too_small("estimate", dir, 0.6 * log_bytes, "corrected.csv");
+  }
+  EstimateFilesOptions file_opt;
+  file_opt.truth = truth;
+  file_opt.corrected = a.corrected;
+  file_opt.smoothed = a.smooth;
+  file_opt.keep_series = a.plot;
+  write_config_used(dir, cfg);
+  const bool gravity = gravity_logged(reader);
+  EstimatePass pass = choose_model(a, run_filter_pass(a, cfg, reader, dir, file_opt), file_opt, gravity, choice);
+  if (choice.used) write_config_used(dir, pass.cfg);
+  const auto& summary = pass.summary;
+  // --smooth: corrected.csv holds the smoother's rows only when its second pass ran to the end
+  double stopped_at_t_s = summary.t_last_s;
+  bool smoothed = false;
+  if (pass.smoother && !stop_requested().load()) {
+    stopped_at_t_s = write_smoothed(a, pass.read_opt, pass.cfg, *pass.smoother, *pass.files, summary);
+    smoothed = !stop_requested().load();
+  }
+  commit_pass(pass, dir);
+  pass.dir = dir;
+  const bool interrupted = stop_requested().load();
+
+  auto warnings = summary.warnings;
+  const std::vector<FigureOutcome> figures =
+      draw_figures(a, reader.metadata(), pass, truth, attitude, interrupted, warnings);
+  auto final_summary = summary;
+  final_summary.warnings = warnings;
+  SummaryContext ctx;
+  ctx.log_path = a.log;
+  ctx.mode = pass.cfg.mode;
+  // a self-calibrating pass interrupted leaves the six-state pass's outputs, which are whole
+  ctx.complete = !interrupted || (choice.interrupted && !a.smooth);
+  ctx.stopped_at_t_s = stopped_at_t_s;
+  ctx.smooth_requested = a.smooth;
+  ctx.smoothed = smoothed;
+  ctx.figures = &figures;
+  ctx.config = &pass.cfg;
+  ctx.tune = a.tune == "auto" ? &tune : nullptr;
+  ctx.selfcal_choice = &choice;
+  write_estimate_summary(dir / "summary.json", ctx, final_summary);
+
+  for (const auto& w : warnings) fmt::print(stderr, "driftless estimate: warning: {}\n", w);
+  print_results(a, summary, truth, interrupted && !choice.interrupted);
+  print_choice(choice);
   if (interrupted) return interrupted_exit_code();
   write_selfcal_files(a, reader.metadata(), summary);
   std::fflush(stdout);
-  return report_health(a, cfg, summary.health);
+  return report_health(a, pass.cfg, summary.health);
 }
 
 const bool registered = register_command(30, [](CLI::App& app) {
@@ -379,10 +528,17 @@ const bool registered = register_command(30, [](CLI::App& app) {
   cmd->add_flag("--plot", a->plot,
                 "Also write Fig. 4 (bias vs truth, deg/s), Fig. 5 (Allan deviation, deg/s vs s) and "
                 "Fig. 9 (attitude error, deg vs s) as PNG + SVG with their gnuplot scripts");
-  cmd->add_flag("--selfcal", a->selfcal,
-                "Self-calibrating mode: each sensor's g-sensitivity (deg/s per g, 9 states a sensor, "
-                "driven by the log's accel columns) is estimated with the bias; summary.json reports it "
-                "with its sigma; docs/estimator.md section 1b");
+  auto* selfcal = cmd->add_flag(
+      "--selfcal", a->selfcal,
+      "Self-calibrating mode: each sensor's g-sensitivity (deg/s per g, 9 states a sensor, driven by the "
+      "log's accel columns or ref_q), scale/misalignment and end-stop angles are estimated with the bias; "
+      "summary.json reports them with their sigma; docs/estimator.md section 1b. Without it the mode is "
+      "chosen from the data: a six-state pass first, and a self-calibrating pass when its health shows an "
+      "error a constant bias cannot absorb (section 1i)");
+  cmd->add_flag("--no-selfcal", a->no_selfcal,
+                "The six-state model (bias only) even where its health calls for the self-calibration: no "
+                "second, self-calibrating pass (docs/estimator.md section 1i)")
+      ->excludes(selfcal);
   cmd->add_flag("--box-at-rest", a->box_at_rest,
                 "The box stands still on the Earth (a lab test): each standstill also measures the rate "
                 "about 'up' (accel columns, else ref_q) as the vertical Earth rate at the log's latitude; "

@@ -19,6 +19,8 @@ constexpr const char* kComponentNames[6] = {"b1_x", "b1_y", "b1_z", "b2_x", "b2_
 using report::json_number;
 using report::json_string;
 
+}  // namespace
+
 const char* cause_key(est::HealthCause c) {
   switch (c) {
     case est::HealthCause::kNoUpdate: return "no_update";
@@ -63,6 +65,8 @@ const char* cause_key(est::HealthCause c) {
   }
   return "?";
 }
+
+namespace {
 
 // the stamps against sample_rate_hz: what they step at, and the likely unit mistake
 std::string stamp_rate_text(const est::HealthFinding& f) {

@@ -12,6 +12,8 @@
 
 namespace driftless::cli {
 
+/// The finding's id in summary.json (docs/estimator.md section 6.1): "rejections_at_position", ...
+const char* cause_key(est::HealthCause c);
 /// "b1_z + b2_y" for the component indices 0..5 (b1_x .. b2_z).
 std::string component_names(const std::vector<int>& components);
 

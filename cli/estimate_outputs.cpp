@@ -186,6 +186,27 @@ void EstimateFiles::commit() {
   progress_.done(fmt::format("{} rows", samples_));
 }
 
+namespace {
+
+// one pass's health in the model choice: its verdict, rejected fraction and NIS mean
+std::string pass_health_json(const est::HealthReport& h) {
+  return fmt::format("{{\"health_verdict\": \"{}\", \"rejected_fraction\": {}, \"nis_mean\": {}}}", est::to_string(h.verdict),
+                     json_number(h.rejected_fraction), json_number(h.nis_mean));
+}
+
+// "self_calibration_choice": how the model was chosen (docs/estimator.md section 1i)
+std::string selfcal_choice_json(const SelfcalChoice& c) {
+  return fmt::format("  \"self_calibration_choice\": {{\"mode\": \"{}\", \"tried\": {}, \"used\": {}, "
+                     "\"interrupted\": {}, \"called_for_by\": {}, \"six_state\": {}, \"self_calibrating\": {}}}",
+                     est::to_string(c.mode), c.tried ? "true" : "false", c.used ? "true" : "false",
+                     c.interrupted ? "true" : "false",
+                     c.tried ? fmt::format("\"{}\"", cause_key(c.cause)) : std::string("null"),
+                     c.tried ? pass_health_json(c.six_state) : std::string("null"),
+                     c.tried ? pass_health_json(c.selfcal) : std::string("null"));
+}
+
+}  // namespace
+
 void write_estimate_summary(const fs::path& path, const SummaryContext& ctx, const est::EstimateSummary& s) {
   std::string o = "{\n";
   const auto add = [&o]<class... Args>(fmt::format_string<Args...> f, Args&&... args) {
@@ -228,6 +249,7 @@ void write_estimate_summary(const fs::path& path, const SummaryContext& ctx, con
       json_number(s.stop_angle_deg[0]), json_number(s.stop_angle_deg[1]), json_number(s.stop_angle_deg[2]),
       json_number(s.stop_angle_deg[3]), json_number(s.stop_angle_sigma_deg[0]), json_number(s.stop_angle_sigma_deg[1]),
       json_number(s.stop_angle_sigma_deg[2]), json_number(s.stop_angle_sigma_deg[3]));
+  if (ctx.selfcal_choice != nullptr) add("{},\n", selfcal_choice_json(*ctx.selfcal_choice));
   add("  \"box_dwells\": {{\"updates\": {}, \"rejected\": {}, \"refused_moving\": {}, \"refused_turning\": {}}},\n",
       s.counters.box_dwell_updates, s.counters.box_dwell_rejected, s.counters.box_dwell_moving,
       s.counters.box_dwell_turned);

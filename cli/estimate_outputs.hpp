@@ -14,6 +14,7 @@
 #include "estimator/background_writer.hpp"
 #include "estimator/output_file.hpp"
 #include "estimator/pipeline.hpp"
+#include "estimator/selfcal_choice.hpp"
 #include "estimator/tune.hpp"
 
 namespace driftless::cli {
@@ -62,6 +63,17 @@ class EstimateFiles : public est::EstimateSink {
   std::uint64_t samples_ = 0;
 };
 
+/// How the model was chosen (docs/estimator.md section 1i): the mode, and in the automatic mode
+/// whether the six-state pass called for a self-calibrating pass, why, and which one was kept.
+struct SelfcalChoice {
+  est::SelfcalMode mode = est::SelfcalMode::kAuto;
+  bool tried = false;        // the self-calibrating pass ran after the six-state pass
+  bool used = false;         // its results are the outputs
+  bool interrupted = false;  // a stop came during it: the six-state pass's outputs stand
+  est::HealthCause cause = est::HealthCause::kNoUpdate;  // the six-state finding that called for it
+  est::HealthReport six_state, selfcal;                  // the two passes' health (when tried)
+};
+
 /// What summary.json says beyond the pass's own summary.
 struct SummaryContext {
   std::string log_path;
@@ -74,6 +86,7 @@ struct SummaryContext {
   const std::vector<FigureOutcome>* figures = nullptr;  // what --plot drew (nullptr: no "figures")
   const est::EstimatorConfig* config = nullptr;  // the configuration used (nullptr: no "health" text)
   const est::TuneResult* tune = nullptr;         // what --tune auto measured (nullptr: "tune": null)
+  const SelfcalChoice* selfcal_choice = nullptr;  // how the model was chosen (nullptr: not said)
 };
 
 /// Writes summary.json (docs/estimator.md): "complete" and "stopped_at_t_s" first, then the

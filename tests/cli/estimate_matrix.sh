@@ -46,7 +46,7 @@ if grep -q "add --box-at-rest" "$t/r.out"; then fail "rock: --box-at-rest advise
 # GIVEN the same rock WHEN estimate --tune auto runs without --selfcal THEN (stop 30) the unmodelled
 # g-sensitivity's shared vertical part is named (main: degraded by the position rejections only, the
 # fix "--selfcal; add --box-at-rest for a box standing still"; DriftLess 203 deg/h, 195 with the bias fixed)
-"$bin" estimate --log "$t/rock.csv" --out "$t/r0" --tune auto > "$t/r0.out" 2>&1
+"$bin" estimate --log "$t/rock.csv" --out "$t/r0" --tune auto --no-selfcal > "$t/r0.out" 2>&1
 [ "$(json "$t/r0/summary.json" "[f['severity'] for f in d['health']['findings'] if f['cause'] == 'vertical_unobserved']")" = "['degraded']" ] ||
   fail "rock without --selfcal: no vertical_unobserved: $(cat "$t/r0.out")"
 grep -q "not modelled without --selfcal.*nothing in this log observes that.*ref_q turned at up to [0-9.]* deg/s over a standstill and was still in none" "$t/r0.out" ||
@@ -82,7 +82,7 @@ grep -q "no flip measured the scale along the hinges.*Flip slower" "$t/c.out" ||
   fail "car, 2 s flips: dwells $(json "$t/c2/summary.json" "d['box_dwells']"), drift $(json "$t/c2/summary.json" "d['attitude_drift_deg_per_h']")"
 # AND without --selfcal the car, which pauses on its straight runs, gets no vertical_unobserved (the
 # box dwells of --selfcal observe it there: the fix is --selfcal, which the NIS finding names)
-"$bin" estimate --log "$t/car2.csv" --out "$t/c20" --tune auto > "$t/c20.out" 2>&1
+"$bin" estimate --log "$t/car2.csv" --out "$t/c20" --tune auto --no-selfcal > "$t/c20.out" 2>&1
 [ "$(json "$t/c20/summary.json" "'vertical_unobserved' not in $causes and d['health']['verdict'] != 'ok'")" = True ] ||
   fail "car without --selfcal: $(cat "$t/c20.out")"
 

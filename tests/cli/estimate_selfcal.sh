@@ -12,11 +12,33 @@ verdict() { grep -o '"verdict": "[a-z]*"' "$1/summary.json" | cut -d'"' -f4; }
 
 # GIVEN 10 minutes of the static scenario
 "$bin" simulate --scenario static --duration 600 --out "$t/sim" > /dev/null 2>&1 || fail "simulate: exit $?"
-# WHEN estimated with defaults THEN failed, exit 1, and the finding proposes --selfcal
-"$bin" estimate --log "$t/sim/log.csv" --out "$t/plain" > "$t/plain.out" 2> "$t/plain.err"
-[[ $? -eq 1 ]] || fail "defaults: expected exit 1: $(cat "$t/plain.err")"
-[[ $(verdict "$t/plain") == failed ]] || fail "defaults: verdict $(verdict "$t/plain")"
-grep -q -- "--selfcal" "$t/plain.err" || fail "defaults: the fix is not named: $(cat "$t/plain.err")"
+# WHEN estimated with the six-state model (--no-selfcal) THEN failed, exit 1, and the finding proposes --selfcal
+"$bin" estimate --log "$t/sim/log.csv" --out "$t/plain" --no-selfcal > "$t/plain.out" 2> "$t/plain.err"
+[[ $? -eq 1 ]] || fail "--no-selfcal: expected exit 1: $(cat "$t/plain.err")"
+[[ $(verdict "$t/plain") == failed ]] || fail "--no-selfcal: verdict $(verdict "$t/plain")"
+grep -q -- "--selfcal" "$t/plain.err" || fail "--no-selfcal: the fix is not named: $(cat "$t/plain.err")"
+grep -q '"self_calibration_choice": {"mode": "off", "tried": false' "$t/plain/summary.json" ||
+  fail "--no-selfcal: the choice is not recorded: $(grep -o '"self_calibration_choice": {[^}]*' "$t/plain/summary.json")"
+# WHEN estimated with defaults THEN (docs/estimator.md section 1i) the six-state pass's rejections at
+# one position call for the self-calibrating pass, which is kept: ok with --strict, the same estimates
+# as --selfcal, the choice said on the console and in summary.json
+"$bin" estimate --log "$t/sim/log.csv" --out "$t/auto" --strict > "$t/auto.out" 2> "$t/auto.err" ||
+  fail "defaults: exit $?: $(cat "$t/auto.out" "$t/auto.err")"
+[[ $(verdict "$t/auto") == ok ]] || fail "defaults: verdict $(verdict "$t/auto")"
+grep -q "the six-state model does not fit this log (verdict failed, finding rejections_at_position" "$t/auto.err" ||
+  fail "defaults: the switch is not said: $(cat "$t/auto.err")"
+grep -q "self-calibration (auto): used; its verdict ok" "$t/auto.out" || fail "defaults: no choice line: $(cat "$t/auto.out")"
+python3 - "$t/auto/summary.json" << 'EOF2' || fail "defaults: self_calibration_choice: $(grep -o '"self_calibration_choice": {.*}},' "$t/auto/summary.json")"
+import json, sys
+c = json.load(open(sys.argv[1]))["self_calibration_choice"]
+ok = c["mode"] == "auto" and c["tried"] and c["used"] and not c["interrupted"]
+ok = ok and c["called_for_by"] == "rejections_at_position"
+ok = ok and c["six_state"]["health_verdict"] == "failed" and c["six_state"]["rejected_fraction"] > 0.3
+ok = ok and c["self_calibrating"]["health_verdict"] == "ok" and c["self_calibrating"]["rejected_fraction"] == 0
+sys.exit(0 if ok else 1)
+EOF2
+[[ ! -e "$t/auto/.selfcal-pass" ]] || fail "defaults: the self-calibrating pass's folder was left behind"
+grep -q '^self_calibration: true' "$t/auto/config_used.txt" || fail "defaults: config_used.txt is not the kept pass's"
 # WHEN estimated with --selfcal --box-at-rest THEN ok (exit 0 even with --strict), nothing rejected
 "$bin" estimate --log "$t/sim/log.csv" --out "$t/sc" --selfcal --box-at-rest --strict > "$t/sc.out" 2> "$t/sc.err" ||
   fail "--selfcal --box-at-rest: exit $?: $(cat "$t/sc.out" "$t/sc.err")"
@@ -24,6 +46,9 @@ grep -q -- "--selfcal" "$t/plain.err" || fail "defaults: the fix is not named: $
 grep -q '"rejected": 0,' "$t/sc/summary.json" || fail "--selfcal: updates rejected"
 grep -q '"self_calibration": {"enabled": true' "$t/sc/summary.json" || fail "no self_calibration block"
 grep -q '"g_sensitivity_sigma_dps_per_g": \[\[\[' "$t/sc/summary.json" || fail "no G sigma in summary.json"
+"$bin" estimate --log "$t/sim/log.csv" --out "$t/forced" --selfcal > /dev/null 2>&1 || fail "--selfcal: exit $?"
+cmp -s "$t/auto/estimate.csv" "$t/forced/estimate.csv" || fail "defaults: estimate.csv differs from --selfcal's"
+cmp -s "$t/auto/attitude.csv" "$t/forced/attitude.csv" || fail "defaults: attitude.csv differs from --selfcal's"
 # AND with --selfcal alone the box dwells between flips (docs/estimator.md section 1d) measure the
 # vertical: ok with --strict, dwell updates reported, none rejected
 "$bin" estimate --log "$t/sim/log.csv" --out "$t/dw" --selfcal --strict > /dev/null 2> "$t/dw.err" ||

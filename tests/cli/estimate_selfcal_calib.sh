@@ -75,7 +75,7 @@ sys.exit(0 if ok else 1)
 EOF
 
 # WHEN the second log is estimated without self-calibration
-"$bin" estimate --log "$t/b/log.csv" --out "$t/plain" > /dev/null 2>&1
+"$bin" estimate --log "$t/b/log.csv" --out "$t/plain" --no-selfcal > /dev/null 2>&1
 [[ $(verdict "$t/plain") == failed ]] || fail "second log without --calib: verdict $(verdict "$t/plain"), expected failed"
 # AND with --calib calib.yaml (no --selfcal)
 "$bin" estimate --log "$t/b/log.csv" --out "$t/cal" --calib "$t/calib.yaml" > "$t/cal.out" 2> "$t/cal.err"
