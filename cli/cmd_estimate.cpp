@@ -1,7 +1,11 @@
 // driftless estimate: run the DriftLess filter over a measurement log and write the bias
 // estimates, corrected outputs, attitude drift and (for simulated logs) errors against truth.
 // Formats: docs/estimator.md.
+#include <atomic>
 #include <chrono>
+#include <exception>
+#include <functional>
+#include <optional>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -254,6 +258,35 @@ bool gravity_logged(const log::LogReader& reader) {
   return true;
 }
 
+// The early sign that the six-state model fails (the self-calibrating pass then starts beside it on
+// the second core, so that a log that needs it costs about one pass of wall time, not two): at least
+// kEarlyRejectedFraction of the first kEarlyUpdates or more updates rejected. Only a head start: the
+// choice is made on the whole passes (estimator/selfcal_choice.hpp). Forwards everything to the files.
+constexpr std::uint64_t kEarlyUpdates = 12;
+constexpr double kEarlyRejectedFraction = 0.2;
+
+class EarlyWatch : public est::EstimateSink {
+ public:
+  EarlyWatch(est::EstimateSink& next, std::function<void()> fire) : next_(next), fire_(std::move(fire)) {}
+  void on_sample(const Sample& s, const est::SampleOutput& o, bool locked) override { next_.on_sample(s, o, locked); }
+  void on_update(const est::UpdateRecord& r, const est::Matrix6d& P, const Sample& s, bool locked) override {
+    next_.on_update(r, P, s, locked);
+    ++updates_;
+    if (!r.accepted) ++rejected_;
+    if (!fired_ && updates_ >= kEarlyUpdates && double(rejected_) >= kEarlyRejectedFraction * double(updates_)) {
+      fired_ = true;
+      fire_();
+    }
+  }
+  void on_attitude(const est::AttitudePoint& p) override { next_.on_attitude(p); }
+
+ private:
+  est::EstimateSink& next_;
+  std::function<void()> fire_;
+  std::uint64_t updates_ = 0, rejected_ = 0;
+  bool fired_ = false;
+};
+
 // one pass of the filter over the log into `dir`: its files stay uncommitted (a pass that is not
 // kept leaves nothing behind)
 struct EstimatePass {
@@ -266,28 +299,109 @@ struct EstimatePass {
 };
 
 EstimatePass run_filter_pass(const EstimateArgs& a, const est::EstimatorConfig& cfg, log::LogReader& reader,
-                             const fs::path& dir, EstimateFilesOptions file_opt) {
+                             const fs::path& dir, EstimateFilesOptions file_opt, bool (*should_stop)() = &stop_polled,
+                             const std::function<void()>& early = {}, bool progress = true) {
   EstimatePass p;
   p.cfg = cfg;
   p.dir = dir;
   p.read_opt = reader_options(a, cfg);
-  file_opt.t_end_s = reader.metadata().get_number("duration_s", kNaN);
+  // the progress display reads the log's duration (none for the pass beside another)
+  file_opt.t_end_s = progress ? reader.metadata().get_number("duration_s", kNaN) : kNaN;
   p.files = std::make_unique<EstimateFiles>(dir, file_opt);
   est::EstimateRunOptions run_opt;
   run_opt.attitude_start_sigma_dps = a.attitude_start_sigma_dps;
   if (a.smooth) p.smoother = std::make_unique<est::FixedIntervalSmoother>(cfg.q_dps2_per_s());
   run_opt.update_observer = p.smoother.get();
-  p.summary = est::run_estimate(reader, cfg, p.files.get(), run_opt, &stop_polled);
+  if (!early) {
+    p.summary = est::run_estimate(reader, cfg, p.files.get(), run_opt, should_stop);
+    return p;
+  }
+  EarlyWatch watch(*p.files, early);
+  p.summary = est::run_estimate(reader, cfg, &watch, run_opt, should_stop);
   return p;
 }
+
+// the self-calibrating pass of the model choice, in DIR/.selfcal-pass: started beside the six-state
+// pass on the second core when that one fails early (EarlyWatch), or after it; abandoned (its files
+// discarded) when the choice does not want it. The destructor abandons a pass still running.
+class SelfcalPass {
+ public:
+  SelfcalPass(const EstimateArgs& a, const est::EstimatorConfig& six_cfg, const fs::path& dir,
+              const EstimateFilesOptions& file_opt)
+      : a_(a), cfg_(six_cfg), staging_(dir / ".selfcal-pass"), file_opt_(file_opt) {
+    cfg_.self_calibration = true;
+    cfg_.validate();
+  }
+  ~SelfcalPass() { abandon(); }
+  SelfcalPass(const SelfcalPass&) = delete;
+  SelfcalPass& operator=(const SelfcalPass&) = delete;
+
+  /// Starts the pass on a thread of its own (no progress display: the six-state pass shows its own).
+  void start() {
+    if (thread_.joinable()) return;
+    started_ = true;
+    thread_ = std::thread([this] {
+      try {
+        result_ = run(&abandon_polled, false);
+      } catch (...) {
+        error_ = std::current_exception();
+      }
+    });
+  }
+  bool started() const { return started_; }
+  /// The pass's result: the one started early (joined), or a pass run now.
+  EstimatePass take() {
+    if (!thread_.joinable()) return run(&stop_polled, true);
+    thread_.join();
+    if (error_) std::rethrow_exception(error_);
+    return std::move(*result_);
+  }
+  /// Stops a pass still running and removes its folder.
+  void abandon() {
+    if (thread_.joinable()) {
+      abandoned().store(true);
+      thread_.join();
+      abandoned().store(false);
+    }
+    result_.reset();
+    if (started_) {
+      std::error_code ec;
+      fs::remove_all(staging_, ec);
+    }
+  }
+
+ private:
+  static std::atomic<bool>& abandoned() {
+    static std::atomic<bool> flag{false};
+    return flag;
+  }
+  static bool abandon_polled() { return stop_requested().load() || abandoned().load(); }
+  EstimatePass run(bool (*should_stop)(), bool progress) {
+    started_ = true;
+    fs::create_directories(staging_);
+    log::LogReader again(a_.log, reader_options(a_, cfg_));
+    return run_filter_pass(a_, cfg_, again, staging_, file_opt_, should_stop, {}, progress);
+  }
+  const EstimateArgs& a_;
+  est::EstimatorConfig cfg_;
+  fs::path staging_;
+  EstimateFilesOptions file_opt_;
+  std::thread thread_;
+  std::optional<EstimatePass> result_;
+  std::exception_ptr error_;
+  bool started_ = false;
+};
 
 // the default model choice (estimator/selfcal_choice.hpp): when the six-state pass shows an error
 // the self-calibration models, the log again with it, in a folder of its own; the better pass is
 // kept. `choice` records what was done for summary.json.
-EstimatePass choose_model(const EstimateArgs& a, EstimatePass six, const EstimateFilesOptions& file_opt,
-                          bool gravity, SelfcalChoice& choice) {
+EstimatePass choose_model(const EstimateArgs& a, EstimatePass six, SelfcalPass& sc_pass, bool gravity,
+                          SelfcalChoice& choice) {
   const est::SelfcalTrigger trig = est::selfcal_trigger(six.summary.health, gravity);
-  if (choice.mode != est::SelfcalMode::kAuto || !trig.wanted || stop_requested().load()) return six;
+  if (choice.mode != est::SelfcalMode::kAuto || !trig.wanted || stop_requested().load()) {
+    sc_pass.abandon();
+    return six;
+  }
   if (!fs::is_regular_file(a.log)) {
     // a stream (a FIFO) cannot be read a second time
     fmt::print(stderr, "driftless estimate: the six-state model does not fit this log (finding {}), and the log is "
@@ -301,22 +415,17 @@ EstimatePass choose_model(const EstimateArgs& a, EstimatePass six, const Estimat
   const est::HealthReport& h = six.summary.health;
   fmt::print(stderr,
              "driftless estimate: the six-state model does not fit this log (verdict {}, finding {}; {} of {} "
-             "updates rejected, NIS mean {:.3g}): estimating again in the self-calibrating mode (--selfcal: "
-             "g-sensitivity, scale/misalignment and end-stop states; --no-selfcal keeps the six-state model)\n",
-             est::to_string(h.verdict), cause_key(trig.cause), h.rejected, h.updates, h.nis_mean);
-  est::EstimatorConfig cfg = six.cfg;
-  cfg.self_calibration = true;
-  cfg.validate();
-  const fs::path staging = six.dir / ".selfcal-pass";
-  fs::create_directories(staging);
-  log::LogReader again(a.log, reader_options(a, cfg));
-  EstimatePass sc = run_filter_pass(a, cfg, again, staging, file_opt);
+             "updates rejected, NIS mean {:.3g}): {} in the self-calibrating mode (--selfcal: g-sensitivity, "
+             "scale/misalignment and end-stop states; --no-selfcal keeps the six-state model)\n",
+             est::to_string(h.verdict), cause_key(trig.cause), h.rejected, h.updates, h.nis_mean,
+             sc_pass.started() ? "estimated beside it" : "estimating again");
+  EstimatePass sc = sc_pass.take();
   choice.selfcal = sc.summary.health;
   choice.interrupted = stop_requested().load();
   choice.used = !choice.interrupted && est::selfcal_pass_better(sc.summary.health, six.summary.health);
   if (!choice.used) {
     sc.files.reset();  // discards its files
-    fs::remove_all(staging);
+    sc_pass.abandon();
     return six;
   }
   six.files.reset();
@@ -438,7 +547,14 @@ int run_estimate_cmd(const EstimateArgs& a) {
   file_opt.keep_series = a.plot;
   write_config_used(dir, cfg);
   const bool gravity = gravity_logged(reader);
-  EstimatePass pass = choose_model(a, run_filter_pass(a, cfg, reader, dir, file_opt), file_opt, gravity, choice);
+  // in the automatic choice, the self-calibrating pass may start early, beside the six-state pass
+  SelfcalPass sc_pass(a, cfg, dir, file_opt);
+  std::function<void()> early;
+  if (choice.mode == est::SelfcalMode::kAuto && gravity && fs::is_regular_file(a.log)) {
+    early = [&sc_pass] { sc_pass.start(); };
+  }
+  EstimatePass pass = choose_model(a, run_filter_pass(a, cfg, reader, dir, file_opt, &stop_polled, early), sc_pass,
+                                   gravity, choice);
   if (choice.used) write_config_used(dir, pass.cfg);
   const auto& summary = pass.summary;
   // --smooth: corrected.csv holds the smoother's rows only when its second pass ran to the end
