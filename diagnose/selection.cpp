@@ -121,8 +121,9 @@ class Selector {
   std::vector<Terms> options(Effect e, const std::vector<Eval>& evals, const Terms& S, int step_no) const;
   bool step(Terms& S, int step_no, double& base);
   std::vector<FittedParam> new_params(const Terms& trial, std::size_t from) const;
-  std::size_t plausible_choice(const std::vector<std::pair<Effect, Terms>>& opts, const std::vector<double>& score,
-                               std::size_t best, const Terms& S);
+  double added_evidence(const Terms& a, const Terms& b, std::size_t from) const;
+  std::size_t choose(const std::vector<std::pair<Effect, Terms>>& opts, const std::vector<double>& score,
+                     std::size_t best, const Terms& S);
   void prune(Terms& S, std::size_t from = 0) const;
   bool refit_noise(const Terms& S);
   void set_variances(const Terms& S);
@@ -409,7 +410,7 @@ bool Selector::step(Terms& S, int step_no, double& base) {
     if (score[i] > best_ev) best_ev = score[i], best_i = i;
   }
   if (best_i < opts.size()) {
-    best_i = plausible_choice(opts, score, best_i, S);
+    best_i = choose(opts, score, best_i, S);
     best_ev = score[best_i], best = opts[best_i].first, best_trial = opts[best_i].second;
   }
   int best_adc = -1;
@@ -455,47 +456,70 @@ std::vector<FittedParam> Selector::new_params(const Terms& trial, std::size_t fr
   return out;
 }
 
-// the option a step takes, given the best-scoring one: an option whose fit is implausible (a
+// the evidence option `b`'s new parameters (from index `from` on) add to option `a`
+double Selector::added_evidence(const Terms& a, const Terms& b, std::size_t from) const {
+  Terms both = a;
+  for (std::size_t t = from; t < b.size(); ++t)
+    if (!contains(both, b[t].ref)) both.push_back(b[t]);
+  if (std::any_of(both.begin() + static_cast<std::ptrdiff_t>(from), both.end(),
+                  [](const Term& t) { return is_signal_chain(t.ref); }))
+    optimise_delays(both);
+  return total(both) - total(a) - static_cast<double>(both.size() - a.size()) * log_m_;
+}
+
+// the option a step takes, given the best-scoring one. An option whose fit is implausible (a
 // cross-axis term of 2000 %) yields to the best plausible option that explains the same residual,
-// i.e. after which the implausible one adds no evidence above the threshold. On a static box the
+// i.e. after which the implausible one adds no evidence above the threshold: on a static box the
 // Earth rate in the flipping sensor's axes changes sign with the gravity there, so a cross-axis
 // term and a g-sensitivity are one signal; scored equal, the catalogue order named the cross-axis
-// term at 416-2154 % (probe finding: navgen --gsens 0.05). The reason is kept as the effect's note
-std::size_t Selector::plausible_choice(const std::vector<std::pair<Effect, Terms>>& opts, const std::vector<double>& score,
-                                       std::size_t best, const Terms& S) {
-  auto absurd = [](const std::vector<FittedParam>& ps) {
+// term at 200-2200 % (probe finding: navgen --gsens 0.05, seeds 30-37). Plausible options the
+// data cannot tell from the one taken (neither adds evidence given the other; a coordinated turn's
+// lateral force is the yaw rate times the speed) are named in its note: the choice is not the data's
+std::size_t Selector::choose(const std::vector<std::pair<Effect, Terms>>& opts, const std::vector<double>& score,
+                             std::size_t best, const Terms& S) {
+  auto absurd = [&](std::size_t i) {
+    const std::vector<FittedParam> ps = new_params(opts[i].second, S.size());
     return std::any_of(ps.begin(), ps.end(), [](const FittedParam& p) { return p.absurd; });
   };
-  const std::vector<FittedParam> implausible = new_params(opts[best].second, S.size());
-  if (!absurd(implausible)) return best;
-  const Terms& bad = opts[best].second;
-  std::vector<std::size_t> order;
+  auto values = [&](std::size_t i) {
+    std::string v;
+    for (const FittedParam& p : new_params(opts[i].second, S.size()))
+      v += fmt::format("{}{} = {:.4g} {}", v.empty() ? "" : ", ", p.name(), p.new_value(), p.unit());
+    return v;
+  };
+  std::vector<std::size_t> order;  // the other supported options, best first
   for (std::size_t i = 0; i < opts.size(); ++i)
     if (i != best && score[i] > in_.threshold) order.push_back(i);
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return score[a] > score[b]; });
-  for (std::size_t i : order) {
-    const Terms& good = opts[i].second;
-    if (absurd(new_params(good, S.size()))) continue;
-    // the implausible option's parameters added to the plausible one, and the other way round
-    Terms both = good;
-    for (std::size_t t = S.size(); t < bad.size(); ++t)
-      if (!contains(both, bad[t].ref)) both.push_back(bad[t]);
-    if (is_signal_chain(bad.back().ref) || is_lowpass(bad.back().ref)) optimise_delays(both);
-    const double t_both = total(both);
-    const double bad_after = t_both - total(good) - static_cast<double>(both.size() - good.size()) * log_m_;
-    if (bad_after > in_.threshold) continue;  // it explains something the plausible one does not
-    const double good_after = t_both - total(bad) - static_cast<double>(both.size() - bad.size()) * log_m_;
-    std::string values;
-    for (const FittedParam& p : implausible)
-      values += fmt::format("{}{} = {:.4g} {}", values.empty() ? "" : ", ", p.name(), p.new_value(), p.unit());
-    notes_[opts[i].first] = fmt::format(
-        "{} fits the same residual (evidence {:.1f}) at implausible values ({}); {} {}", effect_id(opts[best].first),
-        score[best], values, effect_id(opts[i].first),
-        good_after > in_.threshold ? "explains all of it and more at plausible values"
-                                   : "is named instead: this log cannot tell the two apart, and its values are plausible");
-    return i;
+  const std::size_t from = S.size();
+  std::size_t chosen = best;
+  std::string note;
+  if (absurd(best)) {
+    for (std::size_t i : order) {
+      if (absurd(i) || added_evidence(opts[i].second, opts[best].second, from) > in_.threshold) continue;
+      const bool apart = added_evidence(opts[best].second, opts[i].second, from) > in_.threshold;
+      note = fmt::format("{} fits the same residual (evidence {:.1f}) at implausible values ({}); {} {}",
+                         effect_id(opts[best].first), score[best], values(best), effect_id(opts[i].first),
+                         apart ? "explains all of it and more at plausible values"
+                               : "is named instead: this log cannot tell the two apart, and its values are plausible");
+      chosen = i;
+      break;
+    }
   }
-  return best;
+  // plausible options of another effect within reach of the chosen one's score that are one signal with it
+  const double reach = in_.threshold + 4.0 * log_m_;
+  for (std::size_t i : order) {
+    if (i == chosen || opts[i].first == opts[chosen].first || score[chosen] - score[i] > reach || absurd(i)) continue;
+    if (added_evidence(opts[chosen].second, opts[i].second, from) > in_.threshold) continue;
+    if (added_evidence(opts[i].second, opts[chosen].second, from) > in_.threshold) continue;
+    note += fmt::format("{}this log cannot tell it from {} (evidence {:.1f}: {})", note.empty() ? "" : "; ",
+                        effect_id(opts[i].first), score[i], values(i));
+  }
+  if (!note.empty()) {
+    std::string& kept = notes_[opts[chosen].first];  // an effect taken again at a later step (the other sensor)
+    kept += (kept.empty() ? "" : "; ") + note;
+  }
+  return chosen;
 }
 
 // backward: drop the least supported parameter (of those from index `from` on) while its
