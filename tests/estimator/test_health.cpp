@@ -146,10 +146,12 @@ TEST(HealthTest, NoStandstillFails) {
   p.duration_s = 120.0;
   p.standstill_s = 1.2;
   const auto s = run_synth(p, "no_standstill.csv");
-  // THEN no update is made and the verdict is failed for that reason
+  // THEN no update is made and the verdict is failed for that reason, named as such: the rests
+  // were too short (standstills_too_short), not "no standstill" (no_update, which it replaces)
   EXPECT_EQ(s.health.updates, 0u);
   EXPECT_EQ(s.health.verdict, HealthVerdict::kFailed);
-  EXPECT_TRUE(has(s.health, HealthCause::kNoUpdate));
+  EXPECT_TRUE(has(s.health, HealthCause::kStandstillsTooShort));
+  EXPECT_FALSE(has(s.health, HealthCause::kNoUpdate));
 }
 
 TEST(HealthTest, RejectionsAtOnePositionNameThePosition) {
