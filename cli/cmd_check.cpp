@@ -8,6 +8,7 @@
 #include <fmt/core.h>
 
 #include "cli/command.hpp"
+#include "cli/estimate_health.hpp"
 #include "estimator/health.hpp"
 #include "estimator/log.hpp"
 #include "estimator/numbers.hpp"
@@ -31,6 +32,28 @@ std::string groups_text(std::uint32_t fields) {
     if ((fields & bit) != 0) out += std::string(" ") + name;
   }
   return out.empty() ? " none" : out;
+}
+
+// the findings that make the log unusable as it is (check exits 1): no data rows, stamps in
+// another unit than seconds; printed first, each with its fix
+bool print_unusable(const log::LogReader& reader) {
+  if (reader.rows_read() == 0) {
+    fmt::print("  error: the log has no data rows (a header only): nothing to estimate; check that the logger "
+               "wrote its samples\n");
+    return true;
+  }
+  const double median_hz = reader.stamp_rate_median_hz(), stated_hz = reader.metadata().sample_rate_hz();
+  const double to_s = median_hz > 0.0 ? est::stamp_unit_to_s(1.0 / median_hz, reader.rows_read()) : kNaN;
+  if (std::isnan(to_s)) return false;
+  if (std::isfinite(stated_hz)) {
+    fmt::print("  error: the stamps step {:.6g} \"s\" (median interval) where sample_rate_hz says {:g} Hz: t is in "
+               "{}? divide t by {:g}\n",
+               1.0 / median_hz, stated_hz, to_s == 1e-3 ? "milliseconds" : to_s == 1e-6 ? "microseconds" : "nanoseconds",
+               1.0 / to_s);
+  } else {
+    fmt::print("  error: {}\n", stamp_unit_text(1.0 / median_hz, to_s));
+  }
+  return true;
 }
 
 void print_findings(const log::LogReader& reader) {
@@ -109,13 +132,16 @@ int run_check(const std::string& path) {
   if (reader.rows_read() > 1) fmt::print("  sample interval: {:.6f} .. {:.6f} s\n", span.min_dt, span.max_dt);
   fmt::print("  columns: {}\n", reader.columns().size());
   fmt::print("  optional groups:{}\n", groups_text(reader.fields()));
+  const bool unusable = print_unusable(reader);
   print_findings(reader);
-  return 0;
+  if (unusable) fmt::print(stderr, "driftless check: {}: not usable as it is (see 'error:' above)\n", path);
+  return unusable ? 1 : 0;
 }
 
 const bool registered = register_command(90, [](CLI::App& app) {
   auto* cmd = app.add_subcommand("check", "Validate a measurement log (docs/log-format.md, the same validation "
-                                          "every command applies) and summarise it; exit 1 on a refused log");
+                                          "every command applies) and summarise it; exit 1 on a refused log, one "
+                                          "without data rows, or stamps in another unit than seconds");
   auto path = std::make_shared<std::string>();
   cmd->add_option("--log", *path, "Measurement log (CSV, driftless-log 1; also the single-sensor form)")
       ->required()

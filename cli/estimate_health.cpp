@@ -61,9 +61,21 @@ const char* cause_key(est::HealthCause c) {
     case est::HealthCause::kCalibUncertain: return "calib_uncertain";
     case est::HealthCause::kVerticalUnobserved: return "vertical_unobserved";
     case est::HealthCause::kClippedFlipsScale: return "clipped_flips_scale";
+    case est::HealthCause::kStandstillsTooShort: return "standstills_too_short";
+    case est::HealthCause::kNoDataRows: return "no_data_rows";
+    case est::HealthCause::kStampUnit: return "stamp_unit";
     default: if (is_flip_cause(c)) return flip_cause_key(c);
   }
   return "?";
+}
+
+std::string stamp_unit_text(double interval_s, double to_s) {
+  const char* unit = to_s == 1e-3 ? "milliseconds" : to_s == 1e-6 ? "microseconds" : "nanoseconds";
+  return fmt::format("the time stamps step {:.6g} \"s\" (median interval) and the header states no sample_rate_hz: "
+                     "no gyro log in seconds is sampled that slowly, so t is in {}? ({:.6g} s, {:.6g} Hz, in "
+                     "seconds). The log wants seconds: divide t by {:g} (or state sample_rate_hz); every duration, "
+                     "gap and noise figure of this run is off by that factor",
+                     interval_s, unit, interval_s * to_s, 1.0 / (interval_s * to_s), 1.0 / to_s);
 }
 
 namespace {
@@ -611,6 +623,20 @@ std::string describe_input_checks(const est::HealthFinding& f, const est::Estima
                          f.value);
     case est::HealthCause::kStampRate:
       return stamp_rate_text(f);
+    case est::HealthCause::kStampUnit:
+      return stamp_unit_text(f.value, f.suggested);
+    case est::HealthCause::kNoDataRows:
+      return "the log has no data rows (a header only): there is nothing to estimate; check that the logger "
+             "wrote its samples (a run stopped before the first row, or a file cut after the header)";
+    case est::HealthCause::kStandstillsTooShort:
+      return fmt::format("all {} rests of the platforms were too short to use: they last {:.2g} s on average "
+                         "({:.2g} s at most) as logged, of which {:.2g} s at most is left once settle_s {:g} s and "
+                         "end_margin_s {:g} s are taken off, below min_standstill_s {:g} s; rest at least {:.2g} s "
+                         "between flips, or lower min_standstill_s (and settle_s) in the configuration (a shorter "
+                         "standstill averages less noise per update)",
+                         f.count, f.positions_deg.empty() ? kNaN : f.positions_deg.front()[0], f.suggested,
+                         f.value, cfg.settle_s, cfg.end_margin_s, f.sigma,
+                         f.sigma + cfg.settle_s + cfg.end_margin_s);
     case est::HealthCause::kAngleJitter:
       return fmt::format("no standstill was found: plat1_deg/plat2_deg move by small steps, up to {:.3g} deg between "
                          "samples, in {:.0f} % of the rows, more than angle_tolerance_deg {:g} (an encoder's noise?), "
@@ -704,6 +730,9 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
     case est::HealthCause::kPriorRejected:
     case est::HealthCause::kParallelHinges:
     case est::HealthCause::kNeverFlipped:
+    case est::HealthCause::kStampUnit:
+    case est::HealthCause::kNoDataRows:
+    case est::HealthCause::kStandstillsTooShort:
     case est::HealthCause::kGyroGapPositions:
     case est::HealthCause::kGyroStartMidFlip:
       return describe_input_checks(f, cfg);
@@ -795,6 +824,12 @@ std::string lock_text(const est::HealthReport& h) {
 
 std::vector<std::string> health_lines(const est::HealthReport& h, const est::EstimatorConfig& cfg) {
   std::vector<std::string> lines;
+  // a log without data rows has no lock, NIS or updates to speak of
+  if (!h.findings.empty() && h.findings.front().cause == est::HealthCause::kNoDataRows) {
+    lines.push_back(fmt::format("health: {}: the log has no data rows", est::to_string(h.verdict)));
+    lines.push_back(fmt::format("  {}: {}", est::to_string(h.findings.front().severity), describe(h.findings.front(), cfg, h)));
+    return lines;
+  }
   lines.push_back(fmt::format(
       "health: {}: {}, {} of {} updates rejected ({:.1f} %), NIS mean {:.3g} (95 % band {:.3g}..{:.3g}), {} re-lock(s)",
       est::to_string(h.verdict), lock_text(h),

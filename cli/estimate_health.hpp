@@ -48,6 +48,9 @@ std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cf
                      est::GravitySource gravity = est::GravitySource::kNone);
 /// The same, the fixes picked by what the run saw (h: its gravity source, box motion and columns).
 std::string describe(const est::HealthFinding& f, const est::EstimatorConfig& cfg, const est::HealthReport& h);
+/// Stamps whose median interval (`interval_s`, as read) only makes sense in another unit
+/// (`to_s`: est::stamp_unit_to_s()): the likely unit and the fix (estimate's finding and check).
+std::string stamp_unit_text(double interval_s, double to_s);
 /// The `"health": {...}` member of summary.json (no trailing comma), indented by two spaces.
 std::string health_json(const est::HealthReport& h, const est::EstimatorConfig& cfg);
 /// The `tune` value of summary.json: what --tune auto measured, or null.

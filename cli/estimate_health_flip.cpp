@@ -106,6 +106,7 @@ const char* flip_cause_key(HealthCause c) {
     case HealthCause::kFlipAxis: return "flip_axis";
     case HealthCause::kFlipTurnRatio: return "flip_turn_ratio";
     case HealthCause::kFlipScale: return "flip_scale";
+    case HealthCause::kFlipsUnchecked: return "flips_unchecked";
     case HealthCause::kFlipsTooSlow: return "flips_too_slow";
     default: return "?";
   }
@@ -130,6 +131,22 @@ std::string describe_flip(const est::HealthFinding& f, const est::EstimatorConfi
                                               : " (with --selfcal its flip gate would reject these flips)",
                          wider, calibrate_fix(run_used(cfg, est::GravitySource::kNone)));
     }
+    case HealthCause::kFlipsUnchecked:
+      if (f.count > 0) {
+        return fmt::format("the hinge axes and angle signs were not checked: a gyro clipped in all {} flips so far "
+                           "that their turn could not be read (below a fifth of the angle change): a wrong "
+                           "hinge*_axis line or angle sign in the header would go unseen, and makes every estimate "
+                           "wrong; flip more slowly or record with a larger gyro range (MPU6050: FS_SEL), and check "
+                           "hinge1_axis/hinge2_axis and the signs of plat1_deg/plat2_deg by hand",
+                           f.count);
+      }
+      return fmt::format("the hinge axes and angle signs were not checked: in {:g} motion(s) between two rests no "
+                         "flip of one platform alone with both angles read was seen (both platforms moved at once, "
+                         "or samples were missing in every flip): a wrong hinge*_axis line or angle sign in the "
+                         "header would go unseen, and makes every estimate wrong; flip one platform at a time, "
+                         "with a rest between flips, and check hinge1_axis/hinge2_axis and the signs of "
+                         "plat1_deg/plat2_deg by hand",
+                         std::isnan(f.suggested) ? 0.0 : f.suggested);
     case HealthCause::kFlipsTooSlow:
       return fmt::format("{} of {:g} flips took longer than flip_max_s {:g} s (the longest {:.1f} s): the "
                          "self-calibration made no flip update from them, so scale and misalignment stay near "

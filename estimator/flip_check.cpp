@@ -51,15 +51,19 @@ void push_clip(ClipDetector& d, const Eigen::Vector3d& y1, const Eigen::Vector3d
 }  // namespace
 
 FlipTurn classify_flip(const Eigen::Vector3d& v, const Eigen::Vector3d& w, const Eigen::Vector3d& a, double dtheta_deg,
-                       double moving_raw_deg, double resting_raw_deg) {
+                       double moving_raw_deg, double resting_raw_deg, bool clipped) {
   const double d = std::fabs(dtheta_deg);
   if (!(d > 0.0) || !v.allFinite() || !w.allFinite()) return FlipTurn::kOther;
+  // "a turn of Δθ": within the tolerance, or for a clipped flip anything it can have been cut to
+  const auto one = [clipped](double x) {
+    return clipped ? x >= kFlipTurnTolerance && x <= 1.0 + kFlipTurnTolerance : near(x, 1.0);
+  };
   const double vn = v.norm();
   const double along = vn > 0.0 ? std::fabs(a.dot(v)) / vn : 0.0;  // |cos| of the turn axis to the hinge
   const double r = a.dot(v) / dtheta_deg;
   if (along >= kFlipAxisCos) {
-    if (near(r, 1.0)) return FlipTurn::kAgrees;
-    if (near(r, -1.0)) return FlipTurn::kSign;
+    if (one(r)) return FlipTurn::kAgrees;
+    if (one(-r)) return FlipTurn::kSign;
     const double ar = std::fabs(r);
     if (near(ar, kRadPerDeg)) return FlipTurn::kGyroRadPerS;
     if (near(ar, 1.0 / kRadPerDeg)) return FlipTurn::kAngleRadians;
@@ -70,8 +74,8 @@ FlipTurn classify_flip(const Eigen::Vector3d& v, const Eigen::Vector3d& w, const
   // the resting sensor's column turned by about Δθ about the moving hinge while the moving one's
   // barely turned (the box's own turn in a second is well under half a flip): columns swapped
   const double wn = w.norm();
-  if (std::fabs(wn / d - 1.0) <= kFlipTurnTolerance && std::fabs(a.dot(w)) >= kFlipAxisCos * wn &&
-      std::fabs(resting_raw_deg / d - 1.0) <= kFlipTurnTolerance && moving_raw_deg < 0.5 * d) {
+  if (one(wn / d) && std::fabs(a.dot(w)) >= kFlipAxisCos * wn && one(resting_raw_deg / d) &&
+      moving_raw_deg < 0.5 * d) {
     return FlipTurn::kSwapped;
   }
   if (along < kFlipAxisCos) return FlipTurn::kAxis;
@@ -130,10 +134,10 @@ bool FlipCheck::push(double t_s, const Eigen::Vector3d& y1_dps, const Eigen::Vec
     p1_rest_ = plat1_deg;
     p2_rest_ = plat2_deg;
     if (!closing || !was_rest_) return false;
-    if (!clip_.suspected().empty()) {  // a gyro clipped in the flip: its turn reads short (saturation finding)
-      ++clipped_;
-      return false;
-    }
+    ++windows_;
+    // a gyro clipped in the flip: its turn reads short (the saturation finding), its axis and sign hold
+    window_clipped_ = !clip_.suspected().empty();
+    clipped_ += window_clipped_ ? 1 : 0;
     // one platform turned, the other stayed (within a twentieth of the turn: encoder noise)
     const double d1 = std::fabs(p1_end_ - p1_start_), d2 = std::fabs(p2_end_ - p2_start_);
     return std::isfinite(d1 + d2) && std::max(d1, d2) > 0.0 && std::min(d1, d2) < 0.05 * std::max(d1, d2);
@@ -177,7 +181,13 @@ void FlipCheck::close(const Frames& f) {
   const double vn = v.norm();
   r.axis_sensor = vn > 0.0 ? Eigen::Vector3d(v / vn * (r.dtheta_deg < 0.0 ? -1.0 : 1.0)) : Eigen::Vector3d::Zero();
   r.hinge_sensor = a;
-  r.kind = classify_flip(v, w, a, r.dtheta_deg, Sm.norm(), Ss.norm());
+  r.clipped = window_clipped_;
+  r.kind = classify_flip(v, w, a, r.dtheta_deg, Sm.norm(), Ss.norm(), r.clipped);
+  // a clipped flip that reads as no turn, or as none of the kinds, says nothing about the hinge
+  if (r.clipped && (r.kind == FlipTurn::kStuck || r.kind == FlipTurn::kOther)) {
+    ++clipped_unusable_;
+    return;
+  }
   records_.push_back(r);
 }
 
@@ -188,6 +198,8 @@ FlipCheckResult FlipCheck::finish() const {
   FlipCheckResult out;
   out.flip_max_s = flip_max_s_;
   out.clipped = clipped_;
+  out.clipped_unusable = clipped_unusable_;
+  out.windows = windows_;
   for (int p = 1; p <= 2; ++p) {
     PlatformFlipSummary& s = out.platform[static_cast<std::size_t>(p - 1)];
     s.first_t_s.fill(kNaN);
@@ -200,7 +212,10 @@ FlipCheckResult FlipCheck::finish() const {
       ++s.flips;
       ++s.count[k];
       if (std::isnan(s.first_t_s[k])) s.first_t_s[k] = r.t_start_s;
-      ratios[k].push_back(r.ratio);
+      s.clipped += r.clipped ? 1 : 0;
+      // a clipped flip's short turn stays out of the agreeing flips' median (the scale along the hinge)
+      if (!r.clipped || r.kind != FlipTurn::kAgrees) ratios[k].push_back(r.ratio);
+      s.scale_flips += !r.clipped && r.kind == FlipTurn::kAgrees ? 1 : 0;
       if (r.kind == FlipTurn::kAxis) s.axis_sensor += r.axis_sensor;
       s.hinge_sensor = r.hinge_sensor;
       if (r.duration_s > flip_max_s_) ++s.slower_than_max;

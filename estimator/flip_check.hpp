@@ -7,8 +7,10 @@
 // platform that stuck while its angle column says it flipped (≈ 0), the angle sign (−1), a wrong
 // hinge line or swapped sensor columns (another axis), a scale error along the hinge (1 ± a few
 // %), flips slower than flip_max_s (the self-calibration's flip updates drop them) and platforms
-// that always turn the same way with the angle wrapped at ±180° (handled: a note). Eigen + std only; push()
-// allocates only when a flip ends (one record).
+// that always turn the same way with the angle wrapped at ±180° (handled: a note). A flip in which a
+// gyro clipped (an MPU6050's ±250 deg/s in a 1 s flip) still shows the turn's axis and sign (the clip
+// only shortens the clipped channel, whose sign stays): it is judged for those, not for the scale.
+// Eigen + std only; push() allocates only when a flip ends (one record).
 //
 // The sums are linear in the readings: with C0 = M_m0^T M_s (resting sensor to moving sensor at
 // its start angle, constant over the flip), sum (y_m - C0 y_s) dt = S_m - C0 S_s, so the check
@@ -66,6 +68,9 @@ struct FlipTurnRecord {
   Eigen::Vector3d axis_sensor = Eigen::Vector3d::Zero();  // unit turn axis, moving sensor axes, sign of Δθ
   Eigen::Vector3d hinge_sensor = Eigen::Vector3d::Zero(); // the header's hinge in the same axes
   FlipTurn kind = FlipTurn::kAgrees;
+  // a gyro clipped in the window: its turn reads short, so only the axis, the sign, the swap and
+  // the units (a ratio beyond 1, which no clip gives) are judged; its ratio stays out of the scale
+  bool clipped = false;
 };
 
 /// One platform's flips, summed up.
@@ -73,12 +78,15 @@ struct PlatformFlipSummary {
   std::uint64_t flips = 0;
   std::array<std::uint64_t, kFlipTurnKinds> count{};        // by FlipTurn
   std::array<double, kFlipTurnKinds> first_t_s{};           // s, the first of each kind (NaN: none)
-  std::array<double, kFlipTurnKinds> median_ratio{};        // turn/Δθ, median over each kind
+  std::array<double, kFlipTurnKinds> median_ratio{};        // turn/Δθ, median over each kind (kAgrees:
+                                                            // the flips without a clip, scale_flips)
   // the median's standard error from the ratios' spread (1.2533 x 1.4826 MAD / sqrt(n); NaN below 3)
   std::array<double, kFlipTurnKinds> median_ratio_sigma{};
   Eigen::Vector3d axis_sensor = Eigen::Vector3d::Zero();    // kAxis: mean measured axis (unit)
   Eigen::Vector3d hinge_sensor = Eigen::Vector3d::Zero();   // the header's hinge, sensor axes
   std::uint64_t slower_than_max = 0;                        // flips longer than flip_max_s
+  std::uint64_t clipped = 0;                                // flips measured with a clip (axis and sign)
+  std::uint64_t scale_flips = 0;                            // agreeing flips without a clip
   // s/deg, the largest window / |Δθ|: a rate error of x deg/s that the rest before a flip does not
   // give (a g-sensitivity term changing as the platform turns) moves its ratio by up to x times this
   double rate_to_ratio_s_per_deg = 0.0;
@@ -90,8 +98,12 @@ struct PlatformFlipSummary {
 struct FlipCheckResult {
   std::array<PlatformFlipSummary, 2> platform;  // [0]: platform 1
   std::uint64_t flips = 0;                      // flips of one platform with both angles read
+  std::uint64_t windows = 0;                    // motion between two rests with both angles read (any)
   std::uint64_t disagree = 0;                   // flips whose kind is neither kAgrees nor kWrapped
-  std::uint64_t clipped = 0;                    // flips left out: a gyro clipped in them (short turn)
+  std::uint64_t clipped = 0;                    // flips in which a gyro clipped (judged for axis and sign)
+  // of those, flips left out: clipped so that their turn reads below kFlipTurnTolerance of Δθ, or
+  // not about any axis the check can name (then nothing about the hinge can be said from them)
+  std::uint64_t clipped_unusable = 0;
   double flip_max_s = kNaN;                     // s, the configured limit (slower_than_max)
 };
 
@@ -138,8 +150,9 @@ class FlipCheck {
   double rest_n_ = 0.0;
   void rest_sample(const Eigen::Vector3d& y1_dps, const Eigen::Vector3d& y2_dps, double dt_s);
   std::vector<FlipTurnRecord> records_;
-  ClipDetector clip_;             // the window's readings (a clipped flip reads short: left out)
-  std::uint64_t clipped_ = 0;
+  ClipDetector clip_;             // the window's readings (a clipped flip reads short: axis and sign only)
+  bool window_clipped_ = false;   // the flip push() just closed had a clip in it
+  std::uint64_t clipped_ = 0, clipped_unusable_ = 0, windows_ = 0;
 };
 
 /// The kind of one flip from its sums (pure; exposed for the tests): `v` = S_m − C0 S_s and

@@ -95,12 +95,27 @@ HealthCause flip_cause(FlipTurn k) {
   return HealthCause::kFlipTurnRatio;
 }
 
-// one finding for the flips of `kind` on the platforms that had any (a unit error shows on both)
+// failed when most of the flips of `platforms` that show `kind` disagree with their angle columns:
+// a wrong unit, hinge or sign on one platform makes every estimate wrong, whatever the other
+// platform's flips say; else degraded (a platform that stuck half-way through the log)
+HealthVerdict disagree_severity(const FlipCheckResult& r, FlipTurn kind, const std::vector<int>& platforms) {
+  std::uint64_t flips = 0, bad = 0;
+  for (int p : platforms) {
+    const PlatformFlipSummary& s = r.platform[static_cast<std::size_t>(p - 1)];
+    if (s.of(kind) == 0) continue;
+    flips += s.flips;
+    bad += s.flips - s.of(FlipTurn::kAgrees) - s.of(FlipTurn::kWrapped);
+  }
+  return 2 * bad > flips ? HealthVerdict::kFailed : HealthVerdict::kDegraded;
+}
+
+// one finding for the flips of `kind` on the platforms that had any (a unit error shows on both);
+// `note`: a note whatever the count, else disagree_severity()
 void add_flip_kind(HealthReport& first, const FlipCheckResult& r, FlipTurn kind, const std::vector<int>& platforms,
-                   HealthVerdict severity) {
+                   bool note = false) {
   HealthFinding f;
   f.cause = flip_cause(kind);
-  f.severity = severity;
+  f.severity = note ? HealthVerdict::kOk : disagree_severity(r, kind, platforms);
   f.sigma = kNaN;
   const int k = static_cast<int>(kind);
   std::uint64_t most = 0;
@@ -123,44 +138,58 @@ void add_flip_kind(HealthReport& first, const FlipCheckResult& r, FlipTurn kind,
   if (f.count > 0) add(first, std::move(f));
 }
 
+// a scale error along platform p's hinge beyond 3 sigma of its prior (its unclipped agreeing flips)
+void add_flip_scale(HealthReport& first, const PlatformFlipSummary& s, int p, const EstimatorConfig& cfg,
+                    HealthVerdict severity) {
+  const double ratio = s.median_ratio[static_cast<int>(FlipTurn::kAgrees)];
+  if (s.scale_flips < 2 || !(std::fabs(ratio - 1.0) > 3.0 * cfg.scale_misalign_sigma_frac)) return;
+  HealthFinding f;
+  f.cause = HealthCause::kFlipScale;
+  f.severity = severity;
+  f.value = ratio;
+  // the spread's standard error and what the rest before each flip cannot take out: the
+  // g-sensitivity's change as the platform turns (its prior x 1 g over the window), in quadrature
+  f.sigma = std::hypot(s.median_ratio_sigma[static_cast<int>(FlipTurn::kAgrees)],
+                       cfg.gsens_sigma_dps_per_g * s.rate_to_ratio_s_per_deg);
+  f.components = {p};
+  f.count = s.scale_flips;
+  f.suggested = double(s.flips);
+  add(first, std::move(f));
+}
+
 }  // namespace
 
-void add_flip_check_findings(HealthReport& h, const FlipCheckResult& r, const EstimatorConfig& cfg) {
-  if (r.flips == 0) return;
+void add_flip_check_findings(HealthReport& h, const FlipCheckResult& r, const EstimatorConfig& cfg,
+                             bool platforms_moved) {
   HealthReport first;
-  // a wrong unit or convention makes every number wrong: failed when most flips disagree
-  const HealthVerdict bad = 2 * r.disagree > r.flips ? HealthVerdict::kFailed : HealthVerdict::kDegraded;
+  // nothing measured although the platforms moved: the hinge axes and angle signs went unchecked,
+  // and a wrong one makes every estimate wrong (degraded: the estimate may yet be right)
+  if (r.flips == 0) {
+    if (!platforms_moved && r.windows == 0 && r.clipped == 0) return;
+    HealthFinding f;
+    f.cause = HealthCause::kFlipsUnchecked;
+    f.count = r.clipped_unusable;
+    f.suggested = double(r.windows);
+    add(first, std::move(f));
+    put_first(h, std::move(first));
+    return;
+  }
   const bool flip_updates = cfg.self_calibration && cfg.flip_updates;
   const HealthVerdict selfcal = flip_updates ? HealthVerdict::kDegraded : HealthVerdict::kOk;
   for (FlipTurn k : {FlipTurn::kGyroRadPerS, FlipTurn::kAngleRadians, FlipTurn::kTimeMs, FlipTurn::kTimeUs}) {
-    add_flip_kind(first, r, k, {1, 2}, bad);
+    add_flip_kind(first, r, k, {1, 2});
   }
   const bool unit_error = !first.findings.empty();
   // by kind, then platform: a stuck platform's wrong angle also spoils the resting frame in the
   // other platform's flips (the box's rate leaks into their turn: kOther), so the causes go first
   for (FlipTurn k : {FlipTurn::kSwapped, FlipTurn::kStuck, FlipTurn::kSign, FlipTurn::kAxis, FlipTurn::kOther}) {
-    for (int p = 1; p <= 2; ++p) add_flip_kind(first, r, k, {p}, bad);
+    for (int p = 1; p <= 2; ++p) add_flip_kind(first, r, k, {p});
   }
   for (int p = 1; p <= 2; ++p) {
     // the flip updates take Δθ modulo 360 with the turn the gyros saw: wrapped flips are used, a note
-    add_flip_kind(first, r, FlipTurn::kWrapped, {p}, HealthVerdict::kOk);
+    add_flip_kind(first, r, FlipTurn::kWrapped, {p}, true);
     // a scale error along the hinge beyond 3 sigma of its prior: the flip gate rejects its flips
-    const PlatformFlipSummary& s = r.platform[static_cast<std::size_t>(p - 1)];
-    const double ratio = s.median_ratio[static_cast<int>(FlipTurn::kAgrees)];
-    if (!unit_error && s.of(FlipTurn::kAgrees) >= 2 && std::fabs(ratio - 1.0) > 3.0 * cfg.scale_misalign_sigma_frac) {
-      HealthFinding f;
-      f.cause = HealthCause::kFlipScale;
-      f.severity = selfcal;
-      f.value = ratio;
-      // the spread's standard error and what the rest before each flip cannot take out: the
-      // g-sensitivity's change as the platform turns (its prior x 1 g over the window), in quadrature
-      f.sigma = std::hypot(s.median_ratio_sigma[static_cast<int>(FlipTurn::kAgrees)],
-                           cfg.gsens_sigma_dps_per_g * s.rate_to_ratio_s_per_deg);
-      f.components = {p};
-      f.count = s.of(FlipTurn::kAgrees);
-      f.suggested = double(s.flips);
-      add(first, std::move(f));
-    }
+    if (!unit_error) add_flip_scale(first, r.platform[static_cast<std::size_t>(p - 1)], p, cfg, selfcal);
   }
   // flips longer than flip_max_s never become flip updates
   const std::uint64_t slow = r.platform[0].slower_than_max + r.platform[1].slower_than_max;
@@ -227,6 +256,36 @@ void add_flip_setup_findings(HealthReport& h, const BoxGeometry& box,
   put_first(h, std::move(first));
 }
 
+void add_short_standstill_finding(HealthReport& h, const StandstillDetector::ShortRests& rests,
+                                  double min_standstill_s, std::uint64_t updates, std::size_t positions) {
+  if (rests.count < kTooShortRests || (updates > 0 && positions > 1)) return;
+  // the platforms did rest and move: "never rested" and "never moved" would point the wrong way
+  std::erase_if(h.findings, [](const HealthFinding& f) {
+    return f.cause == HealthCause::kNoUpdate || f.cause == HealthCause::kNeverFlipped;
+  });
+  HealthFinding f;
+  f.cause = HealthCause::kStandstillsTooShort;
+  f.severity = HealthVerdict::kFailed;
+  f.count = rests.count;
+  f.value = rests.longest_usable_s;
+  f.sigma = min_standstill_s;
+  f.suggested = rests.longest_logged_s;
+  f.positions_deg = {{rests.mean_logged_s(), rests.longest_logged_s}};
+  HealthReport first;
+  add(first, std::move(f));
+  put_first(h, std::move(first));
+  h.verdict = HealthVerdict::kFailed;
+}
+
+void add_no_rows_finding(HealthReport& h) {
+  HealthFinding f;
+  f.cause = HealthCause::kNoDataRows;
+  f.severity = HealthVerdict::kFailed;
+  h.findings.clear();
+  h.findings.push_back(std::move(f));
+  h.verdict = HealthVerdict::kFailed;
+}
+
 void add_angle_jitter_finding(HealthReport& h, const StandstillDetector::AngleJitter& j, double tolerance_deg) {
   if (j.samples == 0 || 2 * j.jittery <= j.samples) return;
   HealthFinding f;
@@ -253,6 +312,33 @@ bool stamp_rate_off(double stated_hz, double median_hz, double mean_hz) {
   const auto off = [stated_hz](double hz) { return std::fabs(hz / stated_hz - 1.0) > kStampRateTolerance; };
   return std::isfinite(stated_hz) && std::isfinite(median_hz) && std::isfinite(mean_hz) && off(median_hz) &&
          off(mean_hz);
+}
+
+double stamp_unit_to_s(double median_interval_s, std::uint64_t rows) {
+  if (!(median_interval_s > kMaxPlausibleIntervalS) || rows < kStampUnitMinRows) return kNaN;
+  for (double f : {1e-3, 1e-6, 1e-9}) {
+    if (median_interval_s * f <= 1.0) return f;
+  }
+  return kNaN;  // beyond a nanosecond clock's: not a unit mistake that can be named
+}
+
+void add_stamp_unit_finding(HealthReport& h, double stated_hz, double median_hz, std::uint64_t rows) {
+  if (std::isfinite(stated_hz) || !(median_hz > 0.0)) return;
+  // the flip-turn check measured the unit already (flip_time_unit): one finding says it
+  for (const HealthFinding& g : h.findings) {
+    if (g.cause == HealthCause::kFlipTimeUnit) return;
+  }
+  const double to_s = stamp_unit_to_s(1.0 / median_hz, rows);
+  if (std::isnan(to_s)) return;
+  HealthFinding f;
+  f.cause = HealthCause::kStampUnit;
+  f.severity = HealthVerdict::kFailed;
+  f.value = 1.0 / median_hz;
+  f.suggested = to_s;
+  f.count = rows;
+  HealthReport first;
+  add(first, std::move(f));
+  put_first(h, std::move(first));
 }
 
 void add_stamp_rate_finding(HealthReport& h, double stated_hz, double median_hz, double mean_hz) {

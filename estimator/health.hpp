@@ -102,6 +102,9 @@ enum class HealthCause {
   kFlipScale,            // 1 ± a few % beyond 3 sigma of the scale prior (value: the median ratio;
                          // sigma: its standard error from the flips' spread, NaN below 3 flips,
                          // and the g-sensitivity prior's change over a flip, in quadrature)
+  kFlipsUnchecked,       // the platforms moved, but no flip could be measured: the hinge axes and
+                         // angle signs were not checked (degraded; count: flips left out because a
+                         // gyro clipped them beyond reading, suggested: motions between two rests)
   kFlipsTooSlow,         // flips longer than flip_max_s (value: the longest, s): no flip update
   kBoxNotAtRest,         // --box-at-rest, yet the box turned while both platforms rested
                          // (box_motion_check.hpp): value = ref_q's largest turn rate over a
@@ -136,6 +139,14 @@ enum class HealthCause {
                          // count = flips skipped, suggested = flip updates used, value = ref_q's
                          // largest turn rate over a standstill (deg/s; NaN: no ref_q)
                          // ... (accel_check.hpp: calib_uncertainty)
+  kStandstillsTooShort,  // the platforms rested, but (nearly) every rest was shorter than
+                         // min_standstill_s once settle_s and end_margin_s are taken off (failed;
+                         // count: such rests, value: their longest usable part, s, sigma:
+                         // min_standstill_s, suggested: the longest rest as logged, s)
+  kNoDataRows,           // the log has a header and no data rows (failed)
+  kStampUnit,            // no sample_rate_hz, and the stamps' median interval makes sense only in
+                         // another unit (failed; value: the interval as read, "s"; suggested: the
+                         // factor to seconds, 1e-3 / 1e-6 / 1e-9; count: rows)
 };
 
 /// One check that did not pass, with the numbers that describe() turns into text.
@@ -244,6 +255,20 @@ bool stamp_rate_off(double stated_hz, double median_hz, double mean_hz);
 /// wrong key), degraded otherwise.
 void add_stamp_rate_finding(HealthReport& h, double stated_hz, double median_hz, double mean_hz);
 
+/// Stamps whose median interval no gyro log in seconds has: above kMaxPlausibleIntervalS (a box
+/// sampled that slowly cannot resolve a flip of a second or two, and a bias-estimation log is not
+/// sampled below 0.5 Hz) over at least kStampUnitMinRows rows. The likely unit is the first of
+/// ms, us, ns that puts the interval at or below 1 s (1 Hz .. 1 GHz); ms stamps at 500 Hz or more
+/// read 2 "s" or less and are not caught here (the flip-turn check's flip_time_unit is).
+inline constexpr double kMaxPlausibleIntervalS = 2.0;
+inline constexpr std::uint64_t kStampUnitMinRows = 1000;
+/// The factor that takes such stamps to seconds (1e-3, 1e-6, 1e-9), or NaN when they are plausible.
+double stamp_unit_to_s(double median_interval_s, std::uint64_t rows);
+/// Puts a failed `stamp_unit` finding first when no rate is stated (`stated_hz` NaN) and
+/// stamp_unit_to_s() names a unit (with a stated rate, `stamp_rate` says it; with a
+/// `flip_time_unit` finding in h, that one).
+void add_stamp_unit_finding(HealthReport& h, double stated_hz, double median_hz, std::uint64_t rows);
+
 /// Hinges closer than this to parallel (deg) cannot observe the bias along their common line.
 inline constexpr double kParallelHingesDeg = 10.0;
 /// Two causes of `never_locked` that more flips cannot cure, put first (failed): parallel hinge
@@ -306,12 +331,25 @@ void put_findings_first(HealthReport& h, std::vector<HealthFinding> first);
 void add_paper_mode_findings(HealthReport& h, const FilterCounters& counters, double flip_angle_deg);
 
 /// The flip-turn check's findings (flip_check.hpp), ahead of the others (a wrong unit, a stuck
-/// platform or a wrong hinge makes the updates wrong): `failed` when most flips disagree with
-/// their angle columns, else `degraded`; a one-way platform's wrapped flips are a note (the flip
-/// updates take Δθ modulo 360, flip_update.hpp); a scale error along a hinge beyond 3 sigma of the
-/// prior and flips slower than flip_max_s are `degraded` with --selfcal (whose flip updates they
-/// defeat), notes without it.
-void add_flip_check_findings(HealthReport& h, const FlipCheckResult& r, const EstimatorConfig& cfg);
+/// platform or a wrong hinge makes the updates wrong): `failed` when most of the flips of the
+/// platform a finding names disagree with its angle column (both platforms' for a unit), else
+/// `degraded`; a one-way platform's wrapped flips are a note (the flip updates take Δθ modulo 360,
+/// flip_update.hpp); a scale error along a hinge beyond 3 sigma of the prior and flips slower than
+/// flip_max_s are `degraded` with --selfcal (whose flip updates they defeat), notes without it.
+/// No flip measured although the platforms moved (`platforms_moved`, or motion the check saw):
+/// `flips_unchecked` (degraded), a wrong header never passes unchecked and unsaid.
+void add_flip_check_findings(HealthReport& h, const FlipCheckResult& r, const EstimatorConfig& cfg,
+                             bool platforms_moved = false);
+
+/// Standstills too short to use: no update, or every update at one position pair while this many
+/// rests or more were discarded as shorter than min_standstill_s: `standstills_too_short` (failed),
+/// which replaces `no_update` / `never_flipped` (the platforms did move). `rests`: the detector's.
+inline constexpr std::uint64_t kTooShortRests = 4;
+void add_short_standstill_finding(HealthReport& h, const StandstillDetector::ShortRests& rests,
+                                  double min_standstill_s, std::uint64_t updates, std::size_t positions);
+
+/// A log with a header and no data rows: `no_data_rows` (failed) replaces every other finding.
+void add_no_rows_finding(HealthReport& h);
 
 /// Watches the updates of one pass and gives the verdict at the end.
 class HealthMonitor {

@@ -320,6 +320,9 @@ void add_input_findings(const log::Metadata& meta, const log::LogReader* reader,
   if (sum.health.verdict != HealthVerdict::kOk) {
     add_flip_setup_findings(sum.health, filter.geometry(), positions, sum.counters.updates);
   }
+  // rests shorter than min_standstill_s: the cause of no update, or of updates at one position only
+  add_short_standstill_finding(sum.health, filter.standstill().short_rests(), cfg.min_standstill_s,
+                               sum.counters.updates, positions.size());
   if (cfg.standstill == StandstillSource::kPlatformColumns && sum.counters.updates == 0) {
     add_angle_jitter_finding(sum.health, filter.standstill().angle_jitter(), cfg.angle_tolerance_deg);
   }
@@ -329,6 +332,7 @@ void add_input_findings(const log::Metadata& meta, const log::LogReader* reader,
   if (reader != nullptr) {
     add_stamp_rate_finding(sum.health, meta.sample_rate_hz(), reader->stamp_rate_median_hz(),
                            reader->stamp_rate_mean_hz());
+    add_stamp_unit_finding(sum.health, meta.sample_rate_hz(), reader->stamp_rate_median_hz(), reader->rows_read());
     add_saturation_findings(sum.health, reader->suspected_clipping(), reader->rows_read());
     add_dead_axis_findings(sum.health, reader->dead_channels());
   }
@@ -469,7 +473,9 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
   name_prior_rejection(sum.health, first_update);
   // the flip check's findings first: the input findings put first lead them (a clipping gyro or
   // rests away from the stops make the flip turns disagree with the angles)
-  add_flip_check_findings(sum.health, flips.finish(), cfg);
+  // (a fixed schedule of positions has no motion in it to check: not "unchecked" there)
+  add_flip_check_findings(sum.health, flips.finish(), cfg,
+                          positions.size() > 1 && cfg.standstill != StandstillSource::kSchedule);
   add_input_findings(meta, reader, cfg, filter, positions, sum);
   add_reference_finding(sum.health, sum.reference);
   sum.box_motion = box_motion.finish();
@@ -483,6 +489,8 @@ EstimateSummary run_pass(const log::Metadata& meta, std::uint32_t fields, const 
   if (check_accel) add_accel_findings(sum.health, accel_check.finish(), cfg.self_calibration);
   // an uncertain calibration applied as exact (no self-calibration to refine it) leads them all
   if (!cfg.self_calibration) add_calib_finding(sum.health, cfg.calibration);
+  // a header and no data: nothing else can be said
+  if (sum.rows == 0) add_no_rows_finding(sum.health);
   return sum;
 }
 

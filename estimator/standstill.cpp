@@ -153,6 +153,7 @@ StandstillStep StandstillDetector::push(const Sample& s, double dt_s, const Eige
       end_standstill();
       start_segment(s.t_s, st.plat1_deg, st.plat2_deg, seg_tag_);
     }
+    t_rest_last_s_ = s.t_s;
     if (s.t_s - seg_.t_rest_s < cfg_.settle_s) {
       st.state = StandstillStep::State::kSettling;
     } else {
@@ -207,9 +208,19 @@ void StandstillDetector::close_segment(SegmentEnd why) {
   if (s.n == 0 || !finite(rate) || duration + 1e-9 < cfg_.min_standstill_s) {
     ++too_short_;
     discarded_last_ = true;
+    note_short_rest(finite(t_rest_last_s_) ? t_rest_last_s_ - s.t_rest_s : 0.0, duration);
     return;
   }
   hand_over(s);
+}
+
+// a rest too short to use: its length as logged and the part that was left of it
+void StandstillDetector::note_short_rest(double logged_s, double usable_s) {
+  ++short_rests_.count;
+  if (!finite(logged_s) || logged_s < 0.0) logged_s = 0.0;
+  short_rests_.sum_logged_s += logged_s;
+  short_rests_.longest_logged_s = std::max(short_rests_.longest_logged_s, logged_s);
+  if (finite(usable_s)) short_rests_.longest_usable_s = std::max(short_rests_.longest_usable_s, usable_s);
 }
 
 void StandstillDetector::hand_over(const StandstillSegment& seg) {

@@ -97,6 +97,14 @@ class StandstillDetector {
   const StandstillSegment& closed(int i) const { return closed_[static_cast<std::size_t>(i)]; }
   /// Standstills too short to use (min_standstill_s), since construction.
   std::uint64_t too_short() const { return too_short_; }
+  /// Those rests' lengths: as logged (first to last resting sample, s) and the part left once
+  /// settle_s and end_margin_s are taken off (s), the longest of each and the logged mean.
+  struct ShortRests {
+    std::uint64_t count = 0;
+    double longest_logged_s = 0.0, longest_usable_s = 0.0, sum_logged_s = 0.0;
+    double mean_logged_s() const { return count > 0 ? sum_logged_s / double(count) : kNaN; }
+  };
+  const ShortRests& short_rests() const { return short_rests_; }
   /// A standstill was discarded by the last push()/finish() (paper mode counts it as a step).
   bool discarded_last() const { return discarded_last_; }
   /// 'standstill: gyro': flips in which both platforms moved at once, since construction.
@@ -130,6 +138,7 @@ class StandstillDetector {
   void accumulate(const Pending& p);
   void commit(const Pending& p);
   void hand_over(const StandstillSegment& seg);
+  void note_short_rest(double logged_s, double usable_s);
   static Pending pending_of(const Sample& s);
 
   EstimatorConfig cfg_;
@@ -150,6 +159,8 @@ class StandstillDetector {
   bool discarded_last_ = false;
   std::int64_t seg_tag_ = 0;  // schedule slot of the sample being pushed
   std::uint64_t too_short_ = 0;
+  double t_rest_last_s_ = kNaN;  // s, the last resting sample of the segment in progress
+  ShortRests short_rests_;
 };
 
 }  // namespace driftless::est

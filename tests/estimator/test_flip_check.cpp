@@ -27,6 +27,8 @@ struct Mistakes {
   bool oneway = false;        // every flip +180, the angle column wrapped to [-180, 180)
   Eigen::Vector3d header_hinge1 = Eigen::Vector3d::UnitZ();  // the header's hinge 1 (truth: z)
   double flip_s = 1.0;        // s, each flip's length
+  double clip_dps = 0.0;      // > 0: every reading clamped to +- this (a gyro's range; the raised
+                              // cosine's 1 s, 180 deg flip peaks at 360 deg/s)
   // deg/s, biases left in the columns (a caller whose filter has not observed them: the check takes
   // them from the rest before each flip)
   Eigen::Vector3d bias1 = Eigen::Vector3d::Zero(), bias2 = Eigen::Vector3d::Zero();
@@ -69,6 +71,10 @@ class Rig {
     y1 += m_.bias1;
     y2 += m_.bias2;
     if (m_.swap) std::swap(y1, y2);
+    if (m_.clip_dps > 0.0) {
+      y1 = y1.cwiseMax(-m_.clip_dps).cwiseMin(m_.clip_dps);
+      y2 = y2.cwiseMax(-m_.clip_dps).cwiseMin(m_.clip_dps);
+    }
     const double c1 = m_.oneway ? wrap_deg(col1_) : col1_, c2 = m_.oneway ? wrap_deg(col2_) : col2_;
     if (!check_.push(t_s_ * m_.time_factor, m_.gyro_factor * y1, m_.gyro_factor * y2, m_.angle_factor * c1,
                      m_.angle_factor * c2, both_rest)) {
@@ -261,6 +267,107 @@ TEST(FlipCheckTest, FindingsComeFirstAndFailWhenMostFlipsDisagree) {
   add_flip_check_findings(clean, run(Mistakes{}), cfg);
   EXPECT_TRUE(clean.findings.empty());
   EXPECT_EQ(clean.verdict, HealthVerdict::kOk);
+}
+
+// the raised cosine of 180 deg over 1 s, 180 (1 - cos 2 pi t) deg/s, is above 250 deg/s for t in
+// (t_c, 1 - t_c), t_c = acos(-25/18) / 2 pi = 0.3136: clipped there it integrates to 180 - 26.7 =
+// 153.3 deg, 0.852 of the turn; the box's rate on the clipped channel and the sampling move it by
+// under 0.02
+constexpr double kClippedRatio = 0.852;
+
+// GIVEN a gyro range of +-250 deg/s that every 1 s flip exceeds (the MPU6050 of the outsider's
+// probe) WHEN checked THEN every flip is measured, flagged clipped, agrees with its turn read short
+// (0.852 of Δθ), and none enters the scale's median: no flip_scale finding, though 0.85 is 15
+// sigma of scale_misalign_sigma_frac 0.01. Before, every such flip was left out unsaid.
+TEST(FlipCheckTest, ClippedFlipsAreMeasuredForAxisAndSignNotScale) {
+  Mistakes m;
+  m.clip_dps = 250.0;
+  Rig rig(m, 5.0);
+  rig.run(6);
+  const FlipCheckResult r = rig.result();
+  EXPECT_EQ(r.flips, 6u);
+  EXPECT_EQ(r.clipped, 6u);
+  EXPECT_EQ(r.clipped_unusable, 0u);
+  EXPECT_EQ(count(r, FlipTurn::kAgrees), 6u);
+  EXPECT_EQ(r.platform[0].scale_flips + r.platform[1].scale_flips, 0u);
+  for (const FlipTurnRecord& f : rig.check().records()) {
+    EXPECT_TRUE(f.clipped);
+    EXPECT_NEAR(f.ratio, kClippedRatio, 0.02);
+  }
+  EstimatorConfig cfg;
+  cfg.self_calibration = true;
+  cfg.scale_misalign_sigma_frac = 0.01;
+  HealthReport h;
+  add_flip_check_findings(h, r, cfg, true);
+  EXPECT_TRUE(h.findings.empty());
+  EXPECT_EQ(h.verdict, HealthVerdict::kOk);
+}
+
+// GIVEN the same clipping gyro with the header's hinge 1 90 deg off, or the angle sign reversed
+// WHEN checked THEN the clipped flips still give the wrong axis (measured z, cos > 0.99) and the
+// sign (ratio -0.852), and the findings are failed: every flip of the platform named disagrees
+TEST(FlipCheckTest, ClippedFlipsStillGiveAWrongHingeAndSign) {
+  Mistakes axis, sign;
+  axis.clip_dps = sign.clip_dps = 250.0;
+  axis.header_hinge1 = Eigen::Vector3d::UnitX() + Eigen::Vector3d::UnitY();
+  sign.angle_factor = -1.0;
+  const FlipCheckResult a = run(axis);
+  EXPECT_EQ(a.platform[0].of(FlipTurn::kAxis), 3u);
+  EXPECT_EQ(a.platform[1].of(FlipTurn::kAgrees), 3u);
+  EXPECT_GT(a.platform[0].axis_sensor.dot(Eigen::Vector3d::UnitZ()), 0.99);
+  const FlipCheckResult s = run(sign);
+  EXPECT_EQ(count(s, FlipTurn::kSign), 6u);
+  EXPECT_NEAR(s.platform[0].median_ratio[static_cast<int>(FlipTurn::kSign)], -kClippedRatio, kFrameLeak);
+  EstimatorConfig cfg;
+  HealthReport ha, hs;
+  add_flip_check_findings(ha, a, cfg, true);
+  ASSERT_FALSE(ha.findings.empty());
+  EXPECT_EQ(ha.findings[0].cause, HealthCause::kFlipAxis);
+  EXPECT_EQ(ha.findings[0].severity, HealthVerdict::kFailed);
+  add_flip_check_findings(hs, s, cfg, true);
+  ASSERT_FALSE(hs.findings.empty());
+  EXPECT_EQ(hs.findings[0].cause, HealthCause::kFlipAngleSign);
+  EXPECT_EQ(hs.verdict, HealthVerdict::kFailed);
+}
+
+// GIVEN a wrong hinge on platform 1 only: 3 of its 3 flips disagree, 3 of platform 2's agree
+// (3 of 6 in all) WHEN the findings are made THEN flip_axis is failed: most of the named
+// platform's flips disagree (docs/estimator.md section 6.4); before, 3 of 6 was not "most": degraded
+TEST(FlipCheckTest, AWrongHingeOnOnePlatformFails) {
+  Mistakes axis;
+  axis.header_hinge1 = Eigen::Vector3d::UnitX() + Eigen::Vector3d::UnitY();
+  const FlipCheckResult a = run(axis);
+  ASSERT_EQ(a.disagree, 3u);
+  ASSERT_EQ(a.flips, 6u);
+  HealthReport h;
+  add_flip_check_findings(h, a, EstimatorConfig{}, true);
+  ASSERT_EQ(h.findings.size(), 1u);
+  EXPECT_EQ(h.findings[0].cause, HealthCause::kFlipAxis);
+  EXPECT_EQ(h.findings[0].severity, HealthVerdict::kFailed);
+  EXPECT_EQ(h.verdict, HealthVerdict::kFailed);
+}
+
+// GIVEN no flip measured WHEN the platforms moved (motion between rests, or clipped beyond reading)
+// THEN flips_unchecked (degraded) says so; WHEN they never moved THEN nothing (never_flipped says it)
+TEST(FlipCheckTest, NoMeasuredFlipIsSaidWhenThePlatformsMoved) {
+  FlipCheckResult none;
+  HealthReport quiet;
+  add_flip_check_findings(quiet, none, EstimatorConfig{}, false);
+  EXPECT_TRUE(quiet.findings.empty());
+  FlipCheckResult both;
+  both.windows = 5;  // e.g. both platforms flipped at once every time
+  HealthReport h;
+  add_flip_check_findings(h, both, EstimatorConfig{}, true);
+  ASSERT_EQ(h.findings.size(), 1u);
+  EXPECT_EQ(h.findings[0].cause, HealthCause::kFlipsUnchecked);
+  EXPECT_EQ(h.findings[0].severity, HealthVerdict::kDegraded);
+  EXPECT_EQ(h.findings[0].suggested, 5.0);
+  FlipCheckResult clipped;
+  clipped.windows = clipped.clipped = clipped.clipped_unusable = 4;
+  HealthReport hc;
+  add_flip_check_findings(hc, clipped, EstimatorConfig{}, false);
+  ASSERT_EQ(hc.findings.size(), 1u);
+  EXPECT_EQ(hc.findings[0].count, 4u);
 }
 
 }  // namespace

@@ -146,10 +146,12 @@ TEST(HealthTest, NoStandstillFails) {
   p.duration_s = 120.0;
   p.standstill_s = 1.2;
   const auto s = run_synth(p, "no_standstill.csv");
-  // THEN no update is made and the verdict is failed for that reason
+  // THEN no update is made and the verdict is failed for that reason, named as such: the rests
+  // were too short (standstills_too_short), not "no standstill" (no_update, which it replaces)
   EXPECT_EQ(s.health.updates, 0u);
   EXPECT_EQ(s.health.verdict, HealthVerdict::kFailed);
-  EXPECT_TRUE(has(s.health, HealthCause::kNoUpdate));
+  EXPECT_TRUE(has(s.health, HealthCause::kStandstillsTooShort));
+  EXPECT_FALSE(has(s.health, HealthCause::kNoUpdate));
 }
 
 TEST(HealthTest, RejectionsAtOnePositionNameThePosition) {
@@ -378,6 +380,48 @@ TEST(HealthTest, ALockAtTheEndOfTheLogIsDegradedNotOk) {
     return w.find("locked on only at t =") != std::string::npos;
   });
   EXPECT_TRUE(said) << (end.warnings.empty() ? std::string("no warning") : end.warnings.front());
+}
+
+
+// GIVEN median stamp intervals as a log in ms, us or ns at 100 Hz reads them (10, 1e4, 1e7 "s") over
+// 60000 rows WHEN judged THEN each names its unit exactly; 1 s (a slow log, or ms at 1 kHz), a
+// 10 "s" interval over 10 rows, and 1e13 (no clock's unit) name none
+TEST(HealthTest, StampIntervalsOnlyAnotherUnitExplainsNameIt) {
+  EXPECT_EQ(stamp_unit_to_s(10.0, 60000), 1e-3);
+  EXPECT_EQ(stamp_unit_to_s(1e4, 60000), 1e-6);
+  EXPECT_EQ(stamp_unit_to_s(1e7, 60000), 1e-9);
+  EXPECT_TRUE(std::isnan(stamp_unit_to_s(1.0, 60000)));
+  EXPECT_TRUE(std::isnan(stamp_unit_to_s(10.0, 10)));
+  EXPECT_TRUE(std::isnan(stamp_unit_to_s(1e13, 60000)));
+  // a stated rate leaves it to stamp_rate; none: a failed stamp_unit finding first
+  HealthReport stated, none;
+  add_stamp_unit_finding(stated, 100.0, 0.1, 60000);
+  EXPECT_TRUE(stated.findings.empty());
+  add_stamp_unit_finding(none, kNaN, 1e-7, 60000);
+  ASSERT_EQ(none.findings.size(), 1u);
+  EXPECT_EQ(none.findings[0].cause, HealthCause::kStampUnit);
+  EXPECT_EQ(none.findings[0].suggested, 1e-9);
+  EXPECT_EQ(none.verdict, HealthVerdict::kFailed);
+}
+
+// GIVEN a synthetic log whose rests (0.6 s) are shorter than settle_s 0.5 + min_standstill_s 1 +
+// end_margin_s 0.1 WHEN estimated THEN the verdict is failed with standstills_too_short first,
+// naming the rests' longest length as logged (0.6 s to a sample) and min_standstill_s, and neither
+// no_update nor never_flipped ("the platforms never moved") is left
+TEST(HealthTest, RestsShorterThanMinStandstillAreNamed) {
+  test::SynthParams p;
+  p.duration_s = 120.0;
+  p.standstill_s = 0.6;
+  const EstimateSummary s = run_synth(p, "short_rests.csv");
+  ASSERT_FALSE(s.health.findings.empty());
+  EXPECT_EQ(s.health.verdict, HealthVerdict::kFailed);
+  const HealthFinding& f = s.health.findings.front();
+  EXPECT_EQ(f.cause, HealthCause::kStandstillsTooShort);
+  EXPECT_GE(f.count, kTooShortRests);
+  EXPECT_NEAR(f.suggested, 0.6, 1.5 / p.rate_hz);
+  EXPECT_EQ(f.sigma, 1.0);
+  EXPECT_FALSE(has(s.health, HealthCause::kNoUpdate));
+  EXPECT_FALSE(has(s.health, HealthCause::kNeverFlipped));
 }
 
 }  // namespace
