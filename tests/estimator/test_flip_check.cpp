@@ -347,6 +347,27 @@ TEST(FlipCheckTest, AWrongHingeOnOnePlatformFails) {
   EXPECT_EQ(h.verdict, HealthVerdict::kFailed);
 }
 
+// GIVEN 42 flips of platform 2, one of them about another axis (the twin's Fig. 9 pan/tilt: a jolt
+// of the moving box during it) WHEN the findings are made THEN flip_axis is a note (no header error
+// shows in 1 of 42), and degraded from 3 of 42 (more than one in 20); failed past half
+TEST(FlipCheckTest, ALoneDisagreeingFlipAmongManyIsANote) {
+  for (const auto& [bad, want] : {std::pair{1u, HealthVerdict::kOk}, std::pair{2u, HealthVerdict::kOk},
+                                  std::pair{3u, HealthVerdict::kDegraded}, std::pair{22u, HealthVerdict::kFailed}}) {
+    FlipCheckResult r;
+    PlatformFlipSummary& s = r.platform[1];
+    s.flips = 42;
+    s.count[static_cast<int>(FlipTurn::kAgrees)] = 42 - bad;
+    s.count[static_cast<int>(FlipTurn::kAxis)] = bad;
+    r.flips = 42;
+    r.disagree = bad;
+    HealthReport h;
+    add_flip_check_findings(h, r, EstimatorConfig{}, true);
+    ASSERT_EQ(h.findings.size(), 1u) << bad;
+    EXPECT_EQ(h.findings[0].cause, HealthCause::kFlipAxis) << bad;
+    EXPECT_EQ(h.findings[0].severity, want) << bad;
+  }
+}
+
 // GIVEN no flip measured WHEN the platforms moved (motion between rests, or clipped beyond reading)
 // THEN flips_unchecked (degraded) says so; WHEN they never moved THEN nothing (never_flipped says it)
 TEST(FlipCheckTest, NoMeasuredFlipIsSaidWhenThePlatformsMoved) {
