@@ -165,8 +165,10 @@ int report_health(const EstimateArgs& a, const est::EstimatorConfig& cfg, const 
   for (const auto& l : lines) fmt::print(bad ? stderr : stdout, "{}{}\n", bad ? "driftless estimate: " : "  ", l);
   if (h.verdict == est::HealthVerdict::kFailed) {
     // the first finding is the cause (never locked, clipping, a schedule paper mode does not fit, ...)
+    const bool no_rows = !h.findings.empty() && h.findings.front().cause == est::HealthCause::kNoDataRows;
     fmt::print(stderr, "driftless estimate: health failed{}: the estimates are not usable (exit 1)\n",
-               !h.locked          ? ", the filter never locked"
+               no_rows            ? ", the log has no data rows"
+               : !h.locked        ? ", the filter never locked"
                : h.locked_at_end ? ""
                                  : ", the filter lost its lock and did not lock again");
     return kExitFailed;
@@ -191,6 +193,8 @@ void print_attitude_line(const est::EstimateSummary& summary) {
              summary.reference.verdict != est::RefFitVerdict::kNotChecked) {
     fmt::print("  attitude: withheld (ref_q does not turn with the gyros: see the health finding "
                "reference_mismatch)\n");
+  } else if (summary.attitude_available && !std::isfinite(summary.attitude_start_s)) {
+    fmt::print("  attitude: not compared (the filter never locked on: see the health verdict)\n");
   } else if (summary.attitude_available) {
     fmt::print("  attitude drift from t = {:.1f} s: {:.2f} deg/h with DriftLess, {:.2f} deg/h with the bias "
                "fixed at that start, {:.2f} deg/h uncorrected\n",

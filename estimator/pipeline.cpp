@@ -148,8 +148,11 @@ void add_filter_warnings(const DriftlessFilter& filter, EstimateSummary& sum) {
   }
   // paper mode's schedule and rest-angle mismatches are health findings (add_paper_mode_findings)
   for (const auto& r : sum.relocks) {
-    sum.warnings.push_back("the NIS gate rejected " + std::to_string(filter.config().gate_relock_after) +
-                           " updates in a row; the filter re-locked at t = " + std::to_string(r.t_s) +
+    // the last of them is not counted as rejected: the re-lock widens P and takes it
+    const int n = filter.config().gate_relock_after;
+    sum.warnings.push_back("the NIS gate refused " + std::to_string(n) + " updates in a row (" +
+                           std::to_string(n - 1) + " rejected; the last one taken after widening P); the filter "
+                           "re-locked at t = " + std::to_string(r.t_s) +
                            " s (NIS " + std::to_string(r.nis) + "): a bias jump, a new sensor, or a model "
                            "that does not fit these sensors; " +
                            (std::isfinite(r.locked_again_t_s)

@@ -17,6 +17,9 @@ verdict() { grep -o '"verdict": "[a-z]*"' "$1/summary.json" | cut -d'"' -f4; }
 [[ $? -eq 1 ]] || fail "--no-selfcal: expected exit 1: $(cat "$t/plain.err")"
 [[ $(verdict "$t/plain") == failed ]] || fail "--no-selfcal: verdict $(verdict "$t/plain")"
 grep -q -- "--selfcal" "$t/plain.err" || fail "--no-selfcal: the fix is not named: $(cat "$t/plain.err")"
+# AND the console says the attitude was not compared (no "nan deg/h" line)
+grep -q "attitude: not compared (the filter never locked on" "$t/plain.out" || fail "--no-selfcal: $(cat "$t/plain.out")"
+if grep -q "nan" "$t/plain.out"; then fail "--no-selfcal: a nan on the console: $(cat "$t/plain.out")"; fi
 grep -q '"self_calibration_choice": {"mode": "off", "tried": false' "$t/plain/summary.json" ||
   fail "--no-selfcal: the choice is not recorded: $(grep -o '"self_calibration_choice": {[^}]*' "$t/plain/summary.json")"
 # WHEN estimated with defaults THEN (docs/estimator.md section 1i) the six-state pass's rejections at
