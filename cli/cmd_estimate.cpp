@@ -1,11 +1,7 @@
 // driftless estimate: run the DriftLess filter over a measurement log and write the bias
 // estimates, corrected outputs, attitude drift and (for simulated logs) errors against truth.
 // Formats: docs/estimator.md.
-#include <atomic>
 #include <chrono>
-#include <exception>
-#include <functional>
-#include <optional>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -23,9 +19,9 @@
 #include "cli/estimate_figures.hpp"
 #include "cli/estimate_health.hpp"
 #include "cli/estimate_outputs.hpp"
+#include "cli/estimate_passes.hpp"
 #include "estimator/calibration.hpp"
 #include "estimator/pipeline.hpp"
-#include "estimator/selfcal_choice.hpp"
 #include "estimator/smoother.hpp"
 #include "estimator/tune.hpp"
 #include "calibration/calib_file.hpp"
@@ -55,8 +51,6 @@ struct EstimateArgs {
   std::string tune;       // "auto": noise density and bias wander from the log (docs/estimator.md section 6.2)
   double attitude_start_sigma_dps = est::EstimateRunOptions{}.attitude_start_sigma_dps;
 };
-
-bool stop_polled() { return stop_requested().load(); }
 
 // --calib-out / --prior-out: what the self-calibrating pass estimated, as calib.yaml and as a twin
 // model prior (docs/calibration.md "calib.yaml from a self-calibration")
@@ -243,237 +237,11 @@ void apply_calib(const EstimateArgs& a, const log::Metadata& meta, est::Estimato
   cfg.calibration = c.to_filter_calibration();
 }
 
-// the column groups a pass parses: the accelerometers only for a g-sensitivity calibration or
-// the self-calibration; the temperatures drive the bias temperature states
-log::ReaderOptions reader_options(const EstimateArgs& a, const est::EstimatorConfig& cfg) {
-  log::ReaderOptions read_opt;
-  read_opt.fields = kFieldRefQ | kFieldTrueBias | kFieldTemp;
-  if (!a.calib.empty() || cfg.self_calibration || cfg.box_at_rest) read_opt.fields |= kFieldAccel;
-  return read_opt;
-}
-
-// what drives the g-sensitivity states is in the log: both accel triads (by name: a pass without
-// the self-calibration does not parse them) or ref_q
-bool gravity_logged(const log::LogReader& reader) {
-  if ((reader.fields() & kFieldRefQ) != 0) return true;
-  for (const char* c : {"accel1_x", "accel1_y", "accel1_z", "accel2_x", "accel2_y", "accel2_z"}) {
-    if (reader.column_index(c) < 0) return false;
-  }
-  return true;
-}
-
-// The early sign that the six-state model fails (the self-calibrating pass then starts beside it on
-// the second core, so that a log that needs it costs about one pass of wall time, not two): at least
-// kEarlyRejectedFraction of the first kEarlyUpdates or more updates rejected. Only a head start: the
-// choice is made on the whole passes (estimator/selfcal_choice.hpp). Forwards everything to the files.
-constexpr std::uint64_t kEarlyUpdates = 12;
-constexpr double kEarlyRejectedFraction = 0.2;
-
-class EarlyWatch : public est::EstimateSink {
- public:
-  EarlyWatch(est::EstimateSink& next, std::function<void()> fire) : next_(next), fire_(std::move(fire)) {}
-  void on_sample(const Sample& s, const est::SampleOutput& o, bool locked) override { next_.on_sample(s, o, locked); }
-  void on_update(const est::UpdateRecord& r, const est::Matrix6d& P, const Sample& s, bool locked) override {
-    next_.on_update(r, P, s, locked);
-    ++updates_;
-    if (!r.accepted) ++rejected_;
-    if (!fired_ && updates_ >= kEarlyUpdates && double(rejected_) >= kEarlyRejectedFraction * double(updates_)) {
-      fired_ = true;
-      fire_();
-    }
-  }
-  void on_attitude(const est::AttitudePoint& p) override { next_.on_attitude(p); }
-
- private:
-  est::EstimateSink& next_;
-  std::function<void()> fire_;
-  std::uint64_t updates_ = 0, rejected_ = 0;
-  bool fired_ = false;
-};
-
-// one pass of the filter over the log into `dir`: its files stay uncommitted (a pass that is not
-// kept leaves nothing behind)
-struct EstimatePass {
-  est::EstimatorConfig cfg;
-  log::ReaderOptions read_opt;
-  std::unique_ptr<EstimateFiles> files;
-  std::unique_ptr<est::FixedIntervalSmoother> smoother;
-  est::EstimateSummary summary;
-  fs::path dir;
-};
-
-EstimatePass run_filter_pass(const EstimateArgs& a, const est::EstimatorConfig& cfg, log::LogReader& reader,
-                             const fs::path& dir, EstimateFilesOptions file_opt, bool (*should_stop)() = &stop_polled,
-                             const std::function<void()>& early = {}, bool progress = true) {
-  EstimatePass p;
-  p.cfg = cfg;
-  p.dir = dir;
-  p.read_opt = reader_options(a, cfg);
-  // the progress display reads the log's duration (none for the pass beside another)
-  file_opt.t_end_s = progress ? reader.metadata().get_number("duration_s", kNaN) : kNaN;
-  p.files = std::make_unique<EstimateFiles>(dir, file_opt);
-  est::EstimateRunOptions run_opt;
-  run_opt.attitude_start_sigma_dps = a.attitude_start_sigma_dps;
-  if (a.smooth) p.smoother = std::make_unique<est::FixedIntervalSmoother>(cfg.q_dps2_per_s());
-  run_opt.update_observer = p.smoother.get();
-  if (!early) {
-    p.summary = est::run_estimate(reader, cfg, p.files.get(), run_opt, should_stop);
-    return p;
-  }
-  EarlyWatch watch(*p.files, early);
-  p.summary = est::run_estimate(reader, cfg, &watch, run_opt, should_stop);
-  return p;
-}
-
-// the self-calibrating pass of the model choice, in DIR/.selfcal-pass: started beside the six-state
-// pass on the second core when that one fails early (EarlyWatch), or after it; abandoned (its files
-// discarded) when the choice does not want it. The destructor abandons a pass still running.
-class SelfcalPass {
- public:
-  SelfcalPass(const EstimateArgs& a, const est::EstimatorConfig& six_cfg, const fs::path& dir,
-              const EstimateFilesOptions& file_opt)
-      : a_(a), cfg_(six_cfg), staging_(dir / ".selfcal-pass"), file_opt_(file_opt) {
-    cfg_.self_calibration = true;
-    cfg_.validate();
-  }
-  ~SelfcalPass() { abandon(); }
-  SelfcalPass(const SelfcalPass&) = delete;
-  SelfcalPass& operator=(const SelfcalPass&) = delete;
-
-  /// Starts the pass on a thread of its own (no progress display: the six-state pass shows its own).
-  void start() {
-    if (thread_.joinable()) return;
-    started_ = true;
-    thread_ = std::thread([this] {
-      try {
-        result_ = run(&abandon_polled, false);
-      } catch (...) {
-        error_ = std::current_exception();
-      }
-    });
-  }
-  bool started() const { return started_; }
-  /// The pass's result: the one started early (joined), or a pass run now.
-  EstimatePass take() {
-    if (!thread_.joinable()) return run(&stop_polled, true);
-    thread_.join();
-    if (error_) std::rethrow_exception(error_);
-    return std::move(*result_);
-  }
-  /// Stops a pass still running and removes its folder.
-  void abandon() {
-    if (thread_.joinable()) {
-      abandoned().store(true);
-      thread_.join();
-      abandoned().store(false);
-    }
-    result_.reset();
-    if (started_) {
-      std::error_code ec;
-      fs::remove_all(staging_, ec);
-    }
-  }
-
- private:
-  static std::atomic<bool>& abandoned() {
-    static std::atomic<bool> flag{false};
-    return flag;
-  }
-  static bool abandon_polled() { return stop_requested().load() || abandoned().load(); }
-  EstimatePass run(bool (*should_stop)(), bool progress) {
-    started_ = true;
-    fs::create_directories(staging_);
-    log::LogReader again(a_.log, reader_options(a_, cfg_));
-    return run_filter_pass(a_, cfg_, again, staging_, file_opt_, should_stop, {}, progress);
-  }
-  const EstimateArgs& a_;
-  est::EstimatorConfig cfg_;
-  fs::path staging_;
-  EstimateFilesOptions file_opt_;
-  std::thread thread_;
-  std::optional<EstimatePass> result_;
-  std::exception_ptr error_;
-  bool started_ = false;
-};
-
-// the default model choice (estimator/selfcal_choice.hpp): when the six-state pass shows an error
-// the self-calibration models, the log again with it, in a folder of its own; the better pass is
-// kept. `choice` records what was done for summary.json.
-EstimatePass choose_model(const EstimateArgs& a, EstimatePass six, SelfcalPass& sc_pass, bool gravity,
-                          SelfcalChoice& choice) {
-  const est::SelfcalTrigger trig = est::selfcal_trigger(six.summary.health, gravity);
-  if (choice.mode != est::SelfcalMode::kAuto || !trig.wanted || stop_requested().load()) {
-    sc_pass.abandon();
-    return six;
-  }
-  if (!fs::is_regular_file(a.log)) {
-    // a stream (a FIFO) cannot be read a second time
-    fmt::print(stderr, "driftless estimate: the six-state model does not fit this log (finding {}), and the log is "
-                       "not a regular file, so it cannot be read again in the self-calibrating mode: save it and "
-                       "run with --selfcal\n", cause_key(trig.cause));
-    return six;
-  }
-  choice.tried = true;
-  choice.cause = trig.cause;
-  choice.six_state = six.summary.health;
-  const est::HealthReport& h = six.summary.health;
-  fmt::print(stderr,
-             "driftless estimate: the six-state model does not fit this log (verdict {}, finding {}; {} of {} "
-             "updates rejected, NIS mean {:.3g}): {} in the self-calibrating mode (--selfcal: g-sensitivity, "
-             "scale/misalignment and end-stop states; --no-selfcal keeps the six-state model)\n",
-             est::to_string(h.verdict), cause_key(trig.cause), h.rejected, h.updates, h.nis_mean,
-             sc_pass.started() ? "estimated beside it" : "estimating again");
-  EstimatePass sc = sc_pass.take();
-  choice.selfcal = sc.summary.health;
-  choice.interrupted = stop_requested().load();
-  choice.used = !choice.interrupted && est::selfcal_pass_better(sc.summary.health, six.summary.health);
-  if (!choice.used) {
-    sc.files.reset();  // discards its files
-    sc_pass.abandon();
-    return six;
-  }
-  six.files.reset();
-  return sc;
-}
-
 // config_used.txt: the configuration of the pass whose results the outputs hold
 void write_config_used(const fs::path& dir, const est::EstimatorConfig& cfg) {
   std::ostringstream used;
   est::write_estimator_config(used, cfg);
   io::write_file(dir / "config_used.txt", used.str());
-}
-
-// the kept pass's files into place: a self-calibrating pass wrote into its own folder
-void commit_pass(EstimatePass& p, const fs::path& dir) {
-  p.files->commit();
-  if (p.dir == dir) return;
-  for (const char* name : {"estimate.csv", "attitude.csv", "corrected.csv"}) {
-    if (fs::exists(p.dir / name)) fs::rename(p.dir / name, dir / name);
-  }
-  fs::remove_all(p.dir);
-}
-
-// the console line after a self-calibrating pass that was tried
-void print_choice(const SelfcalChoice& c) {
-  if (!c.tried) return;
-  const auto rej = [](const est::HealthReport& h) { return 100.0 * h.rejected_fraction; };
-  if (c.interrupted) {
-    fmt::print(stderr, "driftless estimate: the self-calibrating pass was interrupted: the outputs are the "
-                       "six-state pass's\n");
-  } else if (c.used) {
-    fmt::print("  self-calibration (auto): used; its verdict {} ({:.1f} % rejected) against the six-state "
-               "model's {} ({:.1f} % rejected)\n",
-               est::to_string(c.selfcal.verdict), rej(c.selfcal), est::to_string(c.six_state.verdict),
-               rej(c.six_state));
-  } else {
-    fmt::print(stderr,
-               "driftless estimate: self-calibration (auto) tried and not used: it fits no better (verdict {}, "
-               "{:.1f} % rejected, NIS mean {:.3g} against the top of its band {:.3g}; the six-state model: {}, "
-               "{:.1f} % rejected), so these are the six-state results; an excess both models leave is noise or "
-               "wander larger than configured, or an error neither models (see the findings)\n",
-               est::to_string(c.selfcal.verdict), rej(c.selfcal), c.selfcal.nis_mean, c.selfcal.nis_mean_band_hi,
-               est::to_string(c.six_state.verdict), rej(c.six_state));
-  }
 }
 
 // the console summary of the kept pass
@@ -527,7 +295,8 @@ int run_estimate_cmd(const EstimateArgs& a) {
   choice.mode = a.no_selfcal ? est::SelfcalMode::kOff : cfg.self_calibration ? est::SelfcalMode::kOn
                                                                              : est::SelfcalMode::kAuto;
   // the first pass's reader: its header and columns decide the outputs
-  log::LogReader reader(a.log, reader_options(a, cfg));
+  const PassInputs in{a.log, !a.calib.empty(), a.smooth, a.attitude_start_sigma_dps};
+  log::LogReader reader(a.log, reader_options(in, cfg));
   if (!a.calib.empty()) apply_calib(a, reader.metadata(), cfg);
   cfg.validate();
   est::TuneResult tune;
@@ -550,15 +319,7 @@ int run_estimate_cmd(const EstimateArgs& a) {
   file_opt.smoothed = a.smooth;
   file_opt.keep_series = a.plot;
   write_config_used(dir, cfg);
-  const bool gravity = gravity_logged(reader);
-  // in the automatic choice, the self-calibrating pass may start early, beside the six-state pass
-  SelfcalPass sc_pass(a, cfg, dir, file_opt);
-  std::function<void()> early;
-  if (choice.mode == est::SelfcalMode::kAuto && gravity && fs::is_regular_file(a.log)) {
-    early = [&sc_pass] { sc_pass.start(); };
-  }
-  EstimatePass pass = choose_model(a, run_filter_pass(a, cfg, reader, dir, file_opt, &stop_polled, early), sc_pass,
-                                   gravity, choice);
+  EstimatePass pass = run_passes(in, cfg, reader, dir, file_opt, choice);
   if (choice.used) write_config_used(dir, pass.cfg);
   const auto& summary = pass.summary;
   // --smooth: corrected.csv holds the smoother's rows only when its second pass ran to the end
