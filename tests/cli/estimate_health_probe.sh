@@ -16,16 +16,8 @@ set -uo pipefail
 bin=$1; src=$2
 # shellcheck source=lib/outsider_log.sh
 source "$src/tests/cli/lib/outsider_log.sh"
-nav="$py $src/tests/estimator/navgen.py"
-mut="$py $src/tests/estimator/mutate.py"
-
-# run NAME WANT_EXIT [estimate options]: estimate on $t/NAME.csv, exit code as expected
-run() {
-  local name=$1 want=$2; shift 2
-  "$bin" estimate --log "$t/$name.csv" --out "$t/o_$name" "$@" > "$t/$name.txt" 2>&1
-  local rc=$?
-  [ "$rc" = "$want" ] || { cat "$t/$name.txt"; fail "$name: exit $rc, expected $want"; }
-}
+# shellcheck source=lib/navgen_runs.sh
+source "$src/tests/cli/lib/navgen_runs.sh"
 # first_finding NAME CAUSE SEVERITY: the first health finding of that run that is not a note (the
 # clipping MPU6050's saturation notes lead) is CAUSE with SEVERITY
 first_finding() {
