@@ -196,13 +196,15 @@ std::string pass_health_json(const est::HealthReport& h) {
 
 // "self_calibration_choice": how the model was chosen (docs/estimator.md section 1i)
 std::string selfcal_choice_json(const SelfcalChoice& c) {
+  const bool ran = c.tried && c.error.empty();
   return fmt::format("  \"self_calibration_choice\": {{\"mode\": \"{}\", \"tried\": {}, \"used\": {}, "
-                     "\"interrupted\": {}, \"called_for_by\": {}, \"six_state\": {}, \"self_calibrating\": {}}}",
+                     "\"interrupted\": {}, \"error\": {}, \"called_for_by\": {}, \"six_state\": {}, "
+                     "\"self_calibrating\": {}}}",
                      est::to_string(c.mode), c.tried ? "true" : "false", c.used ? "true" : "false",
-                     c.interrupted ? "true" : "false",
+                     c.interrupted ? "true" : "false", c.error.empty() ? std::string("null") : json_string(c.error),
                      c.tried ? fmt::format("\"{}\"", cause_key(c.cause)) : std::string("null"),
                      c.tried ? pass_health_json(c.six_state) : std::string("null"),
-                     c.tried ? pass_health_json(c.selfcal) : std::string("null"));
+                     ran ? pass_health_json(c.selfcal) : std::string("null"));
 }
 
 }  // namespace

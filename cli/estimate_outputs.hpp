@@ -70,6 +70,7 @@ struct SelfcalChoice {
   bool tried = false;        // the self-calibrating pass ran after the six-state pass
   bool used = false;         // its results are the outputs
   bool interrupted = false;  // a stop came during it: the six-state pass's outputs stand
+  std::string error;         // it could not read the log (a column only it parses): the six-state outputs stand
   est::HealthCause cause = est::HealthCause::kNoUpdate;  // the six-state finding that called for it
   est::HealthReport six_state, selfcal;                  // the two passes' health (when tried)
 };

@@ -202,7 +202,16 @@ EstimatePass choose_model(const PassInputs& a, EstimatePass six, SelfcalPass& sc
              "scale/misalignment and end-stop states; --no-selfcal keeps the six-state model)\n",
              est::to_string(h.verdict), cause_key(trig.cause), h.rejected, h.updates, h.nis_mean,
              sc_pass.started() ? "estimated beside it" : "estimating again");
-  EstimatePass sc = sc_pass.take();
+  EstimatePass sc;
+  try {
+    sc = sc_pass.take();
+  } catch (const log::LogError& e) {
+    // the accel columns, which only the self-calibrating pass parses, may be what it refuses:
+    // the six-state results stand, and the reason is said (a full disk still ends the run)
+    choice.error = e.what();
+    sc_pass.discard(std::move(sc));
+    return six;
+  }
   choice.selfcal = sc.summary.health;
   choice.interrupted = stop_requested().load();
   choice.used = !choice.interrupted && est::selfcal_pass_better(sc.summary.health, six.summary.health);
@@ -243,7 +252,10 @@ void commit_pass(EstimatePass& p, const fs::path& dir) {
 void print_choice(const SelfcalChoice& c) {
   if (!c.tried) return;
   const auto rej = [](const est::HealthReport& h) { return 100.0 * h.rejected_fraction; };
-  if (c.interrupted) {
+  if (!c.error.empty()) {
+    fmt::print(stderr, "driftless estimate: the self-calibrating pass could not read the log ({}): these are the "
+                       "six-state results; fix the log (or --no-selfcal)\n", c.error);
+  } else if (c.interrupted) {
     fmt::print(stderr, "driftless estimate: the self-calibrating pass was interrupted: the outputs are the "
                        "six-state pass's\n");
   } else if (c.used) {

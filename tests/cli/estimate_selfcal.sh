@@ -49,6 +49,17 @@ grep -q '^self_calibration: true' "$t/auto/config_used.txt" || fail "defaults: c
 grep -q '"rejected": 0,' "$t/sc/summary.json" || fail "--selfcal: updates rejected"
 grep -q '"self_calibration": {"enabled": true' "$t/sc/summary.json" || fail "no self_calibration block"
 grep -q '"g_sensitivity_sigma_dps_per_g": \[\[\[' "$t/sc/summary.json" || fail "no G sigma in summary.json"
+# AND when only the self-calibrating pass can refuse the log (an accel value that is no number: the
+# six-state pass does not parse those columns) THEN the six-state results stand, the reason is said,
+# and summary.json carries it; nothing of the second pass is left behind
+awk -F, -v OFS=, '/^t,/ { for (i = 1; i <= NF; ++i) if ($i == "accel1_x") c = i; print; next }
+  !/^#/ && ++n == 30000 { $c = "abc" } { print }' "$t/sim/log.csv" > "$t/bad_accel.csv"
+"$bin" estimate --log "$t/bad_accel.csv" --out "$t/bad" > /dev/null 2> "$t/bad.err"
+[[ $? -eq 1 ]] || fail "bad accel: expected exit 1 (the six-state verdict)"
+grep -q "the self-calibrating pass could not read the log (.*bad_accel.csv:[0-9]*: column 'accel1_x': expected a number" "$t/bad.err" ||
+  fail "bad accel: the reason is not said: $(cat "$t/bad.err")"
+grep -q '"used": false, "interrupted": false, "error": ".*accel1_x' "$t/bad/summary.json" || fail "bad accel: no error in summary.json"
+[[ ! -e "$t/bad/.selfcal-pass" ]] || fail "bad accel: the second pass's folder was left behind"
 "$bin" estimate --log "$t/sim/log.csv" --out "$t/forced" --selfcal > /dev/null 2>&1 || fail "--selfcal: exit $?"
 cmp -s "$t/auto/estimate.csv" "$t/forced/estimate.csv" || fail "defaults: estimate.csv differs from --selfcal's"
 cmp -s "$t/auto/attitude.csv" "$t/forced/attitude.csv" || fail "defaults: attitude.csv differs from --selfcal's"
