@@ -284,6 +284,7 @@ RunUsed run_used(const est::EstimatorConfig& cfg, const est::HealthReport& h) {
   u.box_gyro_change_dps = h.box_motion.gyro_change_dps;
   u.ref_q = h.ref_q_logged;
   u.accel = h.accel_logged;
+  for (const auto& f : h.findings) u.short_rests = u.short_rests || f.cause == est::HealthCause::kStandstillsTooShort;
   return u;
 }
 
@@ -423,6 +424,9 @@ std::string describe_lock(const est::HealthFinding& f, const est::EstimatorConfi
                                                     "about the box vertical looks like a bias common to both "
                                                     "sensors, which only a pause of the box observes. " +
                                                         vertical_fix(u, cfg)
+                                            : u.short_rests
+                                                  ? "the rests between flips are too short to use "
+                                                    "(standstills_too_short above): rest longer, not more flips"
                                                   : "record more flips (both platforms, both directions) or a longer log");
     case est::HealthCause::kUnobservable:
       return fmt::format("{} kept most of the prior sigma (largest sigma {:.3g} deg/s): the flips in this "

@@ -31,6 +31,7 @@ struct RunUsed {
   double box_ref_rate_dps = kNaN;      // ref_q's largest turn rate over a standstill, deg/s
   double box_gyro_change_dps = kNaN;   // the fused rate's largest change within one, deg/s
   bool ref_q = false, accel = false;   // the log has ref_q / accel columns
+  bool short_rests = false;            // a standstills_too_short finding: the rests, not the flips, are the cause
 };
 RunUsed run_used(const est::EstimatorConfig& cfg, est::GravitySource gravity);
 /// The same with what the run saw: the box's motion at the rests and the log's columns.

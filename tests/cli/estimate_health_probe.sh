@@ -56,6 +56,9 @@ run r 1; first_finding r standstills_too_short failed
 grep -q "min_standstill_s 1 s" "$t/r.txt" || fail "r: min_standstill_s not named"
 grep -q "0.5 s" "$t/r.txt" || fail "r: the rest length not named"
 if grep -q "never moved" "$t/r.txt"; then fail "r: still says the platforms never moved"; fi
+# AND never_locked, which follows, points at the rests, not at more flips
+grep -q "never locked: .*the rests between flips are too short to use" "$t/r.txt" || fail "r: never_locked: $(cat "$t/r.txt")"
+if grep -q "record more flips" "$t/r.txt"; then fail "r: never_locked still asks for more flips"; fi
 
 # 4. stamps in ns and in ms, no rate key; ms with the rate key
 $nav --out "$t/ns.csv" --sensor mpu6050 --tunit ns --no-rate-key --seed 25 > /dev/null || fail "navgen ns"
