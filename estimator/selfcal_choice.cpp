@@ -1,5 +1,7 @@
 #include "estimator/selfcal_choice.hpp"
 
+#include <cmath>
+
 namespace driftless::est {
 
 const char* to_string(SelfcalMode m) {
@@ -37,10 +39,13 @@ bool has_bad(const HealthReport& h, HealthCause c) {
   return false;
 }
 
-// `a` has a degraded or failed finding whose cause `b` has not
+// `a` has a degraded or failed finding whose cause `b` has not. An NIS above its band is not
+// counted: the noise level is the configuration's, which both passes share (--tune auto measures
+// it), and the six-state pass's NIS over the updates its gate accepted can hide it
 bool adds_finding(const HealthReport& a, const HealthReport& b) {
   for (const HealthFinding& f : a.findings) {
-    if (f.severity != HealthVerdict::kOk && !has_bad(b, f.cause)) return true;
+    if (f.severity == HealthVerdict::kOk || f.cause == HealthCause::kNoiseUnderstated) continue;
+    if (!has_bad(b, f.cause)) return true;
   }
   return false;
 }
@@ -70,9 +75,12 @@ int verdict_rank(HealthVerdict v) {
 
 bool selfcal_pass_better(const HealthReport& selfcal, const HealthReport& six_state) {
   // NaN (no accepted update, or none rejected to compare) compares false: not better
-  const bool fits = selfcal.nis_mean <= selfcal.nis_mean_band_hi;
   const double gain = six_state.rejected_fraction - selfcal.rejected_fraction;
   const int a = verdict_rank(selfcal.verdict), b = verdict_rank(six_state.verdict);
+  // its NIS in its band, or a better verdict with fewer rejections: the noise set too low, which
+  // the NIS shows, is no reason to keep a six-state pass that rejects what the other explains
+  const bool fits = std::isfinite(selfcal.nis_mean) &&
+                    (selfcal.nis_mean <= selfcal.nis_mean_band_hi || (a > b && gain >= kSelfcalRejectionGain));
   return fits && gain >= 0.0 && a >= b && !adds_finding(selfcal, six_state) &&
          (a > b || gain >= kSelfcalRejectionGain);
 }

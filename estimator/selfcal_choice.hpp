@@ -30,12 +30,13 @@ SelfcalTrigger selfcal_trigger(const HealthReport& six_state, bool gravity_logge
 int verdict_rank(HealthVerdict v);
 
 /// Whether the self-calibrating pass's results replace the six-state pass's: where its model fits
-/// the data better. All of: its NIS mean at or below the top of its 95 % band (the innovations are
-/// what its sigma says: the model explains them), no more of its updates rejected, a verdict at
-/// least as good, no degraded or failed finding of a cause the six-state pass did not have (it must
-/// remove the problem, not trade it for another: a late lock, an unobserved vertical), and a gain: a
-/// better verdict or kSelfcalRejectionGain less rejected. Noise larger than configured fits neither
-/// model (its fix is --tune auto); the six-state results then stand.
+/// the data better. All of: no more of its updates rejected, a verdict at least as good, no degraded
+/// or failed finding of a cause the six-state pass did not have (it must remove the problem, not
+/// trade it for another: a late lock, an unobserved vertical; an NIS above its band does not count,
+/// the noise level being the configuration's), a gain (a better verdict or kSelfcalRejectionGain
+/// less rejected), and its NIS mean at or below the top of its 95 % band unless its verdict is
+/// better with that gain in rejections. Noise larger than configured that no model explains (more
+/// rejected) keeps the six-state results; its fix is --tune auto.
 inline constexpr double kSelfcalRejectionGain = 0.05;
 bool selfcal_pass_better(const HealthReport& selfcal, const HealthReport& six_state);
 

@@ -83,7 +83,14 @@ TEST(SelfcalChoice, TheSelfCalibratingPassIsKeptWhereItsModelFits) {
   // GIVEN noise larger than configured: the self-calibrating pass's verdict is better but more of
   // its updates are rejected THEN the six-state results stand (the fix is --tune auto)
   EXPECT_FALSE(selfcal_pass_better(pass(HealthVerdict::kDegraded, 0.73, 3.82, 4.7), pass(HealthVerdict::kFailed, 0.5, 7.58)));
-  // GIVEN fewer rejections but its NIS above its band THEN not kept: its model does not explain them
+  // GIVEN an uncalibrated BMI088 pair estimated with the MPU6050's noise (navgen, seed 7): six-state
+  // failed, 48 % rejected; self-calibrating degraded by its NIS above the band (the noise set too
+  // low), nothing rejected THEN kept: its NIS excess is the configuration's (--tune auto makes it ok)
+  HealthReport noisy_sc = pass(HealthVerdict::kDegraded, 0.0, 5.05, 4.06);
+  noisy_sc.findings.push_back({});
+  noisy_sc.findings.back().cause = HealthCause::kNoiseUnderstated;
+  EXPECT_TRUE(selfcal_pass_better(noisy_sc, pass(HealthVerdict::kFailed, 0.483, 0.64)));
+  // GIVEN fewer rejections but its NIS above its band, at the same verdict THEN not kept
   EXPECT_FALSE(selfcal_pass_better(pass(HealthVerdict::kDegraded, 0.1, 6.0), pass(HealthVerdict::kDegraded, 0.3, 9.0)));
   // GIVEN the same verdict and a gain below kSelfcalRejectionGain THEN not kept
   EXPECT_FALSE(selfcal_pass_better(pass(HealthVerdict::kDegraded, 0.27, 3.0),
