@@ -61,7 +61,15 @@ FlipTurn classify_flip(const Eigen::Vector3d& v, const Eigen::Vector3d& w, const
   const double vn = v.norm();
   const double along = vn > 0.0 ? std::fabs(a.dot(v)) / vn : 0.0;  // |cos| of the turn axis to the hinge
   const double r = a.dot(v) / dtheta_deg;
-  if (along >= kFlipAxisCos) {
+  // the box's own turn over the window (the resting sensor's) is taken out in the moving sensor's
+  // start frame, but its part across the hinge turns with the platform, so up to twice it stays
+  // across the hinge: on a box that turns during the flip (the twin's Fig. 9 pan/tilt, 80-105 deg in
+  // a flip's window) a turn of ±Δθ about the hinge is the hinge (agreeing, or of the wrong sign),
+  // whatever that leftover leans it by
+  const double across = std::sqrt(std::max(0.0, vn * vn - a.dot(v) * a.dot(v)));
+  const bool on_hinge =
+      along >= kFlipAxisCos || ((one(r) || one(-r)) && across <= kFlipAxisTan * d + 2.0 * resting_raw_deg);
+  if (on_hinge) {
     if (one(r)) return FlipTurn::kAgrees;
     if (one(-r)) return FlipTurn::kSign;
     const double ar = std::fabs(r);
@@ -78,7 +86,7 @@ FlipTurn classify_flip(const Eigen::Vector3d& v, const Eigen::Vector3d& w, const
       moving_raw_deg < 0.5 * d) {
     return FlipTurn::kSwapped;
   }
-  if (along < kFlipAxisCos) return FlipTurn::kAxis;
+  if (!on_hinge) return FlipTurn::kAxis;
   return FlipTurn::kOther;
 }
 

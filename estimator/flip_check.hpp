@@ -55,6 +55,7 @@ inline constexpr int kFlipTurnKinds = 11;
 inline constexpr double kFlipTurnTolerance = 0.2;
 /// The measured axis "is" the hinge when their angle is below acos of this (30 deg).
 inline constexpr double kFlipAxisCos = 0.866;
+inline constexpr double kFlipAxisTan = 0.577;  // tan 30 deg: the same bound as a turn across the hinge
 
 /// One flip as the check measured it.
 struct FlipTurnRecord {
@@ -158,8 +159,9 @@ class FlipCheck {
 /// The kind of one flip from its sums (pure; exposed for the tests): `v` = S_m − C0 S_s and
 /// `w` = S_s − C0^T S_m in the moving / resting sensor axes (deg), `a` the moving hinge in the
 /// moving sensor's axes (unit), `dtheta_deg` the angle columns' change, `moving_raw_deg` and
-/// `resting_raw_deg` the norms |S_m| and |S_s| (each column's own turn, box turn included).
+/// `resting_raw_deg` the norms |S_m| and |S_s| (each column's own turn, box turn included),
+/// `clipped` a gyro clipped in the window (the turn may then be cut short, never lengthened).
 FlipTurn classify_flip(const Eigen::Vector3d& v, const Eigen::Vector3d& w, const Eigen::Vector3d& a, double dtheta_deg,
-                       double moving_raw_deg, double resting_raw_deg);
+                       double moving_raw_deg, double resting_raw_deg, bool clipped);
 
 }  // namespace driftless::est

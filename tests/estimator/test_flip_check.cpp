@@ -347,6 +347,21 @@ TEST(FlipCheckTest, AWrongHingeOnOnePlatformFails) {
   EXPECT_EQ(h.verdict, HealthVerdict::kFailed);
 }
 
+// GIVEN a flip of 180 deg about the header's hinge (x) on a box that turned 105 deg during its window
+// (the twin's Fig. 9 pan/tilt, seed 16: the leftover of the box's turn across the hinge, 121 deg,
+// leans the measured axis 34 deg off it) THEN the hinge agrees; the same leftover on a box that did
+// not turn is another axis, and a turn about another axis than the header's is one however the box turned
+TEST(FlipCheckTest, ABoxTurningDuringAFlipLeavesTheHingeAgreeing) {
+  const Eigen::Vector3d a = Eigen::Vector3d::UnitX();
+  const Eigen::Vector3d v(-179.128, -118.539, 26.2603), w(26.2603, -179.128, 118.539);
+  EXPECT_EQ(classify_flip(v, w, a, -180.0, v.norm(), 105.1, false), FlipTurn::kAgrees);
+  EXPECT_EQ(classify_flip(v, w, a, -180.0, v.norm(), 0.0, false), FlipTurn::kAxis);
+  // the header says y: the turn about y is the box's, not 180 deg
+  EXPECT_EQ(classify_flip(v, w, Eigen::Vector3d::UnitY(), -180.0, v.norm(), 105.1, false), FlipTurn::kAxis);
+  // the sign: a turn of -Δθ about the hinge
+  EXPECT_EQ(classify_flip(v, w, a, 180.0, v.norm(), 105.1, false), FlipTurn::kSign);
+}
+
 // GIVEN 42 flips of platform 2, one of them about another axis (the twin's Fig. 9 pan/tilt: a jolt
 // of the moving box during it) WHEN the findings are made THEN flip_axis is a note (no header error
 // shows in 1 of 42), and degraded from 3 of 42 (more than one in 20); failed past half
