@@ -31,15 +31,9 @@ namespace {
 
 bool stop_polled() { return stop_requested().load(); }
 
-// what drives the g-sensitivity states is in the log: both accel triads (by name: a pass without
-// the self-calibration does not parse them) or ref_q
-bool gravity_logged(const log::LogReader& reader) {
-  if ((reader.fields() & kFieldRefQ) != 0) return true;
-  for (const char* c : {"accel1_x", "accel1_y", "accel1_z", "accel2_x", "accel2_y", "accel2_z"}) {
-    if (reader.column_index(c) < 0) return false;
-  }
-  return true;
-}
+// what drives the g-sensitivity states is in the log: both accel triads (a pass without the
+// self-calibration does not parse them) or ref_q
+bool gravity_logged(const log::LogReader& reader) { return (reader.header_fields() & (kFieldAccel | kFieldRefQ)) != 0; }
 
 // The early sign that the six-state model fails (the self-calibrating pass then starts beside it on
 // the second core, so that a log that needs it costs about one pass of wall time, not two): at least
@@ -84,12 +78,10 @@ EstimatePass run_filter_pass(const PassInputs& a, const est::EstimatorConfig& cf
   run_opt.attitude_start_sigma_dps = a.attitude_start_sigma_dps;
   if (a.smooth) p.smoother = std::make_unique<est::FixedIntervalSmoother>(cfg.q_dps2_per_s());
   run_opt.update_observer = p.smoother.get();
-  if (!early) {
-    p.summary = est::run_estimate(reader, cfg, p.files.get(), run_opt, should_stop);
-    return p;
-  }
+  // the files directly, or through the watch that may start the self-calibrating pass early
   EarlyWatch watch(*p.files, early);
-  p.summary = est::run_estimate(reader, cfg, &watch, run_opt, should_stop);
+  est::EstimateSink* sink = early ? static_cast<est::EstimateSink*>(&watch) : p.files.get();
+  p.summary = est::run_estimate(reader, cfg, sink, run_opt, should_stop);
   return p;
 }
 

@@ -175,6 +175,9 @@ class LogReader {
   /// Optional column groups present (SampleField bits); a group counts only when complete.
   /// kLayoutSingleSensor is set for the single-sensor form.
   std::uint32_t fields() const { return fields_; }
+  /// The optional column groups complete in the header, parsed or not (ReaderOptions::fields
+  /// chooses which of them fields() holds).
+  std::uint32_t header_fields() const { return header_fields_; }
   /// 1 (single-sensor form) or 2.
   int sensors() const { return (fields_ & kLayoutSingleSensor) != 0 ? 1 : 2; }
   const std::vector<std::string>& columns() const { return columns_; }
@@ -244,6 +247,7 @@ class LogReader {
   Metadata meta_;
   std::vector<std::string> columns_;
   std::uint32_t fields_ = 0;
+  std::uint32_t header_fields_ = 0;
   std::vector<double*> target_;  // column -> value in row_sample_ (nullptr for unknown columns)
   std::vector<char> parse_;      // column -> 0 skip, 1 parse strictly (known), 2 parse leniently (unknown)
   Sample row_sample_;            // the row being read; columns the file lacks stay NaN

@@ -171,6 +171,7 @@ void LogReader::map_columns() {
     for (std::size_t k = 0; k < detail::kColumns.size(); ++k) {
       if (detail::kColumns[k].field == bit && !seen[k] && !(single && detail::kColumns[k].sensor == 2)) all = false;
     }
+    if (all) header_fields_ |= bit;
     if (all && (opts_.fields & bit) != 0) fields_ |= bit;
   }
   row_.assign(columns_.size(), kNaN);

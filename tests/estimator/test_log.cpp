@@ -80,6 +80,25 @@ TEST(LogTest, RoundTripKeepsValuesAtTheirWrittenPrecision) {
   EXPECT_EQ(r.events()[0].text, "t=0.095000 switch twin -> replay");
 }
 
+// GIVEN a log with accel, ref_q and temperature columns WHEN read parsing only the temperatures
+// THEN fields() holds the parsed group, header_fields() every complete one (estimate's model choice
+// asks whether gravity is logged before any pass parses the accel columns)
+TEST(LogTest, HeaderFieldsNameTheGroupsPresentWhetherParsedOrNot) {
+  const auto path = temp_file("header_fields.csv");
+  Metadata meta;
+  meta.set("sample_rate_hz", "100");
+  {
+    LogWriter w(path, meta, kFieldAccel | kFieldRefQ | kFieldTemp);
+    for (int i = 0; i < 3; ++i) w.write(make_sample(0.01 * i));
+    w.finish(true);
+  }
+  ReaderOptions temps;
+  temps.fields = kFieldTemp;
+  LogReader r(path, temps);
+  EXPECT_EQ(r.fields(), kFieldTemp);
+  EXPECT_EQ(r.header_fields(), kFieldAccel | kFieldRefQ | kFieldTemp);
+}
+
 TEST(LogTest, SameSamplesGiveByteIdenticalFiles) {
   const auto a = temp_file("det_a.csv");
   const auto b = temp_file("det_b.csv");
