@@ -414,14 +414,19 @@ Eigen::Matrix3d DriftlessFilter::scale_misalign_sigma(int sensor) const {
 
 Vector6d DriftlessFilter::correction_sigma_dps() const {
   if (!has_gsens_states()) return sigma_dps();
-  // o_i = b_i + G_i f_i: J = [I 0 .. (I kron f_i^T) ..] per sensor
-  Eigen::Matrix<double, 6, kFullStateDim> J = Eigen::Matrix<double, 6, kFullStateDim>::Zero();
-  J.block<6, 6>(0, 0).setIdentity();
+  // o_i = b_i + G_i f_i: row r of J = e_r plus f_i^T in the columns of G_i's row r (row-major vec,
+  // as gsens_jacobian), so diag(J P J^T)_r = P_rr + 2 f^T P_(g, r) + f^T P_(g, g) f with g those
+  // three columns: the product's 6 diagonal entries, not its 6x52x52 (called on every sample)
+  Vector6d var = P_.diagonal().head<6>();
   for (int i = 0; i < 2; ++i) {
     const Eigen::Vector3d& f = last_f_g_[static_cast<std::size_t>(i)];
-    if (f.allFinite()) J.block<3, 9>(3 * i, i == 0 ? kGSens1.start : kGSens2.start) = gsens_jacobian(Eigen::Matrix3d::Identity(), f);
+    if (!f.allFinite()) continue;
+    for (int r = 0; r < 3; ++r) {
+      const Eigen::Index b = 3 * i + r, g = (i == 0 ? kGSens1.start : kGSens2.start) + 3 * r;
+      var[b] += 2.0 * f.dot(P_.block<3, 1>(g, b)) + f.dot(P_.block<3, 3>(g, g) * f);
+    }
   }
-  return (J * P_ * J.transpose()).diagonal().cwiseSqrt();
+  return var.cwiseSqrt();
 }
 
 // a window [t_first, t_last] averaged by a measurement made at t_update >= t_last: the mean is

@@ -236,6 +236,8 @@ class DriftlessFilter {
   /// the last update (deg/s): what "locked" means. The bias sigma without self-calibration; with
   /// it, b_i alone may stay unobservable (a g-sensitivity along a fixed gravity looks like bias).
   Vector6d correction_sigma_dps() const;
+  /// The specific force of the last update in sensor `sensor`'s axes (g; NaN before one with accel).
+  const Eigen::Vector3d& last_specific_force_g(int sensor) const { return last_f_g_[sensor == 1 ? 0 : 1]; }
   /// The whole state [b1; b2; k1; k2; G1; G2; E1; E2] and its covariance (units as above).
   const StateVector& state() const { return x_; }
   const StateMatrix& full_covariance() const { return P_; }

@@ -226,23 +226,35 @@ class LogReader {
   struct Closer {
     void operator()(std::FILE* f) const noexcept { std::fclose(f); }
   };
+  struct Pipeline;  // the parse thread and its batches (log_reader.cpp)
+  struct Batch;     // rows parsed ahead
+  struct Special;   // a line of a batch that is no data row
   bool read_line(std::string_view& line);
   [[noreturn]] void fail(std::string_view what) const;
   void read_header();
   void parse_header_line(std::string_view line);
   void map_columns();
-  bool split_row(std::string_view line, std::string& problem);
+  bool split_row(std::string_view line, double* row, std::string& problem) const;
+  void parse_batch(Batch& b);
+  void parse_ahead();
+  bool take_special(const Special& sp);
   void check_row(const Sample& s);
   bool platforms_resting(const Sample& s);
 
   std::filesystem::path path_;
   ReaderOptions opts_;
   std::unique_ptr<std::FILE, Closer> file_;
+  // read by the constructor (the header), then by the parse thread only (parse_ahead)
   std::string buf_;
   std::size_t chunk_bytes_ = 0;  // bytes read at a time
   std::size_t buf_pos_ = 0;
   bool eof_ = false;
+  bool tail_unterminated_ = false;  // the line read last ended the file without a line end
+  std::size_t lines_read_ = 0;
+  std::unique_ptr<Pipeline> pipe_;
+  // the rows as next() hands them out
   bool last_line_unterminated_ = false;
+  bool finished_ = false;
   std::size_t line_no_ = 0;
   Metadata meta_;
   std::vector<std::string> columns_;

@@ -1,6 +1,11 @@
 // The measurement log: round trip, crash safety and clear errors on malformed files.
+#include <sys/stat.h>
+
+#include <chrono>
 #include <fstream>
+#include <sstream>
 #include <string>
+#include <thread>
 
 #include <gtest/gtest.h>
 
@@ -496,6 +501,106 @@ TEST(LogTest, ForeignRecordIsToldToConvertAndACutCompleteLogSaysWhy) {
   EXPECT_NE(why.find(":5: expected 9 fields as in the header, got 6; it is the last line and has no line end"),
             std::string::npos) << why;
   EXPECT_NE(why.find("complete: true"), std::string::npos) << why;
+}
+
+// what a reader gives of a file: every row's t and gyro1_x, the events, and the error it ends on
+struct ReadOut {
+  std::vector<double> t, g;
+  std::vector<std::string> events;
+  std::string error;
+  bool dropped_tail = false;
+};
+
+ReadOut read_out(const std::filesystem::path& p) {
+  ReadOut o;
+  LogReader r(p);
+  o.error = message_of([&] {
+    Sample s;
+    while (r.next(s)) {
+      o.t.push_back(s.t_s);
+      o.g.push_back(s.gyro1_dps.x());
+    }
+  });
+  for (const Event& e : r.events()) o.events.push_back(std::to_string(e.line) + " " + e.text);
+  o.dropped_tail = r.dropped_truncated_row();
+  return o;
+}
+
+// rows over several of the parse thread's batches (4096 rows), with events, blank lines and
+// metadata-like comments among them, and a tail chosen by the caller
+std::string long_log(const std::string& complete, const std::string& tail) {
+  std::ostringstream os;
+  os << "# format: driftless-log 1\n# complete: " << complete
+     << "\nt,gyro1_x,gyro1_y,gyro1_z,gyro2_x,gyro2_y,gyro2_z,plat1_deg,plat2_deg\n";
+  for (int i = 0; i < 10000; ++i) {
+    if (i % 4095 == 7) os << "# event: mark " << i << "\n\n";
+    os << i * 0.01 << "," << (i % 97) * 0.125 << ",2,3,4,5,6,90,90\n";
+  }
+  os << tail;
+  return os.str();
+}
+
+TEST(LogTest, TheParseThreadGivesTheRowsEventsAndErrorsOfAStreamReadInPlace) {
+  // GIVEN long logs (a file is parsed on a thread of its own, a FIFO on the caller's) that end well,
+  // on a malformed row, and on a row cut mid-write in an incomplete and in a complete log
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"true", ""},
+      {"true", "100.5,1,2,x,4,5,6,90,90\n101,1,2,3,4,5,6,90,90\n"},
+      {"false", "100.5,1,2,3,4,5,6,90,90\n100.51,1,2,3,4"},
+      {"true", "100.5,1,2,3,4,5,6,90,90\n100.51,1,2,3,4"},
+      {"true", "100.5,1,2,3,4,5,6,90,90\n99,1,2,3,4,5,6,90,90\n"},
+  };
+  int k = 0;
+  for (const auto& [complete, tail] : cases) {
+    const std::string text = long_log(complete, tail);
+    const auto file = temp_file("threaded_" + std::to_string(k) + ".csv");
+    write_text(file, text);
+    const auto fifo = temp_file("stream_" + std::to_string(k++) + ".fifo");
+    std::filesystem::remove(fifo);
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+    std::thread writer([&] { write_text(fifo, text); });
+    const ReadOut a = read_out(file), b = read_out(fifo);
+    writer.join();
+    // THEN both give the same rows, events (with their lines) and error (file:line apart from the name)
+    EXPECT_EQ(a.t, b.t) << tail;
+    EXPECT_EQ(a.g, b.g) << tail;
+    EXPECT_EQ(a.events, b.events) << tail;
+    EXPECT_EQ(a.dropped_tail, b.dropped_tail) << tail;
+    const auto after_name = [](const std::string& e, const std::filesystem::path& p) {
+      return e.empty() ? e : e.substr(e.find(p.filename().string()) + p.filename().string().size());
+    };
+    EXPECT_EQ(after_name(a.error, file), after_name(b.error, fifo)) << tail;
+    ASSERT_GE(a.t.size(), 10000u);
+    EXPECT_EQ(a.events.size(), 3u);
+  }
+  // and the cases end as the serial reader ended them
+  const ReadOut bad = read_out(temp_file("threaded_1.csv"));
+  EXPECT_NE(bad.error.find(":10010: column 'gyro1_z': expected a number, got 'x'"), std::string::npos) << bad.error;
+  EXPECT_EQ(bad.t.size(), 10000u);
+  const ReadOut cut = read_out(temp_file("threaded_2.csv"));
+  EXPECT_TRUE(cut.error.empty()) << cut.error;
+  EXPECT_TRUE(cut.dropped_tail);
+  EXPECT_EQ(cut.t.size(), 10001u);
+  EXPECT_NE(read_out(temp_file("threaded_3.csv")).error.find("has no line end"), std::string::npos);
+  EXPECT_NE(read_out(temp_file("threaded_4.csv")).error.find(":10011: t = 99.000000 s is not greater"),
+            std::string::npos);
+}
+
+TEST(LogTest, AReaderLeftMidFileStopsItsParseThread) {
+  // GIVEN a long log of which a caller reads a few rows only
+  const auto file = temp_file("left_mid_file.csv");
+  std::string text = long_log("true", "");
+  for (int i = 0; i < 3; ++i) text += text.substr(text.find("0,0,2"));  // t stops rising: never reached
+  write_text(file, text);
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int i = 0; i < 50; ++i) {
+    LogReader r(file);
+    Sample s;
+    for (int j = 0; j < 5000 && r.next(s); ++j) {
+    }
+  }
+  // THEN the readers go away at once (their threads stopped, not run to the end or left blocked)
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 20.0);
 }
 
 }  // namespace

@@ -65,6 +65,28 @@ TEST(SelfCalTest, GSensitivityOnTheHorizontalHingeIsRecovered) {
   EXPECT_GT(f.sigma_dps()[2], 0.9 * prior);
 }
 
+// GIVEN a self-calibrating filter after 20 minutes with full g-sensitivity matrices (its covariance
+// correlates biases and G columns) THEN the correction's sigma is diag(J P J^T)^(1/2) with J the
+// full Jacobian of o_i = b_i + G_i f_i, to rounding (the filter computes only the diagonal's terms)
+TEST(SelfCalTest, TheCorrectionSigmaIsTheDiagonalOfTheFullProduct) {
+  test::SynthParams p = static_box(20.0);
+  p.G_dps_per_g[1] << -0.04, 0.06, 0.03, 0.05, -0.07, 0.02, 0.03, 0.05, -0.06;
+  const DriftlessFilter f = run(p, config(true));
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(6, f.full_covariance().cols());
+  J.leftCols<6>().setIdentity();
+  for (int i = 0; i < 2; ++i) {
+    const Eigen::Vector3d& g = f.last_specific_force_g(i + 1);
+    ASSERT_TRUE(g.allFinite());
+    EXPECT_NEAR(g.norm(), 1.0, 0.01);  // a box at rest: gravity only
+    for (int r = 0; r < 3; ++r) J.block<1, 3>(3 * i + r, kGSens1.start + 9 * i + 3 * r) = g.transpose();
+  }
+  const Vector6d dense = (J * f.full_covariance() * J.transpose()).diagonal().cwiseSqrt();
+  const Vector6d sparse = f.correction_sigma_dps();
+  for (int k = 0; k < 6; ++k) EXPECT_NEAR(sparse[k], dense[k], 1e-12 * dense[k]) << k;
+  // the G terms matter: the bias sigma alone is not the correction's
+  EXPECT_GT((f.sigma_dps() - sparse).cwiseAbs().maxCoeff(), 0.01);
+}
+
 // GIVEN the same box with only G2_yy = 0.08 deg/s per g and no rest assumption: at each flip of
 // platform 2 its offset along the box vertical keeps its sign, like a bias common to both sensors
 // WHEN the self-calibrating filter runs THEN G2_yy keeps its prior sigma and sensor 1's vertical
