@@ -296,7 +296,7 @@ int run_estimate_cmd(const EstimateArgs& a) {
                                                                              : est::SelfcalMode::kAuto;
   // the first pass's reader: its header and columns decide the outputs
   const PassInputs in{a.log, !a.calib.empty(), a.smooth, a.attitude_start_sigma_dps};
-  log::LogReader reader(a.log, reader_options(in, cfg));
+  log::LogReader reader(a.log, first_reader_options(in, cfg, choice.mode));
   if (!a.calib.empty()) apply_calib(a, reader.metadata(), cfg);
   cfg.validate();
   est::TuneResult tune;

@@ -12,6 +12,7 @@
 
 #include "cli/command.hpp"
 #include "cli/estimate_health.hpp"
+#include "estimator/sample_tee.hpp"
 #include "estimator/selfcal_choice.hpp"
 
 namespace driftless::cli {
@@ -24,6 +25,13 @@ log::ReaderOptions reader_options(const PassInputs& in, const est::EstimatorConf
   log::ReaderOptions read_opt;
   read_opt.fields = kFieldRefQ | kFieldTrueBias | kFieldTemp;
   if (in.calib || cfg.self_calibration || cfg.box_at_rest) read_opt.fields |= kFieldAccel;
+  return read_opt;
+}
+
+log::ReaderOptions first_reader_options(const PassInputs& in, const est::EstimatorConfig& cfg, est::SelfcalMode mode) {
+  log::ReaderOptions read_opt = reader_options(in, cfg);
+  // the automatic choice may hand the rows on to the self-calibrating pass: its columns too
+  if (mode == est::SelfcalMode::kAuto) read_opt.fields |= kFieldAccel;
   return read_opt;
 }
 
@@ -64,9 +72,17 @@ class EarlyWatch : public est::EstimateSink {
   bool fired_ = false;
 };
 
+// Where a pass's rows come from: its reader itself, or (`next`) the rows another pass read from it,
+// which fill the column groups `fields`, the reader's header `header` copied before it was read
+struct RowSource {
+  const est::SampleSource* next = nullptr;
+  std::uint32_t fields = 0;
+  const log::Metadata* header = nullptr;
+};
+
 EstimatePass run_filter_pass(const PassInputs& a, const est::EstimatorConfig& cfg, log::LogReader& reader,
                              const fs::path& dir, EstimateFilesOptions file_opt, bool (*should_stop)() = &stop_polled,
-                             const std::function<void()>& early = {}, bool progress = true) {
+                             const std::function<void()>& early = {}, bool progress = true, RowSource rows = {}) {
   EstimatePass p;
   p.cfg = cfg;
   p.dir = dir;
@@ -81,7 +97,9 @@ EstimatePass run_filter_pass(const PassInputs& a, const est::EstimatorConfig& cf
   // the files directly, or through the watch that may start the self-calibrating pass early
   EarlyWatch watch(*p.files, early);
   est::EstimateSink* sink = early ? static_cast<est::EstimateSink*>(&watch) : p.files.get();
-  p.summary = est::run_estimate(reader, cfg, sink, run_opt, should_stop);
+  p.summary = rows.next == nullptr
+                  ? est::run_estimate(reader, cfg, sink, run_opt, should_stop)
+                  : est::run_estimate(*rows.header, reader, rows.fields, *rows.next, cfg, sink, run_opt, should_stop);
   return p;
 }
 
@@ -100,16 +118,26 @@ class SelfcalPass {
   SelfcalPass(const SelfcalPass&) = delete;
   SelfcalPass& operator=(const SelfcalPass&) = delete;
 
+  /// The rows the six-state pass reads, from `reader` (its header `header`), handed on through
+  /// `tee`: start() then takes them instead of reading the log again, while the tee has them all.
+  void share(est::SampleTee& tee, log::LogReader& reader, const log::Metadata& header) {
+    tee_ = &tee;
+    shared_reader_ = &reader;
+    header_ = &header;
+  }
   /// Starts the pass on a thread of its own (no progress display: the six-state pass shows its own).
   void start() {
     if (thread_.joinable()) return;
     started_ = true;
-    thread_ = std::thread([this] {
+    const bool shared = tee_ != nullptr && tee_->attach();
+    thread_ = std::thread([this, shared] {
       try {
-        result_ = run(&abandon_polled, false);
+        result_ = shared ? run_shared() : run(&abandon_polled, false);
       } catch (...) {
         error_ = std::current_exception();
       }
+      // a pass that stopped early reads no more: the six-state pass must not wait for it
+      if (tee_ != nullptr) tee_->detach();
     });
   }
   bool started() const { return started_; }
@@ -131,6 +159,7 @@ class SelfcalPass {
   void abandon() {
     if (taken_) return;
     if (thread_.joinable()) {
+      if (tee_ != nullptr) tee_->detach();
       abandoned().store(true);
       thread_.join();
       abandoned().store(false);
@@ -156,10 +185,20 @@ class SelfcalPass {
     log::LogReader again(a_.log, reader_options(a_, cfg_));
     return run_filter_pass(a_, cfg_, again, staging_, file_opt_, should_stop, {}, progress);
   }
+  // on the six-state pass's rows; the tee ends them where that pass stopped reading
+  EstimatePass run_shared() {
+    fs::create_directories(staging_);
+    const est::SampleSource next = [this](Sample& s) { return tee_->next(s); };
+    const RowSource rows{&next, shared_reader_->fields(), header_};
+    return run_filter_pass(a_, cfg_, *shared_reader_, staging_, file_opt_, &abandon_polled, {}, false, rows);
+  }
   const PassInputs& a_;
   est::EstimatorConfig cfg_;
   fs::path staging_;
   EstimateFilesOptions file_opt_;
+  est::SampleTee* tee_ = nullptr;
+  log::LogReader* shared_reader_ = nullptr;
+  const log::Metadata* header_ = nullptr;
   std::thread thread_;
   std::optional<EstimatePass> result_;
   std::exception_ptr error_;
@@ -220,14 +259,45 @@ EstimatePass choose_model(const PassInputs& a, EstimatePass six, SelfcalPass& sc
 EstimatePass run_passes(const PassInputs& in, const est::EstimatorConfig& cfg, log::LogReader& reader,
                         const fs::path& dir, const EstimateFilesOptions& file_opt, SelfcalChoice& choice) {
   const bool gravity = gravity_logged(reader);
-  // in the automatic choice the self-calibrating pass may start early, beside the six-state pass
+  const log::Metadata header = reader.metadata();  // before any row: what a reader of its own starts with
+  // in the automatic choice the self-calibrating pass may start early, beside the six-state pass, on
+  // the rows that pass reads (one parse for both)
+  const bool automatic = choice.mode == est::SelfcalMode::kAuto && gravity && fs::is_regular_file(in.log);
+  est::SampleTee tee;
   SelfcalPass sc_pass(in, cfg, dir, file_opt);
   std::function<void()> early;
-  if (choice.mode == est::SelfcalMode::kAuto && gravity && fs::is_regular_file(in.log)) {
+  if (automatic) {
+    sc_pass.share(tee, reader, header);
     early = [&sc_pass] { sc_pass.start(); };
   }
-  return choose_model(in, run_filter_pass(in, cfg, reader, dir, file_opt, &stop_polled, early), sc_pass, gravity,
-                      choice);
+  // the six-state pass sees its rows as a reader of its own options would give them: without the
+  // accel columns read for the other pass
+  const bool mask = (reader.fields() & kFieldAccel) != 0 && (reader_options(in, cfg).fields & kFieldAccel) == 0;
+  const est::SampleSource next = [&](Sample& s) {
+    if (!reader.next(s)) return false;
+    if (automatic) tee.offer(s);
+    if (mask) {
+      s.accel1_mps2.setConstant(kNaN);
+      s.accel2_mps2.setConstant(kNaN);
+    }
+    return true;
+  };
+  const RowSource rows{&next, mask ? reader.fields() & ~kFieldAccel : reader.fields(), &reader.metadata()};
+  EstimatePass six;
+  try {
+    six = run_filter_pass(in, cfg, reader, dir, file_opt, &stop_polled, early, true, rows);
+  } catch (const log::LogError&) {
+    tee.detach();
+    sc_pass.abandon();
+    if (!mask || reader.refused_group() != kFieldAccel) throw;
+    // an accel value, which the six-state pass does not read, is what the reader refused: that
+    // pass again on a reader of its own (the self-calibrating pass then says what it refused)
+    log::LogReader own(in.log, reader_options(in, cfg));
+    SelfcalPass again(in, cfg, dir, file_opt);
+    return choose_model(in, run_filter_pass(in, cfg, own, dir, file_opt), again, gravity, choice);
+  }
+  tee.end();
+  return choose_model(in, std::move(six), sc_pass, gravity, choice);
 }
 
 // the kept pass's files into place: a self-calibrating pass wrote into its own folder

@@ -38,7 +38,11 @@ struct EstimatePass {
 /// The column groups a pass with `cfg` parses.
 log::ReaderOptions reader_options(const PassInputs& in, const est::EstimatorConfig& cfg);
 
-/// The pass with `cfg` over `reader` (opened with reader_options(in, cfg)) into `dir` and, where
+/// The column groups the first pass's reader parses: reader_options(in, cfg), and in the automatic
+/// choice (`mode`) the accel columns too, so that it can hand its rows on to the self-calibrating pass.
+log::ReaderOptions first_reader_options(const PassInputs& in, const est::EstimatorConfig& cfg, est::SelfcalMode mode);
+
+/// The pass with `cfg` over `reader` (opened with first_reader_options(in, cfg, choice.mode)) into `dir` and, where
 /// `choice.mode` is automatic and the choice wants it, the self-calibrating pass; returns the kept
 /// pass with its files uncommitted and fills `choice` (summary.json's self_calibration_choice).
 EstimatePass run_passes(const PassInputs& in, const est::EstimatorConfig& cfg, log::LogReader& reader,

@@ -218,6 +218,9 @@ class LogReader {
   std::vector<est::ClippedChannel> suspected_clipping() const { return clip_.suspected(); }
   /// Gyro channels empty in every row, or stuck at one value (estimator/clip_detector.hpp).
   std::vector<est::DeadChannel> dead_channels() const { return clip_.dead(sensors() == 1 ? 3 : 6); }
+  /// The optional column group (SampleField bit) of the column whose value next() refused, once
+  /// it has thrown for one; 0 for any other refusal (a required column, a row of the wrong width).
+  std::uint32_t refused_group() const { return refused_group_; }
   /// "file:line" for messages.
   std::string where() const;
   const std::filesystem::path& path() const { return path_; }
@@ -234,7 +237,7 @@ class LogReader {
   void read_header();
   void parse_header_line(std::string_view line);
   void map_columns();
-  bool split_row(std::string_view line, double* row, std::string& problem) const;
+  bool split_row(std::string_view line, double* row, std::string& problem, int& bad_column) const;
   void parse_batch(Batch& b);
   void parse_ahead();
   bool take_special(const Special& sp);
@@ -255,6 +258,7 @@ class LogReader {
   // the rows as next() hands them out
   bool last_line_unterminated_ = false;
   bool finished_ = false;
+  std::uint32_t refused_group_ = 0;
   std::size_t line_no_ = 0;
   Metadata meta_;
   std::vector<std::string> columns_;

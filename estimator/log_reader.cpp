@@ -73,6 +73,7 @@ struct LogReader::Special {
   std::string text;            // the comment line, or the malformed row's problem
   std::size_t line = 0;
   bool unterminated = false;   // the line had no line end (the file's last)
+  int column = -1;             // kProblem: the column whose value is no number (-1: the row's width)
   std::exception_ptr error;    // kError: what reading threw
 };
 
@@ -331,7 +332,7 @@ bool LogReader::read_line(std::string_view& line) {
 
 // splits a row into `row` (every column, as row_); false with `problem` set on a malformed row.
 // Reads only what the constructor set (columns_, parse_): the parse thread calls it
-bool LogReader::split_row(std::string_view line, double* row, std::string& problem) const {
+bool LogReader::split_row(std::string_view line, double* row, std::string& problem, int& bad_column) const {
   const char* p = line.data();
   const char* const end = line.data() + line.size();
   std::size_t col = 0;
@@ -362,6 +363,7 @@ bool LogReader::split_row(std::string_view line, double* row, std::string& probl
     if (!parse_field(p, field_end, row[col])) {
       if (parse_[col] == 1) {
         problem = "column '" + columns_[col] + "': expected a number, got '" + std::string(p, field_end) + "'";
+        bad_column = static_cast<int>(col);
         return false;
       }
       row[col] = kNaN;  // an unknown column may hold text: ignored
@@ -461,17 +463,18 @@ void LogReader::parse_batch(Batch& b) {
       const std::string_view t = trim(line);
       if (t.empty()) continue;
       if (t.front() == '#') {
-        b.specials.push_back(Special{b.rows(), Kind::kComment, std::string(t), lines_read_, false, nullptr});
+        b.specials.push_back(Special{b.rows(), Kind::kComment, std::string(t), lines_read_, false, -1, nullptr});
         continue;
       }
       const std::size_t r = b.rows();
       b.values.resize((r + 1) * ncol);
       std::string problem;
-      const bool ok = split_row(line, b.values.data() + r * ncol, problem);
+      int bad_column = -1;
+      const bool ok = split_row(line, b.values.data() + r * ncol, problem, bad_column);
       if (!ok || tail_unterminated_) {
         // an unterminated last row that parses is still the reader's to judge (take_special)
         b.specials.push_back(Special{r, ok ? Kind::kUnterminated : Kind::kProblem, std::move(problem), lines_read_,
-                                     tail_unterminated_, nullptr});
+                                     tail_unterminated_, bad_column, nullptr});
       }
       if (!ok) {
         b.values.resize(r * ncol);
@@ -481,7 +484,7 @@ void LogReader::parse_batch(Batch& b) {
       b.lines.push_back(lines_read_);
     }
   } catch (...) {
-    b.specials.push_back(Special{b.rows(), Kind::kError, {}, lines_read_, false, std::current_exception()});
+    b.specials.push_back(Special{b.rows(), Kind::kError, {}, lines_read_, false, -1, std::current_exception()});
     b.end = true;
   }
 }
@@ -519,6 +522,11 @@ bool LogReader::take_special(const Special& sp) {
   }
   if (sp.kind == Special::Kind::kUnterminated) return true;  // a complete log's last row, kept
   std::string problem = sp.text;
+  if (sp.column >= 0) {
+    for (const auto& c : detail::kColumns) {
+      if (columns_[static_cast<std::size_t>(sp.column)] == c.name) refused_group_ = c.field;
+    }
+  }
   if (last_line_unterminated_) {
     problem += meta_.complete() ? "; it is the last line and has no line end: the log was cut mid-write (copied while "
                                   "being written?) although it says 'complete: true' (set 'complete: false' to use the rows before it)"

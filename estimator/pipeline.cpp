@@ -505,6 +505,12 @@ EstimateSummary run_estimate(log::LogReader& reader, const EstimatorConfig& cfg,
                   cfg, sink, opt, should_stop);
 }
 
+EstimateSummary run_estimate(const log::Metadata& meta, const log::LogReader& reader, std::uint32_t fields,
+                             const SampleSource& next, const EstimatorConfig& cfg, EstimateSink* sink,
+                             const EstimateRunOptions& opt, bool (*should_stop)()) {
+  return run_pass(meta, fields, next, &reader, cfg, sink, opt, should_stop);
+}
+
 EstimateSummary run_estimate(const log::Metadata& meta, std::uint32_t fields, const SampleSource& next,
                              const EstimatorConfig& cfg, EstimateSink* sink, const EstimateRunOptions& opt,
                              bool (*should_stop)()) {

@@ -184,6 +184,15 @@ struct EstimateSummary {
 EstimateSummary run_estimate(log::LogReader& reader, const EstimatorConfig& cfg, EstimateSink* sink,
                              const EstimateRunOptions& opt = {}, bool (*should_stop)() = nullptr);
 
+/// The pass over the rows of `reader` as `next` gives them (another pass reads the reader and
+/// hands its rows on: `fields` says which column groups they fill; `meta` is the reader's header,
+/// copied before the other pass began); the reader's findings (gaps, clipping, the stamp rate) are
+/// added at the end, so the other pass must be done with the reader by then.
+EstimateSummary run_estimate(const log::Metadata& meta, const log::LogReader& reader, std::uint32_t fields,
+                             const SampleSource& next,
+                             const EstimatorConfig& cfg, EstimateSink* sink, const EstimateRunOptions& opt = {},
+                             bool (*should_stop)() = nullptr);
+
 /// The same pass over a stream: `meta` describes it as a log header would (box geometry,
 /// latitude, completeness), `fields` says which optional column groups its samples fill
 /// (SampleField bits: true_bias, ref_q). Whatever `next` throws ends the pass and propagates.

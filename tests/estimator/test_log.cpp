@@ -586,6 +586,27 @@ TEST(LogTest, TheParseThreadGivesTheRowsEventsAndErrorsOfAStreamReadInPlace) {
             std::string::npos);
 }
 
+TEST(LogTest, TheRefusedColumnsGroupIsKnown) {
+  // GIVEN a value that is no number in an accel column, and one in a gyro column (required)
+  const auto accel = temp_file("bad_accel.csv"), gyro = temp_file("bad_gyro.csv");
+  const std::string head =
+      "# format: driftless-log 1\nt,gyro1_x,gyro1_y,gyro1_z,gyro2_x,gyro2_y,gyro2_z,plat1_deg,plat2_deg,"
+      "accel1_x,accel1_y,accel1_z,accel2_x,accel2_y,accel2_z\n0,1,2,3,4,5,6,90,90,0,0,1,0,0,1\n";
+  write_text(accel, head + "0.01,1,2,3,4,5,6,90,90,0,x,1,0,0,1\n");
+  write_text(gyro, head + "0.01,1,2,y,4,5,6,90,90,0,0,1,0,0,1\n");
+  for (const auto& [path, group] : {std::pair<std::filesystem::path, std::uint32_t>{accel, kFieldAccel}, {gyro, 0u}}) {
+    LogReader r(path);
+    Sample s;
+    EXPECT_EQ(r.refused_group(), 0u);
+    EXPECT_FALSE(message_of([&] {
+                   while (r.next(s)) {
+                   }
+                 }).empty());
+    // THEN the reader says which optional group it refused (none for a required column)
+    EXPECT_EQ(r.refused_group(), group) << path;
+  }
+}
+
 TEST(LogTest, AReaderLeftMidFileStopsItsParseThread) {
   // GIVEN a long log of which a caller reads a few rows only
   const auto file = temp_file("left_mid_file.csv");
