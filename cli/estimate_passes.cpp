@@ -30,8 +30,10 @@ log::ReaderOptions reader_options(const PassInputs& in, const est::EstimatorConf
 
 log::ReaderOptions first_reader_options(const PassInputs& in, const est::EstimatorConfig& cfg, est::SelfcalMode mode) {
   log::ReaderOptions read_opt = reader_options(in, cfg);
-  // the automatic choice may hand the rows on to the self-calibrating pass: its columns too
-  if (mode == est::SelfcalMode::kAuto) read_opt.fields |= kFieldAccel;
+  // the automatic choice may hand the rows on to the self-calibrating pass: its columns too (only
+  // for a file: a stream is never read twice, so its second pass never comes, nor a re-read below)
+  std::error_code ec;
+  if (mode == est::SelfcalMode::kAuto && fs::is_regular_file(in.log, ec)) read_opt.fields |= kFieldAccel;
   return read_opt;
 }
 
@@ -289,7 +291,7 @@ EstimatePass run_passes(const PassInputs& in, const est::EstimatorConfig& cfg, l
   } catch (const log::LogError&) {
     tee.detach();
     sc_pass.abandon();
-    if (!mask || reader.refused_group() != kFieldAccel) throw;
+    if (!mask || reader.refused_group() != kFieldAccel || !fs::is_regular_file(in.log)) throw;
     // an accel value, which the six-state pass does not read, is what the reader refused: that
     // pass again on a reader of its own (the self-calibrating pass then says what it refused)
     log::LogReader own(in.log, reader_options(in, cfg));

@@ -60,6 +60,16 @@ grep -q "the self-calibrating pass could not read the log (.*bad_accel.csv:[0-9]
   fail "bad accel: the reason is not said: $(cat "$t/bad.err")"
 grep -q '"used": false, "interrupted": false, "error": ".*accel1_x' "$t/bad/summary.json" || fail "bad accel: no error in summary.json"
 [[ ! -e "$t/bad/.selfcal-pass" ]] || fail "bad accel: the second pass's folder was left behind"
+# AND the same log through a FIFO (read once: no second pass, so its accel columns are not read)
+# THEN the six-state results as from the file, and the console says why no second pass
+mkfifo "$t/bad.fifo" && { cat "$t/bad_accel.csv" > "$t/bad.fifo" & }
+timeout 120 "$bin" estimate --log "$t/bad.fifo" --out "$t/badfifo" > /dev/null 2> "$t/badfifo.err"
+status=$?
+wait
+[[ $status -eq 1 ]] || fail "bad accel through a FIFO: expected exit 1 (the six-state verdict), got $status: $(cat "$t/badfifo.err")"
+grep -q "the log is not a regular file, so it cannot be read again" "$t/badfifo.err" ||
+  fail "bad accel through a FIFO: $(cat "$t/badfifo.err")"
+cmp -s "$t/bad/estimate.csv" "$t/badfifo/estimate.csv" || fail "bad accel through a FIFO: estimate.csv differs from the file's"
 "$bin" estimate --log "$t/sim/log.csv" --out "$t/forced" --selfcal > /dev/null 2>&1 || fail "--selfcal: exit $?"
 cmp -s "$t/auto/estimate.csv" "$t/forced/estimate.csv" || fail "defaults: estimate.csv differs from --selfcal's"
 cmp -s "$t/auto/attitude.csv" "$t/forced/attitude.csv" || fail "defaults: attitude.csv differs from --selfcal's"
