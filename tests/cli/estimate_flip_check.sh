@@ -10,12 +10,6 @@ bin=$1; src=$2
 source "$src/tests/cli/lib/outsider_log.sh"
 # shellcheck source=lib/navgen_runs.sh
 source "$src/tests/cli/lib/navgen_runs.sh"
-# first_finding NAME CAUSE SEVERITY: the first health finding of that run is CAUSE with SEVERITY
-first_finding() {
-  local got
-  got=$(grep -o '"cause": "[a-z_]*", "severity": "[a-z]*"' "$t/o_$1/summary.json" | head -1)
-  [ "$got" = "\"cause\": \"$2\", \"severity\": \"$3\"" ] || { cat "$t/$1.txt"; fail "$1: first finding $got, expected $2 ($3)"; }
-}
 no_flip_finding() {
   if grep -q '"cause": "flip' "$t/o_$1/summary.json"; then cat "$t/$1.txt"; fail "$1: a flip finding on a clean log"; fi
 }

@@ -11,3 +11,13 @@ run() {
   local rc=$?
   [ "$rc" = "$want" ] || { cat "$t/$name.txt"; fail "$name: exit $rc, expected $want"; }
 }
+
+# first_finding NAME CAUSE SEVERITY: the first health finding of run NAME is CAUSE with SEVERITY;
+# with skip_notes=1 set by the caller, the first that is not a note ("ok": a clipping MPU6050's
+# saturation notes lead)
+first_finding() {
+  local got
+  got=$(grep -o '"cause": "[a-z_]*", "severity": "[a-z]*"' "$t/o_$1/summary.json" |
+    if [ "${skip_notes:-0}" = 1 ]; then grep -v '"ok"'; else cat; fi | head -1)
+  [ "$got" = "\"cause\": \"$2\", \"severity\": \"$3\"" ] || { cat "$t/$1.txt"; fail "$1: first finding $got, expected $2 ($3)"; }
+}
