@@ -442,24 +442,23 @@ DriftlessFilter::WindowWander DriftlessFilter::window_wander(double t_first_s, d
   return {0.5 * T + g, T / 3.0 + g};
 }
 
-template <int D>
-bool DriftlessFilter::update(const Eigen::Matrix<double, D, 1>& r, const Eigen::Matrix<double, D, kFullStateDim>& H,
-                             const Eigen::Matrix<double, D, D>& R, UpdateRecord& rec, bool may_relock,
+bool DriftlessFilter::update(const Rows& r, const Rows& H, const Rows& R, UpdateRecord& rec, bool may_relock,
                              WindowWander wander) {
+  const int D = int(r.rows());
   // P here is P_k + Q_k (predict_to ran); the recursion of section 2, S^-1 through a Cholesky solve.
   // A window average (section 1h): the noise -H_b u is correlated with the prior's error,
   // C = Cov(e, n) = -q c H_b^T, so P H^T + C replaces P H^T and S = H P H^T + H C + C^T H^T + R
   // + q v H_b H_b^T; the gain and both covariance forms below take them as they are
-  Eigen::Matrix<double, kFullStateDim, D> PHt = P_ * H.transpose();
-  Eigen::Matrix<double, D, D> S = R;
+  Eigen::MatrixXd PHt = P_ * H.transpose();
+  Eigen::MatrixXd S = R;
   if (wander.c_s > 0.0 || wander.v_s > 0.0) {
-    const Eigen::Matrix<double, D, kStateDim> Hb = H.template leftCols<kStateDim>();
-    PHt.template topRows<kStateDim>() -= (q_rate_dps2_per_s_ * wander.c_s) * Hb.transpose();
+    const Eigen::MatrixXd Hb = H.leftCols(kStateDim);
+    PHt.topRows(kStateDim) -= (q_rate_dps2_per_s_ * wander.c_s) * Hb.transpose();
     S += (q_rate_dps2_per_s_ * (wander.v_s - wander.c_s)) * Hb * Hb.transpose();  // + C^T H^T here, H C below
   }
   S += H * PHt;
-  Eigen::LLT<Eigen::Matrix<double, D, D>> llt(S);
-  const Eigen::Matrix<double, D, 1> innov = r - H * x_;
+  Eigen::LLT<Eigen::MatrixXd> llt(S);
+  const Eigen::VectorXd innov = r - H * x_;
   rec.dim = D;
   rec.innovation_dps.setZero();
   rec.innovation_dps.head(D) = innov;
@@ -485,14 +484,14 @@ bool DriftlessFilter::update(const Eigen::Matrix<double, D, 1>& r, const Eigen::
     // one try on the widened P: the part of the innovation outside H's range (a rank-deficient
     // stacked H, a residual the model cannot explain) does not shrink with P, so a second re-lock
     // from here would recurse without end
-    return update<D>(r, H, R, rec, /*may_relock=*/false, wander);
+    return update(r, H, R, rec, /*may_relock=*/false, wander);
   }
   consecutive_rejections_ = 0;
   // an offline smoother keeps the state before the gain (the prediction) and after it
   std::unique_ptr<std::pair<StateVector, StateMatrix>> prior;
   if (observer_ != nullptr) prior = std::make_unique<std::pair<StateVector, StateMatrix>>(x_, P_);
   // W = (P + Q) H^T S^-1
-  const Eigen::Matrix<double, kFullStateDim, D> W = llt.solve(PHt.transpose()).transpose();
+  const Eigen::MatrixXd W = llt.solve(PHt.transpose()).transpose();
   x_ += W * innov;
   if (cfg_.covariance_update == CovarianceUpdate::kJoseph) {
     // (I - W H) P (I - W H)^T + W R W^T multiplied out, P H^T = PHt: P - W (H P) - (W (H P))^T +
@@ -588,11 +587,11 @@ int DriftlessFilter::use_segment(const StandstillSegment& s) {
     Eigen::Matrix<double, 4, 4> R4 = Eigen::Matrix<double, 4, 4>::Zero();
     R4.topLeftCorner<3, 3>() = cur.R;
     R4(3, 3) = var_z;
-    const bool ok = update<4>(r4, H4, R4, rec, true, wander);
+    const bool ok = update(r4, H4, R4, rec, true, wander);
     emit_update(rec, ok);
     result = ok ? 1 : -1;
   } else if (cfg_.mode == FilterMode::kGeneral) {
-    const bool ok = update<3>(cur.r, cur.H, cur.R, rec, true, wander);
+    const bool ok = update(cur.r, cur.H, cur.R, rec, true, wander);
     emit_update(rec, ok);
     result = ok ? 1 : -1;
   } else if (prev_res_.valid && ((prev_res_.pattern + 1) % 4) == pattern) {
@@ -605,7 +604,7 @@ int DriftlessFilter::use_segment(const StandstillSegment& s) {
     Eigen::Matrix<double, 6, 6> R6 = Eigen::Matrix<double, 6, 6>::Zero();
     R6.block<3, 3>(0, 0) = prev_res_.R;
     R6.block<3, 3>(3, 3) = cur.R;
-    const bool ok = update<6>(r6, H6, R6, rec);
+    const bool ok = update(r6, H6, R6, rec);
     emit_update(rec, ok);
     result = ok ? 1 : -1;
   }
@@ -1124,7 +1123,7 @@ void DriftlessFilter::use_box_dwell() {
   if (!rest_row(seg, M1, M2, var_r, h, z(0), var_z(0))) return;
   var_z(0) += turn_dps * turn_dps;  // a turn below the row's sigma (unturned_dwell) is noise
   UpdateRecord rec;  // not emitted: the platform updates' record and counts stay theirs
-  const bool ok = update<1>(z, h, var_z, rec, false, wander);
+  const bool ok = update(z, h, var_z, rec, false, wander);
   ++counters_.box_dwell_updates;
   if (!ok) ++counters_.box_dwell_rejected;
   predict_to(std::max(seg.t_last_s, t_filter_s_));
@@ -1193,20 +1192,11 @@ void DriftlessFilter::use_flip() {
   R.diagonal().array() += 6.0 * se * se * so * so * fr.span_s * fr.span_s;
   predict_to(std::max(0.5 * (flips_.t_start_s() + flips_.t_end_s()), t_filter_s_));
   UpdateRecord rec;  // not emitted: the standstill updates' record and counts stay theirs
-  const bool ok = update<3>(fr.z_deg, H, R, rec, false);
+  const bool ok = update(fr.z_deg, H, R, rec, false);
   ++counters_.flip_updates;
   if (!ok) ++counters_.flip_rejected;
   if (ok) counters_.flip_nis_sum += rec.nis;
   predict_to(std::max(flips_.t_end_s(), t_filter_s_));
 }
-
-template bool DriftlessFilter::update<1>(const Eigen::Matrix<double, 1, 1>&, const Eigen::Matrix<double, 1, kFullStateDim>&,
-                                         const Eigen::Matrix<double, 1, 1>&, UpdateRecord&, bool, WindowWander);
-template bool DriftlessFilter::update<3>(const Eigen::Matrix<double, 3, 1>&, const Eigen::Matrix<double, 3, kFullStateDim>&,
-                                         const Eigen::Matrix<double, 3, 3>&, UpdateRecord&, bool, WindowWander);
-template bool DriftlessFilter::update<4>(const Eigen::Matrix<double, 4, 1>&, const Eigen::Matrix<double, 4, kFullStateDim>&,
-                                         const Eigen::Matrix<double, 4, 4>&, UpdateRecord&, bool, WindowWander);
-template bool DriftlessFilter::update<6>(const Eigen::Matrix<double, 6, 1>&, const Eigen::Matrix<double, 6, kFullStateDim>&,
-                                         const Eigen::Matrix<double, 6, 6>&, UpdateRecord&, bool, WindowWander);
 
 }  // namespace driftless::est
