@@ -13,6 +13,7 @@ packages=(
   libbz2-dev liblz4-dev  # compressed bag chunks read directly (importers/bag_records.cpp)
   chromium  # the look test (tests/cli/look.sh) opens the report and the figures headless
   python3-numpy  # the independent log generator of the diagnose tests (tests/diagnose/independent_log.py)
+  zstd  # CI keeps the test generators' logs compressed for its second suite (tests/cli/lib/py_cached.sh)
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -3,7 +3,8 @@
 # tests/diagnose/probe_log.py by default; a script sets its own $gen after sourcing, e.g.
 # independent_log.py or tests/estimator/navgen.py). Expects $src (the source folder). Gives $py,
 # $gen, a scratch folder $t removed on exit, and fail(); exits 77 (skipped) when the Python has no numpy.
-py=/usr/bin/python3
+# python3, through the wrapper that shares the generated logs between CI's two suites (lib/py_cached.sh)
+py=$src/tests/cli/lib/py_cached.sh
 gen=$src/tests/diagnose/probe_log.py
 "$py" -c 'import numpy' 2>/dev/null || { echo "no numpy for $py: skipped"; exit 77; }
 t=$(mktemp -d); trap 'rm -rf "$t"' EXIT
