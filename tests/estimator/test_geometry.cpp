@@ -39,6 +39,25 @@ TEST(Geometry, LogMapInvertsExpMapAndTakesTheShortWay) {
   EXPECT_TRUE(rotvec_rad(Eigen::Quaterniond::Identity()).isZero(0.0));
 }
 
+// the small-angle series of both maps against the closed forms they stand in for (Eigen's
+// angle-axis quaternion, 2 atan2(s, w) / s), on both sides of each series' bound and at it: equal to
+// rounding (a few ulp; the series' omitted terms are below 1e-22)
+TEST(Geometry, TheSmallAngleSeriesEqualTheClosedFormsToRounding) {
+  const Eigen::Vector3d axis = Eigen::Vector3d(0.36, -0.48, 0.8);  // unit
+  for (double angle : {1e-150, 1e-12, 1e-6, 1e-3, 1.9e-3, 2.0e-3, 0.01, 0.0624, 0.0625, 0.0626, 0.2}) {
+    const Eigen::Vector3d phi = angle * axis;
+    const Eigen::Quaterniond exact(Eigen::AngleAxisd(angle, axis));
+    const Eigen::Quaterniond q = quat_from_rotvec(phi);
+    EXPECT_LE((q.coeffs() - exact.coeffs()).cwiseAbs().maxCoeff(), 4e-16) << angle;
+    EXPECT_LE((q.vec() - exact.vec()).norm(), 4e-16 * exact.vec().norm()) << angle;
+    const double s = exact.vec().norm();
+    const Eigen::Vector3d log_exact = exact.vec() * (2.0 * std::atan2(s, exact.w()) / s);
+    EXPECT_LE((rotvec_rad(exact) - log_exact).norm(), 4e-16 * angle) << angle;
+  }
+  EXPECT_TRUE(quat_from_rotvec(Eigen::Vector3d::Constant(std::nan(""))).coeffs().isApprox(
+      Eigen::Quaterniond::Identity().coeffs()));
+}
+
 TEST(Geometry, EarthRateHasWgs84MagnitudeAndItsLatitudeDerivative) {
   // 15.041 deg/h at any latitude; vertical component Omega sin(phi)
   EXPECT_NEAR(earth_rate_enu_radps(52.0).norm() * kDegPerRad * 3600.0, 15.0411, 1e-4);
