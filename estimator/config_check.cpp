@@ -14,8 +14,6 @@ namespace {
 
 constexpr double kBiasInstabilityFactor = 0.6642824702679600;  // sqrt(2 ln 2 / pi)
 
-bool finite(double v) { return std::isfinite(v); }
-
 }  // namespace
 
 void Calibration::validate() const {
@@ -48,7 +46,7 @@ void Calibration::validate() const {
     throw std::invalid_argument("calibration: end-stop angle errors with calibrated matrices, which hold the stop angles already");
   auto check = [&](const std::vector<CalibratedPosition>& list, int sensor) {
     for (const auto& p : list) {
-      if (!finite(p.plat_deg) || !p.M_body_from_sensor.allFinite()) {
+      if (!std::isfinite(p.plat_deg) || !p.M_body_from_sensor.allFinite()) {
         throw std::invalid_argument("calibration: sensor " + std::to_string(sensor) +
                                     " has a non-finite angle or matrix entry");
       }
@@ -85,7 +83,7 @@ void EstimatorConfig::validate() const {
   positive(angle_tolerance_deg, "angle_tolerance_deg", "deg");
   positive(gyro_motion_threshold_dps, "gyro_motion_threshold_dps", "deg/s");
   positive(standstill_period_s, "standstill_period_s", "s");
-  if (!finite(initial_plat1_deg) || !finite(initial_plat2_deg)) {
+  if (!std::isfinite(initial_plat1_deg) || !std::isfinite(initial_plat2_deg)) {
     throw std::invalid_argument("estimator config: initial_plat1_deg/initial_plat2_deg must be numbers (deg)");
   }
   positive(noise_density_dps_rthz, "noise_density_dps_rthz", "deg/s/sqrt(Hz)");
@@ -107,7 +105,7 @@ void EstimatorConfig::validate() const {
     throw std::invalid_argument("estimator config: self_calibration and box_at_rest need mode: general");
   }
   non_negative(temp_coef_sigma_dps_per_degc, "temp_coef_sigma_dps_per_degc", "deg/s per degC (0 = no temperature states)");
-  if (!finite(initial_bias_dps)) throw std::invalid_argument("estimator config: initial_bias_dps must be a number");
+  if (!std::isfinite(initial_bias_dps)) throw std::invalid_argument("estimator config: initial_bias_dps must be a number");
   positive(initial_sigma_dps, "initial_sigma_dps", "deg/s");
   positive(variance_floor_dps2, "variance_floor_dps2", "(deg/s)^2");
   if (gate_relock_after < 0) {
