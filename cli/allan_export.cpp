@@ -8,12 +8,11 @@
 #include <fmt/core.h>
 
 #include "cli/allan_result.hpp"
+#include "estimator/sample.hpp"
 #include "estimator/output_file.hpp"
 
 namespace driftless::cli::allan {
 namespace {
-
-constexpr double kRadPerDeg = 0.017453292519943295769;
 
 // one exported value: the fit's value or, when not identifiable, its 95 % upper bound
 struct Value {
@@ -33,7 +32,7 @@ Value worst(const Result& r, importers::Quantity q, bool noise, int axis) {
   Value best;
   for (const auto& c : r.channels) {
     if (c.quantity != q || (axis >= 0 && c.axis != axis)) continue;
-    const double scale = q == importers::Quantity::kRate ? kRadPerDeg : 1.0;
+    const double scale = q == importers::Quantity::kRate ? driftless::kRadPerDeg : 1.0;
     const Value v = pick(noise ? c.fit.N : c.fit.K, scale, c.name);
     if (std::isfinite(v.v) && (!std::isfinite(best.v) || v.v > best.v)) best = v;
     if (axis >= 0 && std::isfinite(best.v)) break;

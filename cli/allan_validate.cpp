@@ -8,12 +8,11 @@
 #include <fmt/core.h>
 
 #include "cli/allan_result.hpp"
+#include "estimator/sample.hpp"
 #include "twin/sensor/sensor_model.hpp"
 
 namespace driftless::cli::allan {
 namespace {
-
-constexpr double kRadPerDeg = 0.017453292519943295769;
 
 // the peak of a Gauss-Markov Allan deviation per unit sigma, and where it lies (tau / T)
 std::pair<double, double> gm_peak() {
@@ -112,7 +111,7 @@ void validate_group(const Result& r, std::array<ChannelResult*, 3> axes, std::si
     twin::SensorModel model(p, r.rate_hz, twin::derive_seed(seed, 7000 + rec));
     for (std::size_t k = 0; k < n; ++k) {
       const auto y = model.step(twin::SensorTruth{static_cast<double>(k) / r.rate_hz, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()});
-      for (int ax = 0; ax < 3; ++ax) x[ax][k] = y.gyro_radps[ax] / kRadPerDeg;
+      for (int ax = 0; ax < 3; ++ax) x[ax][k] = y.gyro_radps[ax] / driftless::kRadPerDeg;
     }
     for (int ax = 0; ax < 3; ++ax) {
       if (axes[ax] == nullptr) continue;

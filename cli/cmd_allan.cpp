@@ -176,7 +176,7 @@ void add_input_options(CLI::App* cmd, AllanArgs& a) {
       ->check(CLI::IsMember({"split", "ignore"}));
 }
 
-const bool registered = register_command(40, [](CLI::App& app) {
+const bool registered_allan = register_command(40, [](CLI::App& app) {
   auto* cmd = app.add_subcommand("allan",
                                  "Allan / modified Allan / Hadamard deviations (deg/s vs tau in s) with NIST SP 1065 "
                                  "intervals, joint fit of Q, N, B, K, R, noise files for Kalibr, OpenVINS, VINS-Mono");

@@ -20,7 +20,7 @@
 namespace driftless::cli {
 namespace {
 
-struct Options {
+struct CalibrateOptions {
   std::string scenario, log, plan, out, method, save_log, save_plan, prior_out;
 };
 
@@ -60,14 +60,14 @@ void print_summary(const est::CalibFit& fit, const calib::RigConditions& rig,
 }
 
 // --prior-out: the calibrated errors as a twin model-config file
-void write_prior(const Options& o) {
+void write_prior(const CalibrateOptions& o) {
   if (o.prior_out.empty()) return;
   const calib::CalibFile c = calib::load_calib(o.out);
   io::write_file(o.prior_out, calib::model_prior_yaml(c));
   fmt::print("wrote {} (model prior)\n", o.prior_out);
 }
 
-int run_from_log(const Options& o) {
+int run_from_log(const CalibrateOptions& o) {
   log::Metadata meta;
   const std::vector<Sample> samples = log::read_all(o.log, &meta);
   const calib::RigPlan plan = calib::load_rig_plan(o.plan);
@@ -94,7 +94,7 @@ int run_from_log(const Options& o) {
   return 0;
 }
 
-int run_from_scenario(const Options& o) {
+int run_from_scenario(const CalibrateOptions& o) {
   const calib::CalibScenario cs = calib::load_calib_scenario(o.scenario);
   calib::RigRun run;
   {
@@ -156,13 +156,13 @@ int run_from_scenario(const Options& o) {
   return 0;
 }
 
-const bool registered = register_command(40, [](CLI::App& app) {
+const bool registered_calibrate = register_command(40, [](CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "calibrate",
       "Calibrate the box on a pan/tilt unit (paper section 4): fit M per sensor and end stop "
       "from a recorded log + rig plan, or run the simulated rig of a scenario; writes calib.yaml "
       "(docs/calibration.md)");
-  auto o = std::make_shared<Options>();
+  auto o = std::make_shared<CalibrateOptions>();
   auto* scen = cmd->add_option("--scenario", o->scenario,
                                "Scenario with a calibration: block; runs the twin's pan/tilt rig "
                                "(e.g. models/scenarios/calibration.yaml)")

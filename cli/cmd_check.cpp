@@ -138,7 +138,7 @@ int run_check(const std::string& path) {
   return unusable ? 1 : 0;
 }
 
-const bool registered = register_command(90, [](CLI::App& app) {
+const bool registered_check = register_command(90, [](CLI::App& app) {
   auto* cmd = app.add_subcommand("check", "Validate a measurement log (docs/log-format.md, the same validation "
                                           "every command applies) and summarise it; exit 1 on a refused log, one "
                                           "without data rows, or stamps in another unit than seconds");

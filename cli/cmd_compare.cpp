@@ -12,12 +12,12 @@
 namespace driftless::cli {
 namespace {
 
-struct Args {
+struct CompareCommandArgs {
   CompareArgs common;
   std::string before;
 };
 
-int run_compare(const Args& a) {
+int run_compare(const CompareCommandArgs& a) {
   Progress progress("compare");
   const CompareSetup s = setup_compare(a.common);
   progress.update(0.3, "replayed");
@@ -42,11 +42,11 @@ int run_compare(const Args& a) {
   return finish_report("compare", a.common, r, 0);
 }
 
-const bool registered = register_command(50, [](CLI::App& app) {
+const bool registered_compare = register_command(50, [](CLI::App& app) {
   auto* cmd = app.add_subcommand("compare", "Compare the model with a measurement log: residual per channel, regime and "
                                             "window, whiteness and Allan deviation against the model's noise, and the "
                                             "missing effects by forward selection (docs/compare.md)");
-  auto a = std::make_shared<Args>();
+  auto a = std::make_shared<CompareCommandArgs>();
   add_compare_options(*cmd, a->common);
   cmd->add_option("--before", a->before, "An earlier model YAML: report the residual before (this) and after (--model)")
       ->check(CLI::ExistingFile);

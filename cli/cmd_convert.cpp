@@ -324,7 +324,7 @@ int run_convert(const ConvertArgs& a) {
   return kExitOk;
 }
 
-const bool registered = register_command(
+const bool registered_convert = register_command(
     45,
     [](CLI::App& app) {
       auto* cmd = app.add_subcommand("convert",

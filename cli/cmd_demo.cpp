@@ -163,7 +163,7 @@ int run_demo(const DemoArgs& a) {
   return failed == 0 && all_ran ? 0 : 1;
 }
 
-const bool registered = register_command(0, [](CLI::App& app) {
+const bool registered_demo = register_command(0, [](CLI::App& app) {
   auto* cmd = app.add_subcommand("demo", "The main job on the built-in default scenario: simulate, estimate "
                                          "(with plots), model-vs-measurement report and a rendered video into "
                                          "DIR; then checks that each output holds what it claims and says where "

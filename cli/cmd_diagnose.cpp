@@ -14,14 +14,14 @@
 namespace driftless::cli {
 namespace {
 
-struct Args {
+struct DiagnoseArgs {
   CompareArgs common;
   std::string apply;
 };
 
 // writes the selected set into a copy of the model, saves it, compares again; the exit code
 // says whether the written model explains the log
-int apply_and_check(const Args& a, const CompareSetup& s, const diagnose::CompareResult& r, diagnose::ReportExtras& x) {
+int apply_and_check(const DiagnoseArgs& a, const CompareSetup& s, const diagnose::CompareResult& r, diagnose::ReportExtras& x) {
   diagnose::CompareModel updated = s.model;
   const diagnose::ApplyReport rep = diagnose::apply_result(updated, r);
   diagnose::save_compare_model(updated, a.apply);
@@ -48,7 +48,7 @@ int apply_and_check(const Args& a, const CompareSetup& s, const diagnose::Compar
   return 0;
 }
 
-int run_diagnose(const Args& a) {
+int run_diagnose(const DiagnoseArgs& a) {
   Progress progress("diagnose");
   const CompareSetup s = setup_compare(a.common);
   const diagnose::CompareResult r = diagnose::compare(s.replay, s.model, s.opt);
@@ -66,11 +66,11 @@ int run_diagnose(const Args& a) {
   return finish_report("diagnose", a.common, r, code);
 }
 
-const bool registered = register_command(51, [](CLI::App& app) {
+const bool registered_diagnose = register_command(51, [](CLI::App& app) {
   auto* cmd = app.add_subcommand("diagnose", "Find the effects the model misses (forward selection: physical and signal-chain "
                                              "effects first, then the noise model) and, with --apply, write the model with "
                                              "all of them and compare again (docs/compare.md)");
-  auto a = std::make_shared<Args>();
+  auto a = std::make_shared<DiagnoseArgs>();
   add_compare_options(*cmd, a->common);
   cmd->add_option("--apply", a->apply, "Write the model with every selected effect and noise-model change to this YAML "
                   "file, then compare again; exit 1 unless the new model is consistent with the log");

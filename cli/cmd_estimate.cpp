@@ -361,7 +361,7 @@ int run_estimate_cmd(const EstimateArgs& a) {
   return report_health(a, pass.cfg, summary.health);
 }
 
-const bool registered = register_command(30, [](CLI::App& app) {
+const bool registered_estimate = register_command(30, [](CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "estimate", "Run the DriftLess bias filter over a measurement log: bias estimates (deg/s), "
                   "corrected outputs, attitude drift (deg/h); docs/estimator.md");

@@ -295,7 +295,7 @@ int run_hil(const HilOptions& o) {
   return report_fdi(*fdi, fdi_json);
 }
 
-const bool registered = register_command(60, [](CLI::App& app) {
+const bool registered_hil = register_command(60, [](CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "hil", "Run the estimator live on the twin, a replayed log, MPU-6050s on I2C, the box's serial link or "
              "their emulators; record a measurement log; switch sources mid-run (docs/hil.md)");

@@ -163,7 +163,7 @@ int run_render(const RenderArgs& a) {
   return kExitOk;
 }
 
-const bool registered = register_command(60, [](CLI::App& app) {
+const bool registered_render = register_command(60, [](CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "render",
       "Render an off-screen video (MP4, H.264 via ffmpeg; PNG frames if ffmpeg is missing) of a "

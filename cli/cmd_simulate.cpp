@@ -50,7 +50,7 @@ int run_simulate(const SimulateArgs& a) {
   return r.complete ? kExitOk : interrupted_exit_code();
 }
 
-const bool registered = register_command(10, [](CLI::App& app) {
+const bool registered_simulate = register_command(10, [](CLI::App& app) {
   auto* cmd = app.add_subcommand("simulate",
                                  "Simulate a scenario in the MuJoCo twin: writes DIR/log.csv (docs/log-format.md) "
                                  "and DIR/scenario.resolved.yaml (docs/scenario.md)");

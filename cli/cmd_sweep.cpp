@@ -25,7 +25,7 @@ namespace {
 
 using namespace driftless::studies;
 
-struct Options {
+struct SweepOptions {
   std::string config;
   std::string out;
   int jobs = 0;
@@ -82,7 +82,7 @@ bool launched_by_mpirun() {
 }
 #endif
 
-int run_sweep(const Options& opt) {
+int run_sweep(const SweepOptions& opt) {
   int rank = 0, size = 1;
 #ifdef DRIFTLESS_HAVE_MPI
   const bool mpi = launched_by_mpirun();
@@ -201,12 +201,12 @@ int run_sweep(const Options& opt) {
   return failed == 0 && failed_ranks == 0 ? 0 : 1;
 }
 
-const bool registered = register_command(60, [](CLI::App& app) {
+const bool registered_sweep = register_command(60, [](CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "sweep",
       "Run a parameter grid x Monte-Carlo seeds (docs/sweep.md) in parallel over the local cores "
       "(and over MPI ranks under mpirun); writes runs.csv, summary.csv and gnuplot plots");
-  auto opt = std::make_shared<Options>();
+  auto opt = std::make_shared<SweepOptions>();
   cmd->add_option("--config", opt->config, "Sweep file (YAML, models/sweeps/*.yaml)")
       ->required()
       ->check(CLI::ExistingFile);
