@@ -404,9 +404,16 @@ bool pick_positional(TextLayout& L) {
   if (n == 6) {
     for (int k = 0; k < 3; ++k) add_pick(L, first + 3 + k, Quantity::kAccel, k);
   }
-  L.assumptions.push_back(std::string("no header: columns ") + (first ? "2-4" : "1-3") + " taken as gyro x, y, z" +
-                          (n == 6 ? std::string(", ") + (first ? "5-7" : "4-6") + " as accel x, y, z" : std::string()) +
-                          " (give --columns to change)");
+  std::string note = "no header: columns ";
+  note += first ? "2-4" : "1-3";
+  note += " taken as gyro x, y, z";
+  if (n == 6) {
+    note += ", ";
+    note += first ? "5-7" : "4-6";
+    note += " as accel x, y, z";
+  }
+  note += " (give --columns to change)";
+  L.assumptions.push_back(std::move(note));
   return true;
 }
 
