@@ -1,0 +1,2 @@
+// The source the libraries' shared precompiled header is built with (cmake/DriftlessFlags.cmake);
+// it holds no code.
