@@ -43,25 +43,32 @@ function(driftless_pch_for_ccache target)
   endif()
 endfunction()
 
-# The libraries' precompiled header: Eigen and the standard library, whose parse was about a third
-# of a library file's compile CPU (~1.3 s of 3-4 s per file, in ~130 files, GCC 12; the same in the
-# sanitizer build). One header for every library, not one each: a GCC header of these is ~110 MB,
-# and one per library made 2.3 GB in CI's two builds and pushed the tests' objects out of ccache's
-# 1 GB (a warm CI of 2026-12-02 missed 89 of 406 compiles). Its flags are the libraries' own
-# (driftless_flags; -fPIC in the shared sanitizer build), so GCC accepts it for each of them; what
-# differs between libraries (their definitions, e.g. FMT_SHARED) does not appear in these headers.
-add_library(driftless_library_pch OBJECT ${CMAKE_CURRENT_LIST_DIR}/pch_anchor.cpp)
-target_link_libraries(driftless_library_pch PRIVATE Eigen3::Eigen driftless_flags)
-set_target_properties(driftless_library_pch PROPERTIES POSITION_INDEPENDENT_CODE "${BUILD_SHARED_LIBS}")
-target_precompile_headers(driftless_library_pch PRIVATE
+# The libraries' precompiled header (driftless_libraries_pch): Eigen and the standard library,
+# whose parse was about a third of a library file's compile CPU (~1.3 s of 3-4 s per file, in ~130
+# files, GCC 12; the same in the sanitizer build). One header for every library, not one each: a
+# GCC header of these is ~110 MB, and one per library made 2.3 GB in CI's two builds and pushed
+# the tests' objects out of ccache's 1 GB (a warm CI of 2026-12-02 missed 89 of 406 compiles).
+# Its flags are the libraries' own (driftless_flags; -fPIC in the shared sanitizer build), so GCC
+# accepts it for each of them; what differs between libraries (their definitions, e.g. FMT_SHARED)
+# does not appear in these headers.
+add_library(driftless_libraries_pch OBJECT ${CMAKE_CURRENT_LIST_DIR}/pch_anchor.cpp)
+target_link_libraries(driftless_libraries_pch PRIVATE Eigen3::Eigen driftless_flags)
+set_target_properties(driftless_libraries_pch PROPERTIES POSITION_INDEPENDENT_CODE "${BUILD_SHARED_LIBS}")
+target_precompile_headers(driftless_libraries_pch PRIVATE
   <Eigen/Core> <Eigen/Geometry>
   <algorithm> <array> <cmath> <cstdint> <limits> <memory> <sstream> <stdexcept> <string> <vector>)
-driftless_pch_for_ccache(driftless_library_pch)
-# driftless_library_pch(target): the library compiles with that header (ccache caches its files:
-# scripts/build.sh sets its pch sloppiness)
+driftless_pch_for_ccache(driftless_libraries_pch)
+# driftless_library_pch(target [NOT_PCH file ...]): the library compiles with that header (ccache
+# caches its files: scripts/build.sh sets its pch sloppiness). The NOT_PCH files compile without
+# it: with the header precompiled, GCC 12 reports a false -Warray-bounds in them, inside
+# std::string's inlined copy of a literal (GCC bugs 105329, 105651), not in our code.
 function(driftless_library_pch target)
-  target_precompile_headers(${target} REUSE_FROM driftless_library_pch)
+  cmake_parse_arguments(ARG "" "" "NOT_PCH" ${ARGN})
+  target_precompile_headers(${target} REUSE_FROM driftless_libraries_pch)
   driftless_pch_for_ccache(${target})
+  if(ARG_NOT_PCH)
+    set_source_files_properties(${ARG_NOT_PCH} PROPERTIES SKIP_PRECOMPILE_HEADERS ON)
+  endif()
 endfunction()
 
 # the repository root is the include root, so an include names its folder:
