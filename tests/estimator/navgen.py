@@ -158,6 +158,39 @@ def quat_from_C(C):
     return np.stack([qw, qx, qy, qz], 1)
 
 
+def format_rows(args, ts, keep, ys, reps, q, fs, temps, biases):
+    """A chunk's CSV rows as one text. A row whose stamp (rounded to 1e-6 of its unit) does not
+    increase on the previous kept row is dropped. One %-format per row for its numbers: the same
+    digits as a format per number (both are Python's correctly rounded fixed notation), at a
+    third of the time; an empty platform angle (NaN) is an empty field."""
+    tscale = {"s": 1, "ms": 1e3, "us": 1e6, "ns": 1e9}[args.tunit]
+    kept = np.nonzero(keep)[0]
+    sel, stamps, prev = [], [], -1e300
+    for k, tv in zip(kept.tolist(), np.round(ts[kept] * tscale, 6).tolist()):
+        if tv <= prev:
+            continue
+        prev = tv
+        sel.append(k)
+        stamps.append(tv)
+    head = np.column_stack([np.array(stamps, dtype=float), ys[0][sel], ys[1][sel]]).tolist()
+    head_fmt = ("%.6f" if args.tunit == "s" else "%.0f") + ",%.7f" * 6
+    angles = [["" if math.isnan(v) else "%.6f" % v for v in reps[j][sel].tolist()] for j in range(2)]
+    parts = []
+    if not args.no_ref:
+        parts.append((q[sel], "%.10f"))
+    if not args.no_accel:
+        parts += [(fs[0][sel], "%.5f"), (fs[1][sel], "%.5f")]
+    if args.temp:
+        parts += [(temps[0][sel][:, None], "%.3f"), (temps[1][sel][:, None], "%.3f")]
+    if not args.no_truth:
+        parts += [(biases[0][sel], "%.9f"), (biases[1][sel], "%.9f")]
+    tail_fmt = "".join(("," + f) * a.shape[1] for a, f in parts)
+    tail = np.column_stack([a for a, _ in parts]).tolist() if parts else [[]] * len(sel)
+    lines = [head_fmt % tuple(h) + "," + a1 + "," + a2 + tail_fmt % tuple(r)
+             for h, a1, a2, r in zip(head, angles[0], angles[1], tail)]
+    return "\n".join(lines) + "\n"
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--out", required=True)
@@ -226,7 +259,6 @@ def main():
     lpf = [args.lowpass, args.lowpass if args.lowpass2 is None else args.lowpass2]
     dt = 1.0 / args.rate
     nt = int(round(args.duration * args.rate))
-    tscale = {"s": 1, "ms": 1e3, "us": 1e6, "ns": 1e9}[args.tunit]
     gaps = [tuple(float(x) for x in g.split(":")) for g in args.gap]
 
     out = open(args.out, "w")
@@ -315,29 +347,7 @@ def main():
         keep = np.ones(n, bool)
         for (g0, gl) in gaps:
             keep &= ~((ts >= g0) & (ts < g0 + gl))
-        lines = []
-        prev = -1e300
-        for k in np.nonzero(keep)[0]:
-            tv = round(ts[k] * tscale, 6)
-            if tv <= prev:
-                continue
-            prev = tv
-            if args.tunit == "s":
-                row = [f"{tv:.6f}"]
-            else:
-                row = [f"{tv:.0f}"]
-            row += [f"{v:.7f}" for v in ys[0][k]] + [f"{v:.7f}" for v in ys[1][k]]
-            row += ["" if np.isnan(reps[j][k]) else f"{reps[j][k]:.6f}" for j in range(2)]
-            if not args.no_ref:
-                row += [f"{v:.10f}" for v in q[k]]
-            if not args.no_accel:
-                row += [f"{v:.5f}" for v in fs[0][k]] + [f"{v:.5f}" for v in fs[1][k]]
-            if args.temp:
-                row += [f"{temps[0][k]:.3f}", f"{temps[1][k]:.3f}"]
-            if not args.no_truth:
-                row += [f"{v:.9f}" for v in biases[0][k]] + [f"{v:.9f}" for v in biases[1][k]]
-            lines.append(",".join(row))
-        out.write("\n".join(lines) + "\n")
+        out.write(format_rows(args, ts, keep, ys, reps, q, fs, temps, biases))
         last_bias = [biases[0][-1], biases[1][-1]]
     out.close()
     import json
