@@ -77,6 +77,26 @@ TEST(ParseDecimal, MatchesFromCharsOnLogTextAndOthers) {
       const char* end = parse_decimal(t.data(), t.data() + t.size(), got);
       ASSERT_EQ(end, t.data() + t.size()) << t;
       ASSERT_EQ(got, reference(t)) << t;
+      // inside a row: eight bytes or more follow the number, so its digits are read eight bytes
+      // at a time, and the run of digits must end at the comma, whatever its length
+      const std::string row = t + ",12345678,9";
+      got = 0.0;
+      end = parse_decimal(row.data(), row.data() + row.size(), got);
+      ASSERT_EQ(end, row.data() + t.size()) << row;
+      ASSERT_EQ(got, reference(t)) << row;
+    }
+  }
+  // every length of integer and fraction digits (0-20), followed by a comma and more digits
+  for (int whole = 0; whole <= 20; ++whole) {
+    for (int frac = 0; frac <= 20; ++frac) {
+      std::string t = std::string(static_cast<std::size_t>(whole), '7');
+      if (frac > 0) t += "." + std::string(static_cast<std::size_t>(frac), '3');
+      if (t.empty()) continue;
+      const std::string row = t + ",9876543210";
+      double got = 0.0;
+      const char* end = parse_decimal(row.data(), row.data() + row.size(), got);
+      ASSERT_EQ(end, row.data() + t.size()) << row;
+      ASSERT_EQ(got, reference(t)) << row;
     }
   }
   for (const std::string t : {"0", "-0", "+1.5", "1e308", "-2.5E-3", "123456789012345678901234", "0.1234567890123456789",
